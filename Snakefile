@@ -1,0 +1,22 @@
+# traj2events: synthetic event-camera datasets from mass-optimal lunar landings.
+#
+#   snakemake --cores 2                              # the default dataset (config/config.yaml)
+#   snakemake --cores 2 --configfile config/paper.yaml
+#
+# Stages so far: base solve per scenario -> continuation sampling -> camera poses.
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/trajectories.smk"
+
+
+rule all:
+    input:
+        all_outputs,
+    default_target: True

@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Set up traj2events on a fresh Debian/Ubuntu machine: system packages (if missing), then
+# a .venv with the package and its pinned dependencies. Idempotent: a second run with
+# nothing changed only checks and returns.
+#   bash setup.sh            # runtime
+#   bash setup.sh --test     # runtime + test dependencies
+set -euo pipefail
+cd "$(dirname "$0")"
+
+extras="" ; [[ "${1:-}" == "--test" ]] && extras="[test]"
+
+need_apt=()
+command -v python3 >/dev/null || need_apt+=(python3)
+python3 -c "import ensurepip, venv" 2>/dev/null || need_apt+=(python3-venv)
+command -v git >/dev/null || need_apt+=(git)
+if ((${#need_apt[@]})); then
+  echo "setup: installing system packages: ${need_apt[*]}"
+  SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_apt[@]}" python3-dev >/dev/null
+fi
+
+[[ -x .venv/bin/python ]] || python3 -m venv .venv
+# Reinstall only when the package's requirements change.
+stamp=".venv/.traj2events-setup"
+want="$(sha256sum pyproject.toml | cut -d' ' -f1)$extras"
+if [[ "$(cat "$stamp" 2>/dev/null)" != "$want" ]]; then
+  echo "setup: installing Python packages into .venv"
+  .venv/bin/python -m pip install -q --upgrade pip
+  .venv/bin/python -m pip install -q -e ".$extras"
+  echo "$want" > "$stamp"
+fi
+.venv/bin/traj2events --version

@@ -1,0 +1,211 @@
+"""Command-line interface: `traj2events SUBCOMMAND --help`. The workflow's rules call these."""
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")  # one process per core is faster than BLAS threads
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from . import __version__
+
+
+def _settings(args):
+    from .config import ScenarioSettings
+
+    text = Path(args.settings[1:]).read_text() if args.settings.startswith("@") else args.settings
+    return ScenarioSettings.from_json(text)
+
+
+def _log(msg: str) -> None:
+    print(f"[{time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
+
+
+def cmd_check_config(args) -> int:
+    from .config import load_config
+
+    config = load_config(args.config, args.schema)
+    n = sum(sc["n_trajectories"] for sc in config["scenarios"].values())
+    print(f"{args.config}: valid ({len(config['scenarios'])} scenarios, {n} trajectories)")
+    return 0
+
+
+def cmd_base(args) -> int:
+    from .io import solution_attrs, vehicle_attrs, write_trajectory
+    from .ocp import LandingProblem, replace_tf_guess
+    from .scenarios import base_conditions
+
+    s = _settings(args)
+    problem = LandingProblem(s.vehicle, s.ocp)
+    bc = base_conditions(s.scenario, s.vehicle)
+    # A cold start is robust (trajectories.md); other t_f guesses are the retries.
+    for factor in (1.0, 0.5, 2.0):
+        trial = replace_tf_guess(bc, bc.tf_guess_s * factor)
+        _log(f"{s.scenario.name}: base solve, N = {s.ocp.n_nodes}, t_f guess {trial.tf_guess_s:.1f} s")
+        sol = problem.solve(trial)
+        _log(f"{s.scenario.name}: {sol.status} after {sol.iterations} iterations, {sol.solve_time_s:.2f} s")
+        if sol.success:
+            break
+    else:
+        print(f"error: scenario '{s.scenario.name}': the base problem (midpoint of every range) did not solve: "
+              f"{sol.status}. Check the ranges and vehicle in the config.", file=sys.stderr)
+        return 1
+    attrs = {**vehicle_attrs(s.vehicle), **solution_attrs(sol, bc), "scenario": s.scenario.name,
+             "epsilon": s.ocp.epsilon, "traj2events_version": __version__}
+    write_trajectory(args.output, (sol.t, sol.state, sol.control), None, attrs)
+    return 0
+
+
+def cmd_sample(args) -> int:
+    import pandas as pd
+
+    from .batch import print_progress, solve_samples
+    from .io import atomic_output, read_trajectory, write_solution_set
+    from .ocp import Solution
+    from .scenarios import base_conditions
+
+    s = _settings(args)
+    base_file = read_trajectory(args.base)
+    base = Solution(base_file.t_nodes, base_file.state_nodes, base_file.control_nodes, float(base_file.attrs["cost"]),
+                    True, str(base_file.attrs["solver_status"]), 0, 0.0, s.ocp.transcription)
+    _log(f"{s.scenario.name}: solving {s.scenario.n_trajectories} samples on {args.jobs} process(es)")
+    start = time.perf_counter()
+    results = solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base,
+                            jobs=args.jobs, progress=print_progress)
+    failed = [r for r in results if not r.success]
+    _log(f"{s.scenario.name}: {len(results) - len(failed)} solved, {len(failed)} failed, "
+         f"{time.perf_counter() - start:.1f} s wall")
+
+    rows = []
+    for r in results:
+        draws = initial_values(r.conditions.initial)
+        rows.append({
+            "id": r.index, "success": r.success, "method": r.method, "attempts": r.attempts,
+            "status": r.solution.status, "reason": "" if r.success else f"{r.method}: {r.solution.status}",
+            "iterations": r.solution.iterations, "total_iterations": r.total_iterations,
+            "tf_s": r.solution.tf_s, "final_mass_kg": r.solution.state[-1, 12], "cost": r.solution.cost,
+            "error_position_m": r.error_position_m, "error_velocity_m_s": r.error_velocity_m_s,
+            "solve_time_s": r.total_time_s, **draws,
+        })
+    attrs = {"scenario": s.scenario.name, "seed": s.seed, "settings": s.to_json(),
+             "traj2events_version": __version__}
+    write_solution_set(args.output, results, attrs)
+    with atomic_output(args.table) as tmp:
+        pd.DataFrame(rows).to_csv(tmp, index=False, float_format="%.9g")
+    return 0
+
+
+def initial_values(x0: np.ndarray) -> dict:
+    """A sample's drawn initial values in config units and names (for the table)."""
+    from .scenarios import RANGE_KEYS
+
+    values = [-x0[0], x0[1], -x0[2], x0[3], x0[4], x0[5], *np.degrees(x0[6:9])]
+    return dict(zip(RANGE_KEYS, values))
+
+
+def cmd_upsample(args) -> int:
+    from .dynamics import Dynamics
+    from .io import read_solution_set, solution_attrs, vehicle_attrs, write_trajectory
+    from .ocp import BoundaryConditions, Solution
+    from .upsample import upsample
+
+    data = read_solution_set(args.solutions)
+    from .config import ScenarioSettings
+
+    s = ScenarioSettings.from_json(data["attrs"]["settings"])
+    row = int(np.flatnonzero(data["index"] == args.id)[0]) if args.id in data["index"] else None
+    if row is None or not data["success"][row]:
+        print(f"error: {args.solutions}: sample {args.id} is not a solved sample", file=sys.stderr)
+        return 1
+    t, state, control = data["t"][row], data["state"][row], data["control"][row]
+    sol = Solution(t, state, control, float(data["cost"][row]), True, str(data["status"][row]),
+                   int(data["iterations"][row]), float(data["solve_time_s"][row]), s.ocp.transcription)
+    bc = BoundaryConditions(data["initial_state"][row], data["final_state"][row], s.scenario.tf_guess_s)
+    poses = upsample(Dynamics(s.vehicle), t, state, control, args.fps, args.method)
+    _log(f"{s.scenario.name}/{args.id:04d}: {len(poses[0])} poses at {args.fps:g} fps ({args.method})")
+    attrs = {**vehicle_attrs(s.vehicle), **solution_attrs(sol, bc), "fps": args.fps, "upsampling": args.method,
+             "scenario": s.scenario.name, "id": args.id, "seed": s.seed, "epsilon": s.ocp.epsilon,
+             "continuation": str(data["method"][row]), "traj2events_version": __version__}
+    write_trajectory(args.output, (t, state, control), poses, attrs)
+    return 0
+
+
+def cmd_summary(args) -> int:
+    from .figures import dataset_figure, summary_table
+    from .io import atomic_output, read_solution_set
+
+    sets = [read_solution_set(p) for p in args.solutions]
+    tables = [__import__("pandas").read_csv(p) for p in args.tables]
+    table = summary_table(sets, tables)
+    with atomic_output(args.table) as tmp:
+        table.to_csv(tmp, index=False, float_format="%.6g")
+    print(table.to_string(index=False), file=sys.stderr)
+    with atomic_output(args.figure) as tmp:
+        dataset_figure(sets).savefig(tmp, format="png", dpi=120, metadata={"Software": None})
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="traj2events",
+        description="Synthetic event-camera datasets from mass-optimal lunar landings. "
+        "The Snakemake workflow calls these subcommands; each can also be run by hand.",
+    )
+    parser.add_argument("--version", action="version", version=f"traj2events {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("check-config", help="validate a dataset config against the schema")
+    p.add_argument("config", help="config YAML, e.g. config/config.yaml")
+    p.add_argument("--schema", default="workflow/schemas/config.schema.yaml", help="schema YAML")
+    p.set_defaults(func=cmd_check_config)
+
+    settings_help = "scenario settings as JSON (or @file): vehicle, ocp, scenario, seed"
+    p = sub.add_parser("base", help="solve a scenario's base problem (every range at its midpoint)")
+    p.add_argument("--settings", required=True, help=settings_help)
+    p.add_argument("--output", "-o", required=True, help="base.h5 (nodes only)")
+    p.set_defaults(func=cmd_base)
+
+    p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
+    p.add_argument("--settings", required=True, help=settings_help)
+    p.add_argument("--base", required=True, help="base.h5 from `traj2events base`")
+    p.add_argument("--output", "-o", required=True, help="solutions.h5: every sample's nodes and status")
+    p.add_argument("--table", required=True, help="samples.csv: one row per sample (status, reason, errors)")
+    p.add_argument("--jobs", "-j", type=int, default=1, help="worker processes (default 1)")
+    p.set_defaults(func=cmd_sample)
+
+    p = sub.add_parser("upsample", help="camera poses at the frame rate for one solved sample")
+    p.add_argument("--solutions", required=True, help="solutions.h5 from `traj2events sample`")
+    p.add_argument("--id", type=int, required=True, help="sample index")
+    p.add_argument("--fps", type=float, required=True, help="frame rate, Hz")
+    p.add_argument("--method", choices=("reintegrate", "spline"), default="reintegrate",
+                   help="reintegrate the dynamics (exact, default) or the paper's cubic spline")
+    p.add_argument("--output", "-o", required=True, help="trajectory.h5")
+    p.set_defaults(func=cmd_upsample)
+
+    p = sub.add_parser("summary", help="per-scenario table and the dataset figure (height and pitch)")
+    p.add_argument("--solutions", nargs="+", required=True, help="solutions.h5 of each scenario")
+    p.add_argument("--tables", nargs="+", required=True, help="samples.csv of each scenario, same order")
+    p.add_argument("--table", required=True, help="output CSV")
+    p.add_argument("--figure", required=True, help="output PNG")
+    p.set_defaults(func=cmd_summary)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    from .config import ConfigError
+
+    try:
+        return args.func(args)
+    except (ConfigError, ValueError, FileNotFoundError, OSError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,145 @@
+"""The 13-state lunar lander of Azzalini et al. (paper.md), in SI units.
+
+State order (the dataset's order everywhere):
+    x y z vx vy vz phi theta psi p q r m
+Inertial frame: origin at the landing site, z down (geometry.md); body frame x forward,
+y right, z down; attitude roll-pitch-yaw with R_iv = Rz(psi) Ry(theta) Rx(phi).
+
+Physical control order: uT in [0, 1] (main engine), u_phi, u_theta, u_psi in [-1, 1]
+(attitude thruster couples).
+
+Two deliberate deviations from the paper's printed equations (paper.md):
+  * the gyroscopic term is ``- omega x (I omega)`` (Euler's rigid-body equation; the
+    paper prints a plus sign);
+  * attitude thrusters burn fuel for either sign of command: the mass flow uses
+    ``|u_phi| + |u_theta| + |u_psi|`` (the paper prints the signed sum, with which an
+    optimiser "creates fuel" by firing backwards).
+The optimiser sees |u| through a smooth split u = u_plus - u_minus (see ocp.py).
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import casadi as ca
+import numpy as np
+
+STATE_NAMES = ("x", "y", "z", "vx", "vy", "vz", "phi", "theta", "psi", "p", "q", "r", "m")
+CONTROL_NAMES = ("uT", "uphi", "utheta", "upsi")
+N_STATE = len(STATE_NAMES)
+N_CONTROL = len(CONTROL_NAMES)
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """Lander constants (SI). Defaults: see docs/trajectories.md for their sources."""
+
+    mass_kg: float = 10_000.0
+    dry_mass_kg: float = 6_000.0
+    thrust_main_N: float = 44_000.0
+    thrust_rcs_N: float = 445.0
+    lever_arm_m: float = 2.0
+    inertia_kgm2: tuple[float, float, float] = (17_500.0, 17_500.0, 20_000.0)
+    isp_s: float = 311.0
+    g_m_s2: float = 1.6242
+    g0_m_s2: float = 9.80665
+    tilt_max_deg: float = 80.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "inertia_kgm2", tuple(float(v) for v in self.inertia_kgm2))
+        if len(self.inertia_kgm2) != 3:
+            raise ValueError("vehicle.inertia_kgm2: expected 3 diagonal values")
+        if not 0 < self.dry_mass_kg < self.mass_kg:
+            raise ValueError("vehicle.dry_mass_kg: expected 0 < dry_mass_kg < mass_kg")
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["inertia_kgm2"] = list(self.inertia_kgm2)
+        return d
+
+
+def rotation_body_to_inertial(phi, theta, psi, lib=np):
+    """R_iv = Rz(psi) Ry(theta) Rx(phi) as a nested list (works for numpy and CasADi)."""
+    cf, sf = lib.cos(phi), lib.sin(phi)
+    ct, st = lib.cos(theta), lib.sin(theta)
+    cp, sp = lib.cos(psi), lib.sin(psi)
+    return [
+        [cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf],
+        [sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf],
+        [-st, ct * sf, ct * cf],
+    ]
+
+
+def rotation_matrix(phi: float, theta: float, psi: float) -> np.ndarray:
+    """R_iv (3 x 3 numpy array) for scalar angles in radians."""
+    return np.array(rotation_body_to_inertial(phi, theta, psi))
+
+
+def _state_derivative_sx(vehicle: Vehicle) -> ca.Function:
+    """Build f(x, u) -> dx/dt symbolically; u is the physical 4-vector."""
+    x = ca.SX.sym("x", N_STATE)
+    u = ca.SX.sym("u", N_CONTROL)
+    v = x[3:6]
+    phi, theta, psi = x[6], x[7], x[8]
+    omega = x[9:12]
+    m = x[12]
+    R = rotation_body_to_inertial(phi, theta, psi, lib=ca)
+    thrust_dir = ca.vertcat(R[0][2], R[1][2], R[2][2])  # body +z in the inertial frame
+    accel = ca.vertcat(0, 0, vehicle.g_m_s2) - vehicle.thrust_main_N * u[0] / m * thrust_dir
+
+    p, q, r = omega[0], omega[1], omega[2]
+    euler_rates = ca.vertcat(
+        p + (q * ca.sin(phi) + r * ca.cos(phi)) * ca.tan(theta),
+        q * ca.cos(phi) - r * ca.sin(phi),
+        (q * ca.sin(phi) + r * ca.cos(phi)) / ca.cos(theta),
+    )
+    inertia = ca.DM(vehicle.inertia_kgm2)
+    torque = 2 * vehicle.lever_arm_m * vehicle.thrust_rcs_N * u[1:4]
+    # Euler's equation: I w' = tau - w x (I w)  (minus sign: physical form).
+    omega_dot = (torque - ca.cross(omega, inertia * omega)) / inertia
+    # Either sign of an attitude command burns fuel: |u| (smooth form in ocp.py).
+    mass_flow = -(vehicle.thrust_main_N * u[0] + 2 * vehicle.thrust_rcs_N * ca.sum1(ca.fabs(u[1:4]))) / (
+        vehicle.isp_s * vehicle.g0_m_s2
+    )
+    xdot = ca.vertcat(v, accel, euler_rates, omega_dot, mass_flow)
+    return ca.Function("f", [x, u], [xdot], ["x", "u"], ["xdot"])
+
+
+def split_control_dynamics(vehicle: Vehicle) -> ca.Function:
+    """f(x, w) with w = (uT, u_plus[3], u_minus[3]), all in [0, 1]: the smooth form of |u|.
+
+    u_att = u_plus - u_minus and |u_att| is replaced by u_plus + u_minus, which is exact
+    at the optimum (firing both halves of a couple only wastes fuel).
+    """
+    f = _state_derivative_sx(vehicle)
+    x = ca.SX.sym("x", N_STATE)
+    w = ca.SX.sym("w", 7)
+    u = ca.vertcat(w[0], w[1:4] - w[4:7])
+    xdot = f(x, u)
+    burn = 2 * vehicle.thrust_rcs_N * ca.sum1(w[1:4] + w[4:7]) / (vehicle.isp_s * vehicle.g0_m_s2)
+    main = vehicle.thrust_main_N * w[0] / (vehicle.isp_s * vehicle.g0_m_s2)
+    xdot = ca.vertcat(xdot[: N_STATE - 1], -(main + burn))
+    return ca.Function("f_split", [x, w], [xdot], ["x", "w"], ["xdot"])
+
+
+@dataclass
+class Dynamics:
+    """Numeric right-hand side f(x, u) for integration (physical 4-control form)."""
+
+    vehicle: Vehicle
+    _f: ca.Function = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._f = _state_derivative_sx(self.vehicle)
+
+    @property
+    def casadi(self) -> ca.Function:
+        return self._f
+
+    def __call__(self, state: np.ndarray, control: np.ndarray) -> np.ndarray:
+        """dx/dt for one state (13,) and control (4,), or batches (n, 13), (n, 4)."""
+        state = np.asarray(state, dtype=float)
+        control = np.asarray(control, dtype=float)
+        if state.ndim == 1:
+            return np.asarray(self._f(state, control)).ravel()
+        out = self._f.map(state.shape[0])(state.T, control.T)
+        return np.asarray(out).T

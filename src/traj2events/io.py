@@ -1,0 +1,169 @@
+"""File formats: HDF5 writers and readers. Every write goes to a temporary name in the
+target folder and is renamed into place only when complete, so an interrupted or failed
+job never leaves a half-written file where the workflow expects a finished one.
+
+HDF5 files are written without object timestamps, so the same content gives the same
+bytes (the only run-dependent value stored is the solver's wall time, `solve_time_s`).
+"""
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+import h5py
+import numpy as np
+
+from .dynamics import CONTROL_NAMES, STATE_NAMES, Vehicle
+from .ocp import BoundaryConditions, Solution
+from .scenarios import SampleResult
+
+
+@contextlib.contextmanager
+def atomic_output(path: str | os.PathLike) -> Iterator[Path]:
+    """Yield a temporary path beside `path`; rename it to `path` if the block succeeds."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; finished files get the usual mode
+    try:
+        yield Path(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def _h5_file(path: Path) -> h5py.File:
+    # Fixed library version bounds and no timestamps: byte-reproducible files.
+    return h5py.File(path, "w", libver=("v110", "v110"), track_order=True)
+
+
+def _dataset(group: h5py.Group, name: str, data: np.ndarray) -> None:
+    data = np.asarray(data)
+    kwargs = {"compression": "gzip", "compression_opts": 4, "shuffle": True} if data.size > 1024 else {}
+    group.create_dataset(name, data=data, track_times=False, **kwargs)
+
+
+def _set_attrs(obj: h5py.HLObject, attrs: dict) -> None:
+    for key, value in attrs.items():
+        if isinstance(value, dict):
+            value = json.dumps(value, sort_keys=True)
+        obj.attrs[key] = value
+
+
+def vehicle_attrs(vehicle: Vehicle) -> dict:
+    """The root attributes that let anyone re-integrate the dynamics from the file."""
+    return {
+        "mass_kg": vehicle.mass_kg,
+        "dry_mass_kg": vehicle.dry_mass_kg,
+        "thrust_main_N": vehicle.thrust_main_N,
+        "thrust_rcs_N": vehicle.thrust_rcs_N,
+        "lever_arm_m": vehicle.lever_arm_m,
+        "inertia_kgm2": np.array(vehicle.inertia_kgm2),
+        "isp_s": vehicle.isp_s,
+        "g_m_s2": vehicle.g_m_s2,
+        "g0_m_s2": vehicle.g0_m_s2,
+        "tilt_max_deg": vehicle.tilt_max_deg,
+    }
+
+
+def vehicle_from_attrs(attrs: h5py.AttributeManager) -> Vehicle:
+    return Vehicle(**{k: (tuple(attrs[k]) if k == "inertia_kgm2" else float(attrs[k]))
+                      for k in Vehicle.__dataclass_fields__})
+
+
+def solution_attrs(solution: Solution, bc: BoundaryConditions) -> dict:
+    return {
+        "initial_state": bc.initial,
+        "final_state": bc.final,
+        "transcription": solution.transcription,
+        "N": len(solution.t),
+        "solver_status": solution.status,
+        "solver_success": solution.success,
+        "iterations": solution.iterations,
+        "solve_time_s": solution.solve_time_s,
+        "cost": solution.cost,
+        "tf_s": solution.tf_s,
+    }
+
+
+def _write_nodes(group: h5py.Group, t: np.ndarray, state: np.ndarray, control: np.ndarray) -> None:
+    _dataset(group, "t", t)
+    _dataset(group, "state", state)
+    _dataset(group, "control", control)
+    group.attrs["state_names"] = list(STATE_NAMES)
+    group.attrs["control_names"] = list(CONTROL_NAMES)
+
+
+def write_trajectory(
+    path: str | os.PathLike,
+    nodes: tuple[np.ndarray, np.ndarray, np.ndarray],
+    poses: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
+    attrs: dict,
+) -> None:
+    """One trajectory: nodes/{t,state,control}, optional poses/{t,state,control}, attrs."""
+    with atomic_output(path) as tmp, _h5_file(tmp) as f:
+        _write_nodes(f.create_group("nodes"), *nodes)
+        if poses is not None:
+            _write_nodes(f.create_group("poses"), *poses)
+        _set_attrs(f, attrs)
+
+
+@dataclass
+class Trajectory:
+    t_nodes: np.ndarray
+    state_nodes: np.ndarray
+    control_nodes: np.ndarray
+    t: np.ndarray | None
+    state: np.ndarray | None
+    control: np.ndarray | None
+    attrs: dict
+    vehicle: Vehicle
+
+
+def read_trajectory(path: str | os.PathLike) -> Trajectory:
+    with h5py.File(path, "r") as f:
+        poses = [f[f"poses/{k}"][()] for k in ("t", "state", "control")] if "poses" in f else [None] * 3
+        return Trajectory(
+            f["nodes/t"][()], f["nodes/state"][()], f["nodes/control"][()], *poses,
+            attrs=dict(f.attrs), vehicle=vehicle_from_attrs(f.attrs),
+        )
+
+
+def write_solution_set(path: str | os.PathLike, results: list[SampleResult], attrs: dict) -> None:
+    """All samples of one scenario, stacked: the checkpoint between solving and upsampling."""
+    n = len(results)
+    with atomic_output(path) as tmp, _h5_file(tmp) as f:
+        _dataset(f, "index", np.array([r.index for r in results], dtype=np.int64))
+        _dataset(f, "t", np.array([r.solution.t for r in results]).reshape(n, -1))
+        _dataset(f, "state", np.array([r.solution.state for r in results]).reshape(n, -1, len(STATE_NAMES)))
+        _dataset(f, "control", np.array([r.solution.control for r in results]).reshape(n, -1, len(CONTROL_NAMES)))
+        _dataset(f, "initial_state", np.array([r.conditions.initial for r in results]).reshape(n, -1))
+        _dataset(f, "final_state", np.array([r.conditions.final for r in results]).reshape(n, -1))
+        _dataset(f, "success", np.array([r.success for r in results], dtype=bool))
+        _dataset(f, "iterations", np.array([r.solution.iterations for r in results], dtype=np.int64))
+        _dataset(f, "solve_time_s", np.array([r.solution.solve_time_s for r in results]))
+        _dataset(f, "cost", np.array([r.solution.cost for r in results]))
+        for key in ("status", "method"):
+            values = [r.solution.status if key == "status" else r.method for r in results]
+            f.create_dataset(key, data=np.array(values, dtype=h5py.string_dtype()), track_times=False)
+        _set_attrs(f, attrs)
+
+
+def read_solution_set(path: str | os.PathLike) -> dict:
+    """Arrays of a solution set by name, plus 'attrs'."""
+    with h5py.File(path, "r") as f:
+        out = {k: f[k][()] for k in f.keys()}
+        for key in ("status", "method"):
+            out[key] = np.array([s.decode() for s in out[key]])
+        out["attrs"] = dict(f.attrs)
+    return out

@@ -1,0 +1,217 @@
+"""Mass-optimal landing as a nonlinear programme (CasADi Opti + IPOPT).
+
+    minimise   J = (1 - eps) (m0 - m(tf)) + eps * integral |u|^2 dt
+    subject to x' = f(x, u),  0 <= uT <= 1,  -1 <= u_att <= 1,
+               cos(phi) cos(theta) >= cos(tilt_max),  z <= 0,  m >= dry mass,
+               x(0) = x0,  x(tf) = xf (yaw and mass free),  tf free.
+
+Transcriptions: Hermite-Simpson (compressed form) with piecewise-linear controls (the
+midpoint control is the mean of its nodes: quadratic interpolants overshoot their bounds
+where controls saturate, trajectories.md), or trapezoidal. The problem is solved in
+nondimensional variables (1000 m, 100 m/s, 10 s, 1e4 kg), which IPOPT needs far fewer
+iterations for, and with MUMPS' own scaling off (bounded iteration counts for every
+t_f guess). It is built once and solved many times with new boundary conditions.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, replace
+
+import casadi as ca
+import numpy as np
+
+from .dynamics import N_STATE, Vehicle, split_control_dynamics
+
+TRANSCRIPTIONS = ("hermite-simpson", "trapezoidal")
+
+# Nondimensionalisation: length, speed, time (= length / speed), mass.
+LENGTH_M, SPEED_M_S, MASS_KG = 1000.0, 100.0, 1.0e4
+TIME_S = LENGTH_M / SPEED_M_S
+STATE_SCALE = np.array([LENGTH_M] * 3 + [SPEED_M_S] * 3 + [1.0] * 3 + [1.0 / TIME_S] * 3 + [MASS_KG])
+COST_SCALE = 1000.0  # J is divided by this so that it is O(1)
+
+# Final state: position, velocity, roll, pitch and body rates are fixed (pinpoint,
+# upright, at rest); yaw and mass are free.
+FINAL_FIXED = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 11])
+
+
+@dataclass(frozen=True)
+class OcpSettings:
+    n_nodes: int = 40
+    transcription: str = "hermite-simpson"
+    epsilon: float = 0.5
+    max_iter: int = 300
+    tol: float = 1e-8
+    tf_min_s: float = 1.0
+    tf_max_s: float = 1000.0
+
+    def __post_init__(self) -> None:
+        if self.transcription not in TRANSCRIPTIONS:
+            raise ValueError(f"ocp.transcription: expected one of {TRANSCRIPTIONS}, got {self.transcription!r}")
+        if self.n_nodes < 3:
+            raise ValueError(f"ocp.n_nodes: expected >= 3, got {self.n_nodes}")
+        if not 0.0 < self.epsilon <= 1.0:
+            raise ValueError(f"ocp.epsilon: expected 0 < epsilon <= 1, got {self.epsilon}")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class BoundaryConditions:
+    """Initial state (13,) and final state (13,), SI and radians; NaN in `final` = free."""
+
+    initial: np.ndarray
+    final: np.ndarray
+    tf_guess_s: float = 60.0
+
+    def interpolate(self, other: "BoundaryConditions", s: float) -> "BoundaryConditions":
+        """(1 - s) self + s other, for homotopy from self (s = 0) to other (s = 1)."""
+        return BoundaryConditions(
+            (1 - s) * self.initial + s * other.initial,
+            (1 - s) * self.final + s * other.final,
+            (1 - s) * self.tf_guess_s + s * other.tf_guess_s,
+        )
+
+
+def replace_tf_guess(bc: BoundaryConditions, tf_guess_s: float) -> BoundaryConditions:
+    return replace(bc, tf_guess_s=tf_guess_s)
+
+
+@dataclass
+class Solution:
+    """Nodes of one solved (or failed) problem: t (N,), state (N, 13), control (N, 4)."""
+
+    t: np.ndarray
+    state: np.ndarray
+    control: np.ndarray
+    cost: float
+    success: bool
+    status: str
+    iterations: int
+    solve_time_s: float
+    transcription: str
+
+    @property
+    def tf_s(self) -> float:
+        return float(self.t[-1])
+
+    def with_timing(self, iterations: int, solve_time_s: float) -> "Solution":
+        return replace(self, iterations=iterations, solve_time_s=solve_time_s)
+
+
+def split_controls(control: np.ndarray) -> np.ndarray:
+    """Physical (N, 4) controls -> the optimiser's (N, 7) split (uT, u+, u-)."""
+    att = control[:, 1:4]
+    return np.hstack([control[:, :1], np.maximum(att, 0.0), np.maximum(-att, 0.0)])
+
+
+class LandingProblem:
+    """The NLP for one vehicle and transcription; `solve` takes new boundary conditions."""
+
+    def __init__(self, vehicle: Vehicle, settings: OcpSettings) -> None:
+        self.vehicle, self.settings = vehicle, settings
+        n = settings.n_nodes
+        scale = ca.DM(STATE_SCALE)
+        f = split_control_dynamics(vehicle)
+        xs, ws = ca.SX.sym("xs", N_STATE), ca.SX.sym("w", 7)
+        f_scaled = ca.Function("f_scaled", [xs, ws], [f(scale * xs, ws) * TIME_S / scale])
+
+        opti = ca.Opti()
+        X = opti.variable(N_STATE, n)  # scaled states at the nodes
+        W = opti.variable(7, n)  # split controls at the nodes
+        tau = opti.variable()  # final time / TIME_S
+        x0 = opti.parameter(N_STATE)  # scaled boundary values
+        xf = opti.parameter(len(FINAL_FIXED))
+        h = tau / (n - 1)
+
+        def control_effort(w):  # |u|^2 with u the physical control
+            return w[0, :] ** 2 + ca.sum1((w[1:4, :] - w[4:7, :]) ** 2)
+
+        Fk = f_scaled.map(n)(X, W)
+        Lk = control_effort(W)
+        if settings.transcription == "hermite-simpson":
+            Wm = 0.5 * (W[:, :-1] + W[:, 1:])  # piecewise-linear controls
+            Xm = 0.5 * (X[:, :-1] + X[:, 1:]) + h / 8 * (Fk[:, :-1] - Fk[:, 1:])
+            Fm = f_scaled.map(n - 1)(Xm, Wm)
+            opti.subject_to(X[:, 1:] - X[:, :-1] == h / 6 * (Fk[:, :-1] + 4 * Fm + Fk[:, 1:]))
+            effort = h / 6 * ca.sum2(Lk[:-1] + 4 * control_effort(Wm) + Lk[1:])
+        else:
+            opti.subject_to(X[:, 1:] - X[:, :-1] == h / 2 * (Fk[:, :-1] + Fk[:, 1:]))
+            effort = h / 2 * ca.sum2(Lk[:-1] + Lk[1:])
+
+        eps = settings.epsilon
+        fuel_kg = MASS_KG * (x0[12] - X[12, -1])
+        opti.minimize(((1 - eps) * fuel_kg + eps * TIME_S * effort) / COST_SCALE)
+
+        opti.subject_to(opti.bounded(0, ca.vec(W), 1))
+        cos_tilt = np.cos(np.radians(vehicle.tilt_max_deg))
+        opti.subject_to(ca.cos(X[6, :]) * ca.cos(X[7, :]) >= cos_tilt)
+        opti.subject_to(X[2, :] <= 0)  # above the ground (z down)
+        opti.subject_to(X[12, :] >= vehicle.dry_mass_kg / MASS_KG)
+        opti.subject_to(X[:, 0] == x0)
+        opti.subject_to(X[FINAL_FIXED.tolist(), -1] == xf)
+        opti.subject_to(opti.bounded(settings.tf_min_s / TIME_S, tau, settings.tf_max_s / TIME_S))
+
+        opti.solver(
+            "ipopt",
+            {"print_time": False, "error_on_fail": False, "expand": True},
+            {
+                "print_level": 0,
+                "sb": "yes",
+                "max_iter": settings.max_iter,
+                "tol": settings.tol,
+                "mumps_scaling": 0,
+                "mumps_permuting_scaling": 0,
+            },
+        )
+        self._opti, self._X, self._W, self._tau = opti, X, W, tau
+        self._x0, self._xf, self._effort = x0, xf, effort
+
+    # -- initial guesses -------------------------------------------------------------
+    def cold_guess(self, bc: BoundaryConditions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Straight-line states from x0 to xf, hover throttle, rest attitude thrusters."""
+        n = self.settings.n_nodes
+        final = np.where(np.isnan(bc.final), bc.initial, bc.final)
+        s = np.linspace(0.0, 1.0, n)[:, None]
+        state = (1 - s) * bc.initial + s * final
+        hover = np.clip(bc.initial[12] * self.vehicle.g_m_s2 / self.vehicle.thrust_main_N, 0, 1)
+        control = np.zeros((n, 4))
+        control[:, 0] = hover
+        return np.linspace(0.0, bc.tf_guess_s, n), state, control
+
+    # -- solve -------------------------------------------------------------------------
+    def solve(
+        self, bc: BoundaryConditions, guess: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    ) -> Solution:
+        """Solve for `bc`, starting from `guess` = (t, state, control) or a cold guess."""
+        opti = self._opti
+        t_guess, state_guess, control_guess = guess if guess is not None else self.cold_guess(bc)
+        opti.set_value(self._x0, bc.initial / STATE_SCALE)
+        opti.set_value(self._xf, (bc.final / STATE_SCALE)[FINAL_FIXED])
+        opti.set_initial(self._X, (state_guess / STATE_SCALE).T)
+        opti.set_initial(self._W, split_controls(control_guess).T)
+        opti.set_initial(self._tau, t_guess[-1] / TIME_S)
+
+        start = time.perf_counter()
+        sol = opti.solve()
+        elapsed = time.perf_counter() - start
+        stats = opti.stats()
+
+        X = np.atleast_2d(sol.value(self._X)).T * STATE_SCALE
+        W = np.atleast_2d(sol.value(self._W)).T
+        tf = float(sol.value(self._tau)) * TIME_S
+        control = np.hstack([W[:, :1], W[:, 1:4] - W[:, 4:7]])
+        eps = self.settings.epsilon
+        cost = (1 - eps) * (bc.initial[12] - X[-1, 12]) + eps * TIME_S * float(sol.value(self._effort))
+        return Solution(
+            t=np.linspace(0.0, tf, self.settings.n_nodes),
+            state=X,
+            control=control,
+            cost=float(cost),
+            success=bool(stats["success"]),
+            status=str(stats["return_status"]),
+            iterations=int(stats["iter_count"]),
+            solve_time_s=elapsed,
+            transcription=self.settings.transcription,
+        )

@@ -1,0 +1,62 @@
+# Shared helpers: config validation (before any job runs), per-scenario params, the
+# package's source hash (so a change in the science reruns the rules it affects), and
+# the list of everything the config asks for.
+import hashlib
+import shlex
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+import traj2events
+from traj2events.config import ConfigError, ScenarioSettings, load_yaml, validate_config
+
+try:
+    validate_config(config, load_yaml(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
+except ConfigError as error:
+    raise WorkflowError(f"invalid configuration: {error}")
+
+# Rules call the `traj2events` command that sits beside the Python running Snakemake
+# (e.g. .venv/bin), so that `.venv/bin/snakemake` works without activating the venv.
+shell.prefix(f"set -euo pipefail; export PATH={shlex.quote(str(Path(sys.executable).parent))}:\"$PATH\"; ")
+PACKAGE_DIR = Path(traj2events.__file__).parent
+SCENARIOS = list(config["scenarios"])
+ENV = "../../envs/trajectories.yaml"
+
+
+wildcard_constraints:
+    scenario="|".join(SCENARIOS),
+    id=r"\d{4}",
+
+
+def source_hash(*modules):
+    """Hash of the package modules a rule runs (plus the CLI that calls them)."""
+    digest = hashlib.sha256()
+    for module in sorted({*modules, "__init__", "cli", "config", "io"}):
+        digest.update((PACKAGE_DIR / f"{module}.py").read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def scenario_settings(wildcards):
+    """Everything the solves of one scenario depend on, as JSON (vehicle, ocp, ranges, seed)."""
+    return ScenarioSettings.from_config(config, wildcards.scenario).to_json()
+
+
+def solved_ids(scenario):
+    """Ids of the solved samples of a scenario (known once its checkpoint has run)."""
+    table = checkpoints.sample_trajectories.get(scenario=scenario).output.table
+    samples = pd.read_csv(table)
+    return [f"{i:04d}" for i in samples.loc[samples["success"], "id"]]
+
+
+def trajectory_files(pattern):
+    """`pattern` (with {scenario} and {id}) for every solved trajectory of every scenario."""
+    return [pattern.format(scenario=s, id=i) for s in SCENARIOS for i in solved_ids(s)]
+
+
+def all_outputs(wildcards):
+    return [
+        "results/summary.csv",
+        "results/figures/trajectories.png",
+        *trajectory_files("results/{scenario}/{id}/trajectory.h5"),
+    ]

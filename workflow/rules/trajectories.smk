@@ -1,0 +1,79 @@
+# Stages 1-3: base solve per scenario, continuation sampling (a checkpoint: failed samples
+# produce no trajectory file), and camera poses at the frame rate per trajectory.
+
+
+rule base_solution:
+    output:
+        "results/{scenario}/base.h5",
+    params:
+        settings=scenario_settings,
+        code=source_hash("dynamics", "ocp", "scenarios"),
+    log:
+        "results/logs/{scenario}/base_solution.log",
+    conda:
+        ENV
+    shell:
+        "traj2events base --settings {params.settings:q} --output {output} 2> {log}"
+
+
+checkpoint sample_trajectories:
+    input:
+        base="results/{scenario}/base.h5",
+    output:
+        solutions="results/{scenario}/solutions.h5",
+        table="results/{scenario}/samples.csv",
+    params:
+        settings=scenario_settings,
+        code=source_hash("dynamics", "ocp", "scenarios", "batch", "upsample"),
+    threads: workflow.cores
+    log:
+        "results/logs/{scenario}/sample_trajectories.log",
+    conda:
+        ENV
+    shell:
+        "traj2events sample --settings {params.settings:q} --base {input.base} "
+        "--output {output.solutions} --table {output.table} --jobs {threads} 2> {log}"
+
+
+rule camera_poses:
+    input:
+        "results/{scenario}/solutions.h5",
+    output:
+        "results/{scenario}/{id}/trajectory.h5",
+    params:
+        fps=config["camera"]["fps"],
+        method=config["upsampling"]["method"],
+        code=source_hash("dynamics", "ocp", "upsample"),
+    log:
+        "results/logs/{scenario}/{id}/camera_poses.log",
+    conda:
+        ENV
+    shell:
+        "traj2events upsample --solutions {input} --id {wildcards.id} --fps {params.fps} "
+        "--method {params.method} --output {output} 2> {log}"
+
+
+rule trajectory_summary:
+    input:
+        solutions=expand("results/{scenario}/solutions.h5", scenario=SCENARIOS),
+        tables=expand("results/{scenario}/samples.csv", scenario=SCENARIOS),
+    output:
+        table=report(
+            "results/summary.csv",
+            caption="../report/summary.rst",
+            category="Trajectories",
+        ),
+        figure=report(
+            "results/figures/trajectories.png",
+            caption="../report/trajectories.rst",
+            category="Trajectories",
+        ),
+    params:
+        code=source_hash("figures"),
+    log:
+        "results/logs/trajectory_summary.log",
+    conda:
+        ENV
+    shell:
+        "traj2events summary --solutions {input.solutions} --tables {input.tables} "
+        "--table {output.table} --figure {output.figure} 2> {log}"
