@@ -1,8 +1,8 @@
 """Solve every sample of a scenario, one process per core.
 
 Each worker builds the NLP once, then solves its share of samples by continuation from
-the base solution and re-integrates each result (DOP853, rtol 1e-10) to measure the
-final-state error. Results do not depend on the number of workers.
+the base solution, accepting a solution only when re-integrating its controls (CVODES,
+see upsample.ShootingCheck) confirms it. Results do not depend on the number of workers.
 """
 from __future__ import annotations
 
@@ -15,27 +15,30 @@ from typing import Callable
 
 from .dynamics import Dynamics, Vehicle
 from .ocp import BoundaryConditions, LandingProblem, OcpSettings, Solution
-from .scenarios import SampleResult, Scenario, sample_conditions, solve_by_continuation
-from .upsample import final_state_error
+from .scenarios import Acceptance, SampleResult, Scenario, sample_conditions, solve_by_continuation
+from .upsample import ShootingCheck
 
 _worker: dict = {}
 
 
 def _init_worker(vehicle: Vehicle, settings: OcpSettings, scenario: Scenario, seed: int,
                  base_bc: BoundaryConditions, base: Solution) -> None:
-    _worker.update(problem=LandingProblem(vehicle, settings), dynamics=Dynamics(vehicle),
-                   vehicle=vehicle, scenario=scenario, seed=seed, base_bc=base_bc, base=base)
+    fine = replace(settings, n_nodes=settings.refine_n_nodes, refine_n_nodes=0) if settings.refine_n_nodes else None
+    check = ShootingCheck(Dynamics(vehicle))
+    _worker.update(
+        problem=LandingProblem(vehicle, settings),
+        fine_problem=LandingProblem(vehicle, fine) if fine else None,
+        verify=lambda sol: check(sol.t, sol.state, sol.control),
+        acceptance=Acceptance(settings.accept_error_m, settings.accept_error_m_s),
+        vehicle=vehicle, scenario=scenario, seed=seed, base_bc=base_bc, base=base,
+    )
 
 
 def _solve_one(index: int) -> SampleResult:
     w = _worker
     bc = sample_conditions(w["scenario"], w["vehicle"], w["seed"], index)
-    result = solve_by_continuation(w["problem"], w["base_bc"], w["base"], bc, index)
-    sol = result.solution
-    if result.success:
-        err_r, err_v = final_state_error(w["dynamics"], sol.t, sol.state, sol.control)
-        result = replace(result, error_position_m=err_r, error_velocity_m_s=err_v)
-    return result
+    return solve_by_continuation(w["problem"], w["base_bc"], w["base"], bc, w["verify"], w["acceptance"],
+                                 w["fine_problem"], index)
 
 
 def solve_samples(

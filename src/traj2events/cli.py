@@ -81,17 +81,12 @@ def cmd_sample(args) -> int:
     _log(f"{s.scenario.name}: {len(results) - len(failed)} solved, {len(failed)} failed, "
          f"{time.perf_counter() - start:.1f} s wall")
 
-    rows = []
-    for r in results:
-        draws = initial_values(r.conditions.initial)
-        rows.append({
-            "id": r.index, "success": r.success, "method": r.method, "attempts": r.attempts,
-            "status": r.solution.status, "reason": "" if r.success else f"{r.method}: {r.solution.status}",
-            "iterations": r.solution.iterations, "total_iterations": r.total_iterations,
-            "tf_s": r.solution.tf_s, "final_mass_kg": r.solution.state[-1, 12], "cost": r.solution.cost,
-            "error_position_m": r.error_position_m, "error_velocity_m_s": r.error_velocity_m_s,
-            "solve_time_s": r.total_time_s, **draws,
-        })
+    rows = [{"id": r.index, "success": r.success, "method": r.method, "attempts": r.attempts,
+             "reason": r.reason, "status": r.solution.status, "N": len(r.solution.t),
+             "iterations": r.solution.iterations, "total_iterations": r.total_iterations,
+             "tf_s": r.solution.tf_s, "final_mass_kg": r.solution.state[-1, 12], "cost": r.solution.cost,
+             "error_position_m": r.error_position_m, "error_velocity_m_s": r.error_velocity_m_s,
+             "solve_time_s": r.total_time_s, **initial_values(r.conditions.initial)} for r in results]
     attrs = {"scenario": s.scenario.name, "seed": s.seed, "settings": s.to_json(),
              "traj2events_version": __version__}
     write_solution_set(args.output, results, attrs)
@@ -109,28 +104,26 @@ def initial_values(x0: np.ndarray) -> dict:
 
 
 def cmd_upsample(args) -> int:
+    from .config import ScenarioSettings
     from .dynamics import Dynamics
-    from .io import read_solution_set, solution_attrs, vehicle_attrs, write_trajectory
-    from .ocp import BoundaryConditions, Solution
+    from .io import read_solution_set, vehicle_attrs, write_trajectory
     from .upsample import upsample
 
     data = read_solution_set(args.solutions)
-    from .config import ScenarioSettings
-
     s = ScenarioSettings.from_json(data["attrs"]["settings"])
-    row = int(np.flatnonzero(data["index"] == args.id)[0]) if args.id in data["index"] else None
-    if row is None or not data["success"][row]:
+    sample = data["samples"].get(args.id)
+    if sample is None or not sample["solver_success"] or sample["method"] == "failed":
         print(f"error: {args.solutions}: sample {args.id} is not a solved sample", file=sys.stderr)
         return 1
-    t, state, control = data["t"][row], data["state"][row], data["control"][row]
-    sol = Solution(t, state, control, float(data["cost"][row]), True, str(data["status"][row]),
-                   int(data["iterations"][row]), float(data["solve_time_s"][row]), s.ocp.transcription)
-    bc = BoundaryConditions(data["initial_state"][row], data["final_state"][row], s.scenario.tf_guess_s)
+    t, state, control = sample["t"], sample["state"], sample["control"]
     poses = upsample(Dynamics(s.vehicle), t, state, control, args.fps, args.method)
     _log(f"{s.scenario.name}/{args.id:04d}: {len(poses[0])} poses at {args.fps:g} fps ({args.method})")
-    attrs = {**vehicle_attrs(s.vehicle), **solution_attrs(sol, bc), "fps": args.fps, "upsampling": args.method,
+    solve = {k: sample[k] for k in ("initial_state", "final_state", "transcription", "N", "solver_status",
+                                     "iterations", "solve_time_s", "cost", "tf_s", "error_position_m",
+                                     "error_velocity_m_s")}
+    attrs = {**vehicle_attrs(s.vehicle), **solve, "fps": args.fps, "upsampling": args.method,
              "scenario": s.scenario.name, "id": args.id, "seed": s.seed, "epsilon": s.ocp.epsilon,
-             "continuation": str(data["method"][row]), "traj2events_version": __version__}
+             "continuation": sample["method"], "traj2events_version": __version__}
     write_trajectory(args.output, (t, state, control), poses, attrs)
     return 0
 
@@ -147,6 +140,26 @@ def cmd_summary(args) -> int:
     print(table.to_string(index=False), file=sys.stderr)
     with atomic_output(args.figure) as tmp:
         dataset_figure(sets).savefig(tmp, format="png", dpi=120, metadata={"Software": None})
+    return 0
+
+
+def cmd_index(args) -> int:
+    import h5py
+    import pandas as pd
+
+    from .io import atomic_output
+
+    rows = []
+    for path in args.trajectories:
+        with h5py.File(path, "r") as f:
+            a = f.attrs
+            rows.append({"scenario": a["scenario"], "id": int(a["id"]), "path": str(path), "tf_s": float(a["tf_s"]),
+                         "n_poses": len(f["poses/t"]), "fps": float(a["fps"]), "N": int(a["N"]),
+                         "final_mass_kg": float(f["nodes/state"][-1, 12]), "continuation": a["continuation"],
+                         "error_position_m": float(a["error_position_m"])})
+    with atomic_output(args.output) as tmp:
+        pd.DataFrame(rows).to_csv(tmp, index=False, float_format="%.9g")
+    _log(f"{args.output}: {len(rows)} trajectories")
     return 0
 
 
@@ -186,6 +199,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="reintegrate the dynamics (exact, default) or the paper's cubic spline")
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
     p.set_defaults(func=cmd_upsample)
+
+    p = sub.add_parser("index", help="one CSV row per trajectory file of a scenario (the dataset index)")
+    p.add_argument("trajectories", nargs="*", help="trajectory.h5 files")
+    p.add_argument("--output", "-o", required=True, help="index.csv")
+    p.set_defaults(func=cmd_index)
 
     p = sub.add_parser("summary", help="per-scenario table and the dataset figure (height and pitch)")
     p.add_argument("--solutions", nargs="+", required=True, help="solutions.h5 of each scenario")

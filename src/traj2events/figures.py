@@ -9,18 +9,21 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 
-def height_pitch_bands(t: np.ndarray, state: np.ndarray) -> dict[str, np.ndarray]:
-    """Normalised time and per-node mean and std of height (m) and pitch (deg).
-
-    t (n, N), state (n, N, 13) of solved samples; nodes sit at the same normalised times.
-    """
-    height = -state[:, :, 2]
-    pitch = np.degrees(state[:, :, 7])
+def height_pitch_bands(samples: list[dict], n_points: int = 101) -> dict[str, np.ndarray]:
+    """Height (m) and pitch (deg) of solved samples on a common normalised time grid,
+    with their mean and standard deviation per grid point (node counts may differ)."""
+    tau = np.linspace(0.0, 1.0, n_points)
+    height = np.array([np.interp(tau, s["t"] / s["t"][-1], -s["state"][:, 2]) for s in samples])
+    pitch = np.array([np.interp(tau, s["t"] / s["t"][-1], np.degrees(s["state"][:, 7])) for s in samples])
     return {
-        "tau": t[0] / t[0, -1],
-        "height_mean": height.mean(axis=0), "height_std": height.std(axis=0), "height": height,
-        "pitch_mean": pitch.mean(axis=0), "pitch_std": pitch.std(axis=0), "pitch": pitch,
+        "tau": tau,
+        "height": height, "height_mean": height.mean(axis=0), "height_std": height.std(axis=0),
+        "pitch": pitch, "pitch_mean": pitch.mean(axis=0), "pitch_std": pitch.std(axis=0),
     }
+
+
+def solved_samples(solution_set: dict) -> dict[int, dict]:
+    return {i: s for i, s in sorted(solution_set["samples"].items()) if s["method"] != "failed"}
 
 
 def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
@@ -28,23 +31,23 @@ def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
     fig, axes = plt.subplots(2, len(solution_sets), figsize=(4.2 * len(solution_sets), 6), squeeze=False,
                              sharex=True)
     for col, data in enumerate(solution_sets):
-        ok = data["success"]
+        solved = solved_samples(data)
         name = data["attrs"]["scenario"]
-        if not ok.any():
+        if not solved:
             axes[0, col].set_title(f"{name}: no solved sample")
             continue
-        b = height_pitch_bands(data["t"][ok], data["state"][ok])
+        b = height_pitch_bands(list(solved.values()))
         for row, key, unit in ((0, "height", "height H = -z (m)"), (1, "pitch", "pitch theta (deg)")):
             ax = axes[row, col]
             mean, std = b[f"{key}_mean"], b[f"{key}_std"]
             ax.fill_between(b["tau"], mean - 3 * std, mean + 3 * std, color="tab:blue", alpha=0.2,
                             label="mean +- 3 sigma")
             ax.plot(b["tau"], mean, color="tab:blue", label="mean")
-            ax.plot(b["tau"], b[key][0], color="tab:orange", ls="--", label=f"sample {int(data['index'][ok][0]):04d}")
+            ax.plot(b["tau"], b[key][0], color="tab:orange", ls="--", label=f"sample {next(iter(solved)):04d}")
             ax.set_ylabel(unit)
             ax.grid(alpha=0.3)
             if row == 0:
-                ax.set_title(f"{name} ({int(ok.sum())} trajectories)")
+                ax.set_title(f"{name} ({len(solved)} trajectories)")
             else:
                 ax.set_xlabel("normalised time t / t_f")
     axes[0, 0].legend(loc="best", fontsize=8)
@@ -63,6 +66,7 @@ def summary_table(solution_sets: list[dict], sample_tables: list[pd.DataFrame]) 
             "solved": len(ok),
             "failed": int((~table["success"]).sum()),
             "solved_first_try": int((table["method"] == "warm").sum()),
+            "refined": int(table["method"].str.endswith("+refined").sum()),
             "final_mass_min_kg": ok["final_mass_kg"].min(),
             "final_mass_mean_kg": ok["final_mass_kg"].mean(),
             "final_mass_max_kg": ok["final_mass_kg"].max(),

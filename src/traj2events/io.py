@@ -139,31 +139,37 @@ def read_trajectory(path: str | os.PathLike) -> Trajectory:
         )
 
 
+def sample_attrs(result: SampleResult) -> dict:
+    sol = result.solution
+    return {
+        **solution_attrs(sol, result.conditions),
+        "method": result.method,
+        "reason": result.reason,
+        "attempts": result.attempts,
+        "total_iterations": result.total_iterations,
+        "total_solve_time_s": result.total_time_s,
+        "error_position_m": result.error_position_m,
+        "error_velocity_m_s": result.error_velocity_m_s,
+    }
+
+
 def write_solution_set(path: str | os.PathLike, results: list[SampleResult], attrs: dict) -> None:
-    """All samples of one scenario, stacked: the checkpoint between solving and upsampling."""
-    n = len(results)
+    """All samples of one scenario (the checkpoint between solving and camera poses):
+    samples/{id:04d}/{t,state,control} with each sample's status in its attributes."""
     with atomic_output(path) as tmp, _h5_file(tmp) as f:
-        _dataset(f, "index", np.array([r.index for r in results], dtype=np.int64))
-        _dataset(f, "t", np.array([r.solution.t for r in results]).reshape(n, -1))
-        _dataset(f, "state", np.array([r.solution.state for r in results]).reshape(n, -1, len(STATE_NAMES)))
-        _dataset(f, "control", np.array([r.solution.control for r in results]).reshape(n, -1, len(CONTROL_NAMES)))
-        _dataset(f, "initial_state", np.array([r.conditions.initial for r in results]).reshape(n, -1))
-        _dataset(f, "final_state", np.array([r.conditions.final for r in results]).reshape(n, -1))
-        _dataset(f, "success", np.array([r.success for r in results], dtype=bool))
-        _dataset(f, "iterations", np.array([r.solution.iterations for r in results], dtype=np.int64))
-        _dataset(f, "solve_time_s", np.array([r.solution.solve_time_s for r in results]))
-        _dataset(f, "cost", np.array([r.solution.cost for r in results]))
-        for key in ("status", "method"):
-            values = [r.solution.status if key == "status" else r.method for r in results]
-            f.create_dataset(key, data=np.array(values, dtype=h5py.string_dtype()), track_times=False)
+        samples = f.create_group("samples")
+        for r in results:
+            group = samples.create_group(f"{r.index:04d}")
+            _write_nodes(group, r.solution.t, r.solution.state, r.solution.control)
+            _set_attrs(group, sample_attrs(r))
         _set_attrs(f, attrs)
 
 
 def read_solution_set(path: str | os.PathLike) -> dict:
-    """Arrays of a solution set by name, plus 'attrs'."""
+    """{"attrs": root attributes, "samples": {id: {"t", "state", "control", **attrs}}}."""
     with h5py.File(path, "r") as f:
-        out = {k: f[k][()] for k in f.keys()}
-        for key in ("status", "method"):
-            out[key] = np.array([s.decode() for s in out[key]])
-        out["attrs"] = dict(f.attrs)
-    return out
+        samples = {}
+        for name, g in f["samples"].items():
+            samples[int(name)] = {"t": g["t"][()], "state": g["state"][()], "control": g["control"][()],
+                                  **{k: (v.item() if isinstance(v, np.generic) else v) for k, v in g.attrs.items()}}
+        return {"attrs": dict(f.attrs), "samples": samples}

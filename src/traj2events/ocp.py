@@ -40,16 +40,23 @@ class OcpSettings:
     n_nodes: int = 40
     transcription: str = "hermite-simpson"
     epsilon: float = 0.5
-    max_iter: int = 300
+    max_iter: int = 100
     tol: float = 1e-8
     tf_min_s: float = 1.0
     tf_max_s: float = 1000.0
+    # A sample is accepted when re-integrating its controls lands within these errors;
+    # one that converges but misses them is re-solved with refine_n_nodes (0: never).
+    accept_error_m: float = 0.1
+    accept_error_m_s: float = 0.01
+    refine_n_nodes: int = 0
 
     def __post_init__(self) -> None:
         if self.transcription not in TRANSCRIPTIONS:
             raise ValueError(f"ocp.transcription: expected one of {TRANSCRIPTIONS}, got {self.transcription!r}")
         if self.n_nodes < 3:
             raise ValueError(f"ocp.n_nodes: expected >= 3, got {self.n_nodes}")
+        if self.refine_n_nodes and self.refine_n_nodes <= self.n_nodes:
+            raise ValueError(f"ocp.refine_n_nodes: expected 0 or more than n_nodes = {self.n_nodes}")
         if not 0.0 < self.epsilon <= 1.0:
             raise ValueError(f"ocp.epsilon: expected 0 < epsilon <= 1, got {self.epsilon}")
 
@@ -155,7 +162,7 @@ class LandingProblem:
 
         opti.solver(
             "ipopt",
-            {"print_time": False, "error_on_fail": False, "expand": True},
+            {"print_time": False, "expand": True},
             {
                 "print_level": 0,
                 "sb": "yes",
@@ -194,16 +201,19 @@ class LandingProblem:
         opti.set_initial(self._tau, t_guess[-1] / TIME_S)
 
         start = time.perf_counter()
-        sol = opti.solve()
+        try:
+            value = opti.solve_limited().value  # returns on soft failures (iteration cap) ...
+        except RuntimeError:
+            value = opti.debug.value  # ... but raises on hard ones (restoration failed): last iterate
         elapsed = time.perf_counter() - start
         stats = opti.stats()
 
-        X = np.atleast_2d(sol.value(self._X)).T * STATE_SCALE
-        W = np.atleast_2d(sol.value(self._W)).T
-        tf = float(sol.value(self._tau)) * TIME_S
+        X = np.atleast_2d(value(self._X)).T * STATE_SCALE
+        W = np.atleast_2d(value(self._W)).T
+        tf = float(value(self._tau)) * TIME_S
         control = np.hstack([W[:, :1], W[:, 1:4] - W[:, 4:7]])
         eps = self.settings.epsilon
-        cost = (1 - eps) * (bc.initial[12] - X[-1, 12]) + eps * TIME_S * float(sol.value(self._effort))
+        cost = (1 - eps) * (bc.initial[12] - X[-1, 12]) + eps * TIME_S * float(value(self._effort))
         return Solution(
             t=np.linspace(0.0, tf, self.settings.n_nodes),
             state=X,

@@ -10,7 +10,8 @@ positive pitch tilts the thrust backwards (braking) and the camera forwards.
 from __future__ import annotations
 
 import zlib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
+from typing import Callable
 
 import numpy as np
 
@@ -90,23 +91,42 @@ def sample_conditions(scenario: Scenario, vehicle: Vehicle, seed: int, index: in
     return boundary_conditions(values, vehicle, scenario.tf_guess_s)
 
 
+@dataclass(frozen=True)
+class Acceptance:
+    """An attempt is accepted only if IPOPT converged *and* re-integrating its controls
+    lands within these final-state errors (spurious optima that exploit the discretisation
+    are off by metres to kilometres)."""
+
+    position_m: float = 0.1
+    velocity_m_s: float = 0.01
+
+
 @dataclass
 class SampleResult:
-    """One sample's outcome: the solution (the last attempt's, if all failed) and how."""
+    """One sample's outcome: the accepted solution (or the last attempt) and how."""
 
     index: int
     conditions: BoundaryConditions
     solution: Solution
-    method: str  # "warm", "homotopy-K" (K steps), "cold" or "failed"
+    method: str  # "warm", "homotopy-K", "cold", each "+refined" if re-solved on a finer mesh; or "failed"
     attempts: int
     total_iterations: int
     total_time_s: float
     error_position_m: float = float("nan")  # final state, re-integrated vs transcribed
     error_velocity_m_s: float = float("nan")
+    reason: str = ""  # why it failed, empty when solved
 
     @property
     def success(self) -> bool:
         return self.method != "failed"
+
+
+def refine_guess(sol: Solution, n_nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A solution interpolated onto n_nodes uniform nodes (warm start on a finer mesh)."""
+    t = np.linspace(0.0, sol.tf_s, n_nodes)
+    state = np.column_stack([np.interp(t, sol.t, c) for c in sol.state.T])
+    control = np.column_stack([np.interp(t, sol.t, c) for c in sol.control.T])
+    return t, state, control
 
 
 def solve_by_continuation(
@@ -114,36 +134,73 @@ def solve_by_continuation(
     base_bc: BoundaryConditions,
     base: Solution,
     bc: BoundaryConditions,
+    verify: Callable[[Solution], tuple[float, float]],
+    acceptance: Acceptance = Acceptance(),
+    fine_problem: LandingProblem | None = None,
     index: int = 0,
-    homotopy_steps: tuple[int, ...] = (3,),
+    homotopy_steps: int = 3,
 ) -> SampleResult:
-    """Solve `bc` from the base solution; retry by homotopy, then from a cold guess.
+    """Solve `bc` starting from the base solution, with retries.
 
-    1. warm start: the base solution as the initial guess;
-    2. homotopy: boundary conditions moved from the base's to the sample's in K steps,
-       each solve warm-started from the previous one;
-    3. cold start from a straight-line guess (robust on its own, trajectories.md).
+    Strategies, in order, until one is accepted:
+      warm:       the base solution as the initial guess;
+      homotopy-K: boundary conditions moved from the base's to the sample's in K steps,
+                  each solve warm-started from the previous one;
+      cold:       a straight-line guess.
+    A strategy whose solve converges but misses `acceptance` is re-solved on
+    `fine_problem`'s mesh from its own solution ("+refined") before moving on.
+    `verify(solution)` returns the re-integrated final-state errors (m, m/s).
     """
     log: list[Solution] = []
+    errors = (float("nan"), float("nan"))
+    reason = ""
 
     def guess(sol: Solution):
         return sol.t, sol.state, sol.control
 
-    def result(method: str) -> SampleResult:
-        return SampleResult(index, bc, log[-1], method, len(log),
-                            sum(s.iterations for s in log), sum(s.solve_time_s for s in log))
+    def accepted(sol: Solution) -> bool:
+        nonlocal errors, reason
+        if not sol.success:
+            reason = f"IPOPT: {sol.status}"
+            return False
+        errors = verify(sol)
+        if errors[0] <= acceptance.position_m and errors[1] <= acceptance.velocity_m_s:
+            return True
+        reason = (f"re-integration error {errors[0]:.3g} m / {errors[1]:.3g} m/s exceeds "
+                  f"{acceptance.position_m} m / {acceptance.velocity_m_s} m/s (N = {len(sol.t)})")
+        return False
 
-    log.append(problem.solve(bc, guess(base)))
-    if log[-1].success:
-        return result("warm")
-    for steps in homotopy_steps:
+    def attempt(strategy) -> bool:
+        sol = strategy()
+        if accepted(sol):
+            return True
+        if sol.success and fine_problem is not None:
+            log.append(fine_problem.solve(bc, refine_guess(sol, fine_problem.settings.n_nodes)))
+            return accepted(log[-1])
+        return False
+
+    def warm():
+        log.append(problem.solve(bc, guess(base)))
+        return log[-1]
+
+    def homotopy():
         previous = base
-        for s in np.linspace(0.0, 1.0, steps + 1)[1:]:
+        for s in np.linspace(0.0, 1.0, homotopy_steps + 1)[1:]:
             log.append(problem.solve(base_bc.interpolate(bc, s), guess(previous)))
             if not log[-1].success:
-                break
+                log[-1] = replace(log[-1], status=f"{log[-1].status} at homotopy step {s:.2f}")
+                return log[-1]
             previous = log[-1]
-        else:
-            return result(f"homotopy-{steps}")
-    log.append(problem.solve(bc))
-    return result("cold" if log[-1].success else "failed")
+        return log[-1]
+
+    def cold():
+        log.append(problem.solve(bc))
+        return log[-1]
+
+    for name, strategy in (("warm", warm), ("homotopy-%d" % homotopy_steps, homotopy), ("cold", cold)):
+        if attempt(strategy):
+            method = name + ("+refined" if len(log[-1].t) != problem.settings.n_nodes else "")
+            return SampleResult(index, bc, log[-1], method, len(log), sum(s.iterations for s in log),
+                                sum(s.solve_time_s for s in log), *errors)
+    return SampleResult(index, bc, log[-1], "failed", len(log), sum(s.iterations for s in log),
+                        sum(s.solve_time_s for s in log), *errors, reason=reason)

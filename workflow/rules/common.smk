@@ -49,14 +49,16 @@ def solved_ids(scenario):
     return [f"{i:04d}" for i in samples.loc[samples["success"], "id"]]
 
 
-def trajectory_files(pattern):
-    """`pattern` (with {scenario} and {id}) for every solved trajectory of every scenario."""
-    return [pattern.format(scenario=s, id=i) for s in SCENARIOS for i in solved_ids(s)]
+def scenario_trajectories(wildcards):
+    """trajectory.h5 of every solved sample of one scenario (the index's inputs)."""
+    return expand("results/{scenario}/{id}/trajectory.h5", scenario=wildcards.scenario, id=solved_ids(wildcards.scenario))
 
 
 def all_outputs(wildcards):
+    # Per-scenario indexes (not the trajectories themselves) keep every scenario's
+    # checkpoint in the DAG from the start, so scenarios run side by side.
     return [
         "results/summary.csv",
         "results/figures/trajectories.png",
-        *trajectory_files("results/{scenario}/{id}/trajectory.h5"),
+        *expand("results/{scenario}/index.csv", scenario=SCENARIOS),
     ]

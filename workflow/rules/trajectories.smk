@@ -53,6 +53,21 @@ rule camera_poses:
         "--method {params.method} --output {output} 2> {log}"
 
 
+rule dataset_index:
+    input:
+        scenario_trajectories,
+    output:
+        "results/{scenario}/index.csv",
+    params:
+        code=source_hash(),
+    log:
+        "results/logs/{scenario}/dataset_index.log",
+    conda:
+        ENV
+    shell:
+        "traj2events index {input} --output {output} 2> {log}"
+
+
 rule trajectory_summary:
     input:
         solutions=expand("results/{scenario}/solutions.h5", scenario=SCENARIOS),

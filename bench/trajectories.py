@@ -1,0 +1,109 @@
+"""Benchmark: trajectory solves, run time against re-integration error.
+
+  python bench/trajectories.py mesh  [--config config/config.yaml]
+      N from 20 to 160, Hermite-Simpson vs trapezoidal, on each scenario's base problem:
+      solve time (median of --repeat) and final-state error after re-integrating the
+      optimal controls with DOP853 (rtol 1e-10).
+  python bench/trajectories.py batch [--config config/paper.yaml] [--jobs 2] [--nodes N]
+      The whole config's samples as the workflow solves them (continuation, retries,
+      re-integration check): wall time, share solved before / after retries, worst errors.
+      Goal (issue 2): 500 trajectories on 2 cores <= 60 s, every error <= 0.1 m, 0.01 m/s.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+import numpy as np  # noqa: E402
+
+from traj2events.batch import solve_samples  # noqa: E402
+from traj2events.config import ScenarioSettings, load_config  # noqa: E402
+from traj2events.dynamics import Dynamics  # noqa: E402
+from traj2events.ocp import LandingProblem  # noqa: E402
+from traj2events.scenarios import base_conditions  # noqa: E402
+from traj2events.upsample import final_state_error  # noqa: E402
+
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+
+def machine() -> str:
+    return f"{platform.node()}, {os.cpu_count()} cores, {platform.processor() or platform.machine()}, Python {platform.python_version()}"
+
+
+def mesh(config: dict, repeat: int) -> None:
+    print("| scenario | transcription | N | iterations | solve (s, median) | final position error (m) | final velocity error (m/s) |")
+    print("|---|---|---|---|---|---|---|")
+    for name in config["scenarios"]:
+        s = ScenarioSettings.from_config(config, name)
+        dyn = Dynamics(s.vehicle)
+        bc = base_conditions(s.scenario, s.vehicle)
+        for transcription, nodes in (("hermite-simpson", (20, 40, 60, 80, 120, 160)),
+                                     ("trapezoidal", (39, 79, 159, 319))):
+            for n in nodes:
+                problem = LandingProblem(s.vehicle, replace(s.ocp, n_nodes=n, transcription=transcription))
+                problem.solve(bc)  # first solve pays for building the expanded functions
+                times, sol = [], None
+                for _ in range(repeat):
+                    sol = problem.solve(bc)
+                    times.append(sol.solve_time_s)
+                err = final_state_error(dyn, sol.t, sol.state, sol.control) if sol.success else (np.nan, np.nan)
+                print(f"| {name} | {transcription} | {n} | {sol.iterations} | {statistics.median(times):.3f} | "
+                      f"{err[0]:.2e} | {err[1]:.2e} |", flush=True)
+
+
+def batch(config: dict, jobs: int, nodes: int | None) -> None:
+    if nodes:
+        config["ocp"]["n_nodes"] = nodes
+    start = time.perf_counter()
+    totals = {"n": 0, "first": 0, "solved": 0}
+    worst_r, worst_v, over = 0.0, 0.0, 0
+    for name in config["scenarios"]:
+        s = ScenarioSettings.from_config(config, name)
+        t0 = time.perf_counter()
+        base = LandingProblem(s.vehicle, s.ocp).solve(base_conditions(s.scenario, s.vehicle))
+        results = solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base,
+                                jobs=jobs)
+        ok = [r for r in results if r.success]
+        er = max((r.error_position_m for r in ok), default=np.nan)
+        ev = max((r.error_velocity_m_s for r in ok), default=np.nan)
+        n_over = sum(r.error_position_m > 0.1 or r.error_velocity_m_s > 0.01 for r in ok)
+        print(f"{name}: {len(results)} samples, {sum(r.method == 'warm' for r in results)} on the first attempt, "
+              f"{len(ok)} solved, max error {er:.3g} m / {ev:.3g} m/s, {n_over} over 0.1 m or 0.01 m/s, "
+              f"{time.perf_counter() - t0:.1f} s", flush=True)
+        totals["n"] += len(results)
+        totals["first"] += sum(r.method == "warm" for r in results)
+        totals["solved"] += len(ok)
+        worst_r, worst_v, over = max(worst_r, er), max(worst_v, ev), over + n_over
+    wall = time.perf_counter() - start
+    print(f"TOTAL: {totals['n']} trajectories, N = {config['ocp']['n_nodes']}, {jobs} processes: {wall:.1f} s wall; "
+          f"{100 * totals['first'] / totals['n']:.1f} % solved before retries, "
+          f"{100 * totals['solved'] / totals['n']:.1f} % after; max error {worst_r:.3g} m / {worst_v:.3g} m/s; "
+          f"{over} over the goal")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("what", choices=("mesh", "batch"))
+    parser.add_argument("--config", default=None, help="config YAML (mesh: config/config.yaml, batch: config/paper.yaml)")
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--nodes", type=int, default=None, help="override ocp.n_nodes (batch)")
+    parser.add_argument("--repeat", type=int, default=3)
+    args = parser.parse_args()
+    default = "config/config.yaml" if args.what == "mesh" else "config/paper.yaml"
+    config = load_config(ROOT / (args.config or default), SCHEMA)
+    print(f"# {args.what} on {machine()}, {time.strftime('%Y-%m-%d')}")
+    mesh(config, args.repeat) if args.what == "mesh" else batch(config, args.jobs, args.nodes)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,42 @@
+"""Shared fixtures: the default vehicle, small problems that solve in well under a second."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from traj2events.dynamics import Dynamics, Vehicle
+from traj2events.ocp import BoundaryConditions, LandingProblem, OcpSettings
+
+ROOT = Path(__file__).resolve().parents[1]
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+
+def landing_bc(downrange=1500.0, altitude=600.0, speed=15.0, pitch_deg=5.0, mass=10_000.0, tf_guess=50.0):
+    """A descent-like landing towards the site at the origin (z down)."""
+    initial = np.array([-downrange, 20.0, -altitude, speed, 0.5, 5.0, np.radians(1.0), np.radians(pitch_deg),
+                        np.radians(2.0), 0.0, 0.0, 0.0, mass])
+    final = np.zeros(13)
+    final[8] = final[12] = np.nan
+    return BoundaryConditions(initial, final, tf_guess)
+
+
+@pytest.fixture(scope="session")
+def vehicle():
+    return Vehicle()
+
+
+@pytest.fixture(scope="session")
+def dynamics(vehicle):
+    return Dynamics(vehicle)
+
+
+@pytest.fixture(scope="session")
+def problem30(vehicle):
+    return LandingProblem(vehicle, OcpSettings(n_nodes=30))
+
+
+@pytest.fixture(scope="session")
+def solved30(problem30):
+    sol = problem30.solve(landing_bc())
+    assert sol.success, sol.status
+    return sol

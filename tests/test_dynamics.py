@@ -1,0 +1,94 @@
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from traj2events.dynamics import Dynamics, Vehicle, rotation_matrix, split_control_dynamics
+
+
+def rest_state(mass=8000.0, angles=(0.0, 0.0, 0.0), rates=(0.0, 0.0, 0.0)):
+    return np.array([0, 0, -100, 0, 0, 0, *angles, *rates, mass], dtype=float)
+
+
+def test_hover_throttle_cancels_gravity(dynamics, vehicle):
+    x = rest_state()
+    u_hover = x[12] * vehicle.g_m_s2 / vehicle.thrust_main_N
+    xdot = dynamics(x, [u_hover, 0, 0, 0])
+    np.testing.assert_allclose(xdot[3:6], 0.0, atol=1e-12)
+    assert xdot[12] == pytest.approx(-vehicle.thrust_main_N * u_hover / (vehicle.isp_s * vehicle.g0_m_s2))
+
+
+def test_free_fall_accelerates_downwards(dynamics, vehicle):
+    xdot = dynamics(rest_state(), [0, 0, 0, 0])
+    np.testing.assert_allclose(xdot[3:6], [0, 0, vehicle.g_m_s2])  # z is down
+
+
+def test_positive_pitch_thrust_brakes_forward_motion(dynamics, vehicle):
+    theta = np.radians(50)
+    x = rest_state(angles=(0, theta, 0))
+    xdot = dynamics(x, [1, 0, 0, 0])
+    a = vehicle.thrust_main_N / x[12]
+    assert xdot[3] == pytest.approx(-a * np.sin(theta))
+    assert xdot[5] == pytest.approx(vehicle.g_m_s2 - a * np.cos(theta))
+
+
+def test_rotation_matrix_is_rz_ry_rx():
+    phi, theta, psi = 0.3, -0.2, 1.1
+    rx = np.array([[1, 0, 0], [0, np.cos(phi), -np.sin(phi)], [0, np.sin(phi), np.cos(phi)]])
+    ry = np.array([[np.cos(theta), 0, np.sin(theta)], [0, 1, 0], [-np.sin(theta), 0, np.cos(theta)]])
+    rz = np.array([[np.cos(psi), -np.sin(psi), 0], [np.sin(psi), np.cos(psi), 0], [0, 0, 1]])
+    np.testing.assert_allclose(rotation_matrix(phi, theta, psi), rz @ ry @ rx, atol=1e-15)
+
+
+def test_euler_rates_equal_body_rates_at_zero_attitude(dynamics):
+    xdot = dynamics(rest_state(rates=(0.1, -0.2, 0.3)), [0, 0, 0, 0])
+    np.testing.assert_allclose(xdot[6:9], [0.1, -0.2, 0.3])
+
+
+def test_gyroscopic_term_has_the_physical_minus_sign(dynamics, vehicle):
+    w = np.array([0.2, -0.1, 0.3])
+    inertia = np.array(vehicle.inertia_kgm2)
+    xdot = dynamics(rest_state(rates=w), [0, 0, 0, 0])
+    np.testing.assert_allclose(xdot[9:12], -np.cross(w, inertia * w) / inertia)
+
+
+def test_torque_free_rotation_conserves_momentum_and_energy():
+    vehicle = Vehicle(inertia_kgm2=(1000.0, 2000.0, 3000.0))  # asymmetric: the sign matters
+    dyn = Dynamics(vehicle)
+    inertia = np.array(vehicle.inertia_kgm2)
+    x0 = rest_state(rates=(0.3, 0.05, -0.2))
+    sol = solve_ivp(lambda t, x: dyn(x, [0, 0, 0, 0]), (0, 60), x0, method="DOP853", rtol=1e-11, atol=1e-12)
+    w0, w1 = x0[9:12], sol.y[9:12, -1]
+    # |I w| is frame-independent; kinetic energy too. The printed "+" sign breaks both.
+    assert np.linalg.norm(inertia * w1) == pytest.approx(np.linalg.norm(inertia * w0), rel=1e-8)
+    assert np.dot(w1, inertia * w1) == pytest.approx(np.dot(w0, inertia * w0), rel=1e-8)
+
+
+@pytest.mark.parametrize("u", [0.5, -0.5])
+def test_attitude_thrusters_burn_fuel_for_either_sign(dynamics, vehicle, u):
+    xdot = dynamics(rest_state(), [0, u, 0, 0])
+    expected = -2 * vehicle.thrust_rcs_N * 0.5 / (vehicle.isp_s * vehicle.g0_m_s2)
+    assert xdot[12] == pytest.approx(expected)
+    assert xdot[9] == pytest.approx(2 * vehicle.lever_arm_m * vehicle.thrust_rcs_N * u / vehicle.inertia_kgm2[0])
+
+
+def test_split_controls_match_physical_form(dynamics, vehicle):
+    f_split = split_control_dynamics(vehicle)
+    x = rest_state(angles=(0.1, 0.2, 0.3), rates=(0.01, 0.02, -0.01))
+    w = np.array([0.6, 0.3, 0.0, 0.2, 0.0, 0.4, 0.0])  # u_att = (0.3, -0.4, 0.2)
+    split = np.asarray(f_split(x, w)).ravel()
+    physical = dynamics(x, [0.6, 0.3, -0.4, 0.2])
+    np.testing.assert_allclose(split, physical, rtol=1e-13)
+
+
+def test_batch_evaluation_matches_single(dynamics):
+    rng = np.random.default_rng(1)
+    states = np.column_stack([rng.normal(size=(5, 12)), rng.uniform(6000, 10000, 5)])
+    controls = rng.uniform(-1, 1, size=(5, 4))
+    batch = dynamics(states, controls)
+    for k in range(5):
+        np.testing.assert_allclose(batch[k], dynamics(states[k], controls[k]))
+
+
+def test_vehicle_rejects_dry_mass_above_wet_mass():
+    with pytest.raises(ValueError, match="dry_mass_kg"):
+        Vehicle(mass_kg=5000.0, dry_mass_kg=6000.0)

@@ -1,0 +1,63 @@
+"""Files: atomic writes, self-describing trajectories, byte-reproducible HDF5."""
+import os
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from conftest import landing_bc
+
+from traj2events.dynamics import Dynamics
+from traj2events.io import atomic_output, read_trajectory, solution_attrs, vehicle_attrs, write_trajectory
+from traj2events.upsample import reintegrate, upsample
+
+
+def test_atomic_output_leaves_nothing_behind_on_failure(tmp_path):
+    target = tmp_path / "out" / "file.h5"
+    with pytest.raises(RuntimeError):
+        with atomic_output(target) as tmp:
+            tmp.write_bytes(b"half")
+            raise RuntimeError("job died")
+    assert not target.exists()
+    assert list(target.parent.iterdir()) == []
+
+
+def test_atomic_output_renames_into_place_with_normal_permissions(tmp_path):
+    target = tmp_path / "file.txt"
+    with atomic_output(target) as tmp:
+        tmp.write_text("done")
+    assert target.read_text() == "done"
+    assert target.stat().st_mode & 0o044  # readable by others, unlike mkstemp's 0600
+
+
+@pytest.fixture()
+def trajectory_file(tmp_path, solved30, vehicle, dynamics):
+    poses = upsample(dynamics, solved30.t, solved30.state, solved30.control, fps=20.0)
+    attrs = {**vehicle_attrs(vehicle), **solution_attrs(solved30, landing_bc()), "fps": 20.0}
+    path = tmp_path / "trajectory.h5"
+    write_trajectory(path, (solved30.t, solved30.state, solved30.control), poses, attrs)
+    return path
+
+
+def test_trajectory_file_layout(trajectory_file):
+    with h5py.File(trajectory_file) as f:
+        assert f["nodes/state"].shape[1] == 13 and f["nodes/control"].shape[1] == 4
+        assert f["poses/state"].shape[0] == f["poses/t"].shape[0] == f["poses/control"].shape[0]
+        for key in ("thrust_main_N", "thrust_rcs_N", "lever_arm_m", "inertia_kgm2", "isp_s", "g_m_s2",
+                    "g0_m_s2", "fps", "initial_state", "final_state", "transcription", "N", "solver_status",
+                    "iterations", "solve_time_s", "cost"):
+            assert key in f.attrs, key
+        assert list(f["nodes"].attrs["state_names"])[:3] == ["x", "y", "z"]
+
+
+def test_trajectory_reintegrates_from_the_file_alone(trajectory_file):
+    tr = read_trajectory(trajectory_file)
+    states, _ = reintegrate(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes, tr.t)
+    np.testing.assert_allclose(states, tr.state, rtol=1e-9, atol=1e-6)
+
+
+def test_same_content_gives_same_bytes(tmp_path, solved30, vehicle):
+    paths = [tmp_path / "a.h5", tmp_path / "b.h5"]
+    for p in paths:
+        write_trajectory(p, (solved30.t, solved30.state, solved30.control), None, vehicle_attrs(vehicle))
+    assert paths[0].read_bytes() == paths[1].read_bytes()

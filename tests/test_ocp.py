@@ -1,0 +1,108 @@
+"""The optimal-control problem: constraints hold, accuracy scales with N, and the edges."""
+import time
+
+import numpy as np
+import pytest
+from conftest import landing_bc
+
+from traj2events.dynamics import Dynamics, Vehicle
+from traj2events.ocp import FINAL_FIXED, LandingProblem, OcpSettings
+from traj2events.upsample import final_state_error, interpolate_controls
+
+
+def max_tilt_deg(sol):
+    return np.degrees(np.arccos(np.cos(sol.state[:, 6]) * np.cos(sol.state[:, 7]))).max()
+
+
+def test_solution_meets_boundary_conditions_and_bounds(solved30, vehicle):
+    bc = landing_bc()
+    np.testing.assert_allclose(solved30.state[0], bc.initial, atol=1e-9)
+    np.testing.assert_allclose(solved30.state[-1, FINAL_FIXED], bc.final[FINAL_FIXED], atol=1e-6)
+    u = solved30.control
+    assert u[:, 0].min() >= -1e-8 and u[:, 0].max() <= 1 + 1e-8
+    assert np.abs(u[:, 1:]).max() <= 1 + 1e-8
+    assert max_tilt_deg(solved30) <= vehicle.tilt_max_deg + 1e-6
+    assert (solved30.state[:, 2] <= 1e-6).all()  # never below the ground (z down)
+    assert vehicle.dry_mass_kg < solved30.state[-1, 12] < vehicle.mass_kg
+
+
+def test_reported_cost_is_the_papers_objective(solved30):
+    # Independent quadrature of the piecewise-linear controls on a fine grid.
+    t = np.linspace(0, solved30.tf_s, 20001)
+    u = interpolate_controls(solved30.t, solved30.control, t)
+    effort = np.trapezoid(np.sum(u**2, axis=1), t)
+    eps = 0.5
+    expected = (1 - eps) * (solved30.state[0, 12] - solved30.state[-1, 12]) + eps * effort
+    assert solved30.cost == pytest.approx(expected, rel=1e-6)
+
+
+def test_hermite_simpson_error_falls_as_fourth_power_of_step(vehicle, dynamics):
+    errors = {}
+    for n in (20, 40):
+        sol = LandingProblem(vehicle, OcpSettings(n_nodes=n)).solve(landing_bc())
+        assert sol.success
+        errors[n] = final_state_error(dynamics, sol.t, sol.state, sol.control)[0]
+    assert errors[20] / errors[40] > 6  # 16 in the limit; kinks in the controls cost some order
+
+
+def test_hermite_simpson_beats_trapezoidal_at_equal_nodes(vehicle, dynamics):
+    err = {}
+    for tr in ("hermite-simpson", "trapezoidal"):
+        sol = LandingProblem(vehicle, OcpSettings(n_nodes=40, transcription=tr)).solve(landing_bc())
+        assert sol.success, tr
+        err[tr] = final_state_error(dynamics, sol.t, sol.state, sol.control)[0]
+    assert err["hermite-simpson"] * 10 < err["trapezoidal"]
+
+
+def test_pitch_near_tilt_limit(problem30, vehicle):
+    bc = landing_bc(pitch_deg=79.0, speed=60.0, altitude=1500.0, downrange=3000.0)
+    sol = problem30.solve(bc)
+    assert sol.success, sol.status
+    assert max_tilt_deg(sol) <= vehicle.tilt_max_deg + 1e-6
+    assert max_tilt_deg(sol) >= 79.0 - 1e-6  # starts right at the edge
+
+
+def test_epsilon_to_zero_gives_bang_bang_throttle(vehicle):
+    smooth = LandingProblem(vehicle, OcpSettings(n_nodes=30, epsilon=0.9)).solve(landing_bc())
+    bang = LandingProblem(vehicle, OcpSettings(n_nodes=30, epsilon=1e-4)).solve(landing_bc())
+    assert smooth.success and bang.success
+
+    def saturated(sol):
+        return np.mean((sol.control[:, 0] < 0.01) | (sol.control[:, 0] > 0.99))
+
+    assert saturated(bang) >= 0.85
+    assert saturated(bang) > saturated(smooth)
+    assert bang.state[-1, 12] >= smooth.state[-1, 12] - 1e-6  # mass-optimal burns no more fuel
+
+
+def test_not_enough_fuel_fails_fast_with_bounded_iterations():
+    vehicle = Vehicle(mass_kg=6100.0, dry_mass_kg=6000.0)
+    problem = LandingProblem(vehicle, OcpSettings(n_nodes=20, max_iter=80))
+    start = time.perf_counter()
+    sol = problem.solve(landing_bc(mass=6100.0, altitude=3000.0, speed=100.0, downrange=5000.0))
+    assert not sol.success
+    assert sol.iterations <= 80
+    assert sol.status in {"Maximum_Iterations_Exceeded", "Infeasible_Problem_Detected",
+                          "Restoration_Failed", "Search_Direction_Becomes_Too_Small"}
+    assert time.perf_counter() - start < 30  # bounded, not a stall (generous: shared machine)
+
+
+def test_extreme_downrange(problem30):
+    sol = problem30.solve(landing_bc(downrange=20_000.0, altitude=3000.0, speed=150.0, pitch_deg=50.0, tf_guess=150.0))
+    assert sol.success, sol.status
+    assert sol.tf_s > 100.0
+
+
+@pytest.mark.parametrize("tf_guess", [2.0, 500.0])
+def test_very_small_and_very_large_tf_guesses_find_the_same_optimum(problem30, solved30, tf_guess):
+    sol = problem30.solve(landing_bc(tf_guess=tf_guess))
+    assert sol.success, sol.status
+    assert sol.tf_s == pytest.approx(solved30.tf_s, rel=0.02)
+    assert sol.state[-1, 12] == pytest.approx(solved30.state[-1, 12], abs=5.0)
+
+
+def test_settings_reject_bad_values():
+    with pytest.raises(ValueError, match="transcription"):
+        OcpSettings(transcription="euler")
+    with pytest.raises(ValueError, match="refine_n_nodes"):
+        OcpSettings(n_nodes=40, refine_n_nodes=30)

@@ -1,0 +1,61 @@
+"""Camera poses at the frame rate."""
+import numpy as np
+import pytest
+
+from traj2events.upsample import frame_times, interpolate_controls, reintegrate, spline_states, upsample
+
+
+def test_frame_times_cover_zero_to_tf():
+    t = frame_times(1.0, 10.0)
+    assert len(t) == 11 and t[0] == 0 and t[-1] == pytest.approx(1.0)
+    t = frame_times(1.05, 10.0)
+    assert len(t) == 11 and t[-1] <= 1.05
+    np.testing.assert_allclose(np.diff(frame_times(75.3, 100.0)), 0.01, atol=1e-12)
+
+
+def test_free_fall_matches_closed_form(dynamics, vehicle):
+    # Engine off, level attitude: z(t) = z0 + vz0 t + g t^2 / 2 exactly.
+    t_nodes = np.linspace(0, 10, 6)
+    x0 = np.array([0, 0, -1000, 3.0, 0, 2.0, 0, 0, 0, 0, 0, 0, 9000.0])
+    t = frame_times(10.0, 25.0)
+    states, final = reintegrate(dynamics, t_nodes, x0, np.zeros((6, 4)), t)
+    np.testing.assert_allclose(states[:, 2], -1000 + 2.0 * t + 0.5 * vehicle.g_m_s2 * t**2, rtol=1e-11, atol=1e-8)
+    np.testing.assert_allclose(states[:, 0], 3.0 * t, atol=1e-9)
+    np.testing.assert_allclose(final, states[-1])
+
+
+def test_reintegrated_poses_pass_through_nodes(solved30, dynamics):
+    t, state, control = upsample(dynamics, solved30.t, solved30.state, solved30.control, fps=100.0)
+    np.testing.assert_array_equal(state[0], solved30.state[0])
+    # Between the re-integration and the transcription lies only the HS error (cm here).
+    at_nodes = np.column_stack([np.interp(solved30.t, t, c) for c in state.T])
+    assert np.abs(at_nodes[:, :3] - solved30.state[:, :3]).max() < 1.0
+    assert control.shape == (len(t), 4) and (np.diff(t) > 0).all()
+
+
+def test_spline_option_interpolates_nodes_exactly(solved30, dynamics):
+    _, state, _ = upsample(dynamics, solved30.t, solved30.state, solved30.control, fps=5.0, method="spline")
+    np.testing.assert_allclose(spline_states(solved30.t, solved30.state, solved30.t), solved30.state, atol=1e-9)
+    assert state.shape[1] == 13
+
+
+def test_controls_are_piecewise_linear():
+    t_nodes = np.array([0.0, 1.0, 3.0])
+    u = np.array([[0, 0, 0, 0], [1, -1, 0, 0], [0, 1, 0, 0]], dtype=float)
+    np.testing.assert_allclose(interpolate_controls(t_nodes, u, np.array([0.5, 2.0]))[:, :2], [[0.5, -0.5], [0.5, 0.0]])
+
+
+def test_upsample_rejects_unknown_method_and_out_of_span_times(solved30, dynamics):
+    with pytest.raises(ValueError, match="upsampling.method"):
+        upsample(dynamics, solved30.t, solved30.state, solved30.control, 10.0, method="linear")
+    with pytest.raises(ValueError, match="t_eval"):
+        reintegrate(dynamics, solved30.t, solved30.state[0], solved30.control, np.array([solved30.tf_s + 1]))
+
+
+def test_shooting_check_agrees_with_dop853(solved30, dynamics):
+    from traj2events.upsample import ShootingCheck, final_state_error
+
+    fast = ShootingCheck(dynamics)(solved30.t, solved30.state, solved30.control)
+    reference = final_state_error(dynamics, solved30.t, solved30.state, solved30.control)
+    assert fast[0] == pytest.approx(reference[0], abs=1e-5)
+    assert fast[1] == pytest.approx(reference[1], abs=1e-6)

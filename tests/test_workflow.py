@@ -1,0 +1,136 @@
+"""The real `snakemake` command on the smoke config, in a temporary directory."""
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from conftest import ROOT
+
+pytestmark = pytest.mark.slow
+SNAKEMAKE = Path(sys.executable).parent / "snakemake"
+
+
+def snakemake(workdir, *args, env=None, check=True):
+    cmd = [str(SNAKEMAKE), "-s", str(ROOT / "Snakefile"), "--directory", str(workdir), "--cores", "2",
+           "--configfile", str(workdir / "config.yaml"), *args]
+    run = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=workdir)
+    if check and run.returncode != 0:
+        raise AssertionError(f"snakemake failed:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}")
+    return run
+
+
+def two_scenario_smoke():
+    """The smoke config plus a second, one-trajectory scenario (to see what an edit touches)."""
+    config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+    other = dict(config["scenarios"]["descent"], n_trajectories=1)
+    config["scenarios"]["hover"] = dict(other, downrange_m=[50.0, 150.0], altitude_m=[100.0, 200.0])
+    return config
+
+
+def jobs_in_dry_run(workdir, env=None):
+    """(rule, wildcards) of the jobs a dry run would execute."""
+    out = snakemake(workdir, "-n", "--quiet", "rules", env=env).stdout
+    rows = [line.split() for line in out.splitlines()]
+    return {r[0]: int(r[1]) for r in rows if len(r) == 2 and r[1].isdigit() and r[0] != "total"}
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    workdir = tmp_path_factory.mktemp("wf")
+    (workdir / "config.yaml").write_text(yaml.safe_dump(two_scenario_smoke()))
+    snakemake(workdir)
+    return workdir
+
+
+def test_smoke_dataset_is_complete(built):
+    results = built / "results"
+    for scenario, n in (("descent", 2), ("hover", 1)):
+        table = pd.read_csv(results / scenario / "samples.csv")
+        assert len(table) == n and table["success"].all()
+        for i in table["id"]:
+            with h5py.File(results / scenario / f"{i:04d}" / "trajectory.h5") as f:
+                assert f.attrs["fps"] == 10.0
+                t = f["poses/t"][()]
+                np.testing.assert_allclose(np.diff(t), 0.1, atol=1e-12)
+                assert f["poses/state"].shape == (len(t), 13)
+                assert abs(f["poses/state"][-1, 2]) < 0.5  # lands at the site
+    index = pd.read_csv(results / "descent" / "index.csv")
+    assert list(index["id"]) == [0, 1] and (index["n_poses"] > 10).all()
+    assert (results / "figures" / "trajectories.png").stat().st_size > 10_000
+    summary = pd.read_csv(results / "summary.csv")
+    assert set(summary["scenario"]) == {"descent", "hover"} and (summary["failed"] == 0).all()
+    assert (results / "logs" / "descent" / "sample_trajectories.log").read_text().count("sample ") >= 2
+    assert not list(results.rglob("*.part"))  # no temporary files left
+
+
+def test_second_run_has_nothing_to_do(built):
+    run = snakemake(built)
+    assert "Nothing to be done" in run.stdout + run.stderr
+
+
+def test_same_config_same_bytes(built, tmp_path):
+    shutil.copy(built / "config.yaml", tmp_path / "config.yaml")
+    snakemake(tmp_path)
+    for rel in ("results/descent/0001/trajectory.h5", "results/hover/0000/trajectory.h5"):
+        with h5py.File(built / rel) as a, h5py.File(tmp_path / rel) as b:
+            for key in ("nodes/t", "nodes/state", "nodes/control", "poses/t", "poses/state", "poses/control"):
+                assert a[key][()].tobytes() == b[key][()].tobytes(), key
+            # Everything but the wall-clock solve time is identical.
+            assert {k for k in a.attrs if k != "solve_time_s"} == {k for k in b.attrs if k != "solve_time_s"}
+            for k in a.attrs:
+                if k != "solve_time_s":
+                    va, vb = np.asarray(a.attrs[k]), np.asarray(b.attrs[k])
+                    assert va.tobytes() == vb.tobytes(), k  # bitwise, NaN included
+    assert (built / "results/figures/trajectories.png").read_bytes() == (tmp_path / "results/figures/trajectories.png").read_bytes()
+
+
+def test_editing_one_scenario_reruns_only_its_jobs(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    workdir = tmp_path / "wf"
+    config = yaml.safe_load((workdir / "config.yaml").read_text())
+    config["scenarios"]["hover"]["altitude_m"] = [120.0, 220.0]
+    (workdir / "config.yaml").write_text(yaml.safe_dump(config))
+    out = snakemake(workdir, "-n").stdout
+    wildcards = [line.strip() for line in out.splitlines() if line.strip().startswith("wildcards:")]
+    assert wildcards and all("scenario=hover" in w for w in wildcards), wildcards
+    jobs = jobs_in_dry_run(workdir)
+    assert jobs.get("base_solution") == 1 and jobs.get("sample_trajectories") == 1
+
+
+def test_code_change_reruns_the_rules_that_use_it(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    workdir = tmp_path / "wf"
+    shutil.copytree(ROOT / "src", tmp_path / "src")
+    env = dict(os.environ, PYTHONPATH=str(tmp_path / "src"))
+    assert jobs_in_dry_run(workdir, env) == {}
+    figures = tmp_path / "src" / "traj2events" / "figures.py"
+    figures.write_text(figures.read_text() + "\n# a change\n")
+    assert jobs_in_dry_run(workdir, env) == {"trajectory_summary": 1, "all": 1}
+    upsample = tmp_path / "src" / "traj2events" / "upsample.py"
+    upsample.write_text(upsample.read_text() + "\n# a change\n")
+    jobs = jobs_in_dry_run(workdir, env)
+    assert jobs.get("sample_trajectories") == 2 and "base_solution" not in jobs  # both scenarios
+
+
+def test_invalid_config_stops_before_any_job(tmp_path):
+    config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+    config["ocp"]["n_nodes"] = 2
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    run = snakemake(tmp_path, check=False)
+    assert run.returncode != 0
+    assert "ocp.n_nodes" in run.stdout + run.stderr and ">= 3" in run.stdout + run.stderr
+    assert not (tmp_path / "results").exists()
+
+
+def test_lint_passes():
+    run = subprocess.run([str(SNAKEMAKE), "--lint", "-s", str(ROOT / "Snakefile")], capture_output=True, text=True,
+                         cwd=ROOT)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "Congratulations" in run.stdout + run.stderr
