@@ -116,7 +116,7 @@ def split_controls(control: np.ndarray) -> np.ndarray:
 class LandingProblem:
     """The NLP for one vehicle and transcription; `solve` takes new boundary conditions."""
 
-    def __init__(self, vehicle: Vehicle, settings: OcpSettings) -> None:
+    def __init__(self, vehicle: Vehicle, settings: OcpSettings, ipopt_options: dict | None = None) -> None:
         self.vehicle, self.settings = vehicle, settings
         n = settings.n_nodes
         scale = ca.DM(STATE_SCALE)
@@ -170,6 +170,7 @@ class LandingProblem:
                 "tol": settings.tol,
                 "mumps_scaling": 0,
                 "mumps_permuting_scaling": 0,
+                **(ipopt_options or {}),
             },
         )
         self._opti, self._X, self._W, self._tau = opti, X, W, tau
