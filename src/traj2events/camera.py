@@ -1,0 +1,91 @@
+"""Pinhole camera (geometry.md): intrinsics, projection, pose from a trajectory state.
+
+Camera frame = body frame: X forward, Y right, Z down = boresight. Image columns run
+along X and rows along Y; a pixel (column j, row i) has its centre at
+    x_s = j + 0.5 - W/2,   y_s = i + 0.5 - H/2     (px, principal point at the centre)
+and projection is x_s = f X / Z, y_s = f Y / Z with f = W / (2 tan(fov/2)).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dynamics import rotation_matrix
+
+
+@dataclass(frozen=True)
+class Camera:
+    width: int
+    height: int
+    fov_deg: float  # across the width
+
+    def __post_init__(self) -> None:
+        if self.width < 1 or self.height < 1:
+            raise ValueError(f"camera.width/height: expected >= 1, got {self.width} x {self.height}")
+        if not 0.0 < self.fov_deg < 180.0:
+            raise ValueError(f"camera.fov_deg: expected 0 < fov < 180, got {self.fov_deg}")
+
+    @property
+    def focal_px(self) -> float:
+        return self.width / (2.0 * np.tan(np.radians(self.fov_deg) / 2.0))
+
+    def pixel_coordinates(self, dtype=np.float64) -> tuple[np.ndarray, np.ndarray]:
+        """Centred pixel coordinates: x_s as a row (1, W) and y_s as a column (H, 1),
+        to broadcast into (H, W) without materialising the grid."""
+        x_s = (np.arange(self.width, dtype=np.float64) + 0.5 - self.width / 2).astype(dtype)
+        y_s = (np.arange(self.height, dtype=np.float64) + 0.5 - self.height / 2).astype(dtype)
+        return x_s[None, :], y_s[:, None]
+
+    def project(self, points_cam: np.ndarray) -> np.ndarray:
+        """Camera-frame points (..., 3) -> centred pixel coordinates (..., 2) (x_s, y_s)."""
+        p = np.asarray(points_cam, dtype=float)
+        return self.focal_px * p[..., :2] / p[..., 2:3]
+
+    def back_project(self, x_s: np.ndarray, y_s: np.ndarray) -> np.ndarray:
+        """Centred pixel coordinates -> rays (..., 3) = (a, b, 1) with a = x_s / f, b = y_s / f."""
+        x_s, y_s = np.broadcast_arrays(np.asarray(x_s, dtype=float), np.asarray(y_s, dtype=float))
+        return np.stack([x_s / self.focal_px, y_s / self.focal_px, np.ones_like(x_s)], axis=-1)
+
+    def to_pixel_index(self, xy_s: np.ndarray) -> np.ndarray:
+        """Centred coordinates (..., 2) -> (column, row) continuous indices (centre of pixel 0 = 0)."""
+        return np.asarray(xy_s) + np.array([self.width / 2 - 0.5, self.height / 2 - 0.5])
+
+
+@dataclass(frozen=True)
+class CameraPose:
+    """Camera position in the inertial frame (m) and R_ic = R_iv (camera -> inertial)."""
+
+    position: np.ndarray
+    rotation: np.ndarray
+
+    def to_camera(self, points_inertial: np.ndarray) -> np.ndarray:
+        """Inertial points (..., 3) -> camera frame."""
+        return (np.asarray(points_inertial) - self.position) @ self.rotation
+
+
+def camera_pose(state: np.ndarray) -> CameraPose:
+    """Pose of the camera for one 13-state (the camera sits at the centre of mass)."""
+    return CameraPose(np.asarray(state[0:3], dtype=float), rotation_matrix(state[6], state[7], state[8]))
+
+
+def camera_motion(state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(v_c, omega): camera-frame velocity R_iv^T v (m/s) and body rates (p, q, r) (rad/s)."""
+    rotation = rotation_matrix(state[6], state[7], state[8])
+    return rotation.T @ np.asarray(state[3:6], dtype=float), np.asarray(state[9:12], dtype=float)
+
+
+# OpenGL cameras look along -Z with +Y up and +X to the right of the image. Ours looks
+# along +Z with image right = +X and image down = +Y, so X_gl = X, Y_gl = -Y, Z_gl = -Z.
+CAMERA_TO_OPENGL = np.diag([1.0, -1.0, -1.0])
+
+
+def opengl_camera_to_world(pose: CameraPose) -> np.ndarray:
+    """4 x 4 camera-to-world matrix of the equivalent OpenGL camera (world = inertial frame).
+
+    The one place where the axis flip between this camera and an OpenGL one is made.
+    """
+    matrix = np.eye(4)
+    matrix[:3, :3] = pose.rotation @ CAMERA_TO_OPENGL
+    matrix[:3, 3] = pose.position
+    return matrix

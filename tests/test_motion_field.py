@@ -1,0 +1,209 @@
+"""Motion field: finite differences, ray-sphere reference, signs, discrete displacement."""
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from traj2events.camera import Camera, camera_motion, camera_pose
+from traj2events.motion_field import (
+    MOON_RADIUS_M,
+    inverse_depth_from_depth,
+    inverse_depth_plane,
+    inverse_depth_sphere,
+    inverse_depth_sphere_textbook,
+    local_vertical,
+    motion_field,
+    site_vertical,
+    sphere_displacement,
+    sphere_flow,
+)
+
+R = MOON_RADIUS_M
+CAM = Camera(64, 48, 45.0)
+
+
+def state_from(position, rotation, velocity, rates):
+    """13-state from a pose (R_iv), inertial velocity and body rates (mass irrelevant)."""
+    theta = -np.arcsin(np.clip(rotation[2, 0], -1, 1))
+    phi = np.arctan2(rotation[2, 1], rotation[2, 2])
+    psi = np.arctan2(rotation[1, 0], rotation[0, 0])
+    return np.array([*position, *velocity, phi, theta, psi, *rates, 8000.0])
+
+
+def rigid_motion(state, dt):
+    """The state after dt of constant inertial velocity and constant body rates."""
+    pose = camera_pose(state)
+    rotation = pose.rotation @ Rotation.from_rotvec(state[9:12] * dt).as_matrix()
+    return state_from(pose.position + state[3:6] * dt, rotation, state[3:6], state[9:12])
+
+
+def random_state(rng, altitude):
+    rotation = Rotation.from_euler("ZYX", rng.uniform(-0.6, 0.6, 3)).as_matrix()
+    position = [rng.uniform(-3000, 0), rng.uniform(-200, 200), -altitude]
+    return state_from(position, rotation, rng.uniform(-80, 80, 3), rng.uniform(-0.2, 0.2, 3))
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_analytic_field_matches_finite_differences(seed):
+    rng = np.random.default_rng(seed)
+    state = random_state(rng, altitude=rng.uniform(20, 4000))
+    pose = camera_pose(state)
+    f = CAM.focal_px
+    flow, terrain = sphere_flow(CAM, state, dtype=np.float64)
+    rows, cols = np.nonzero(terrain)
+    pick = rng.choice(len(rows), size=20, replace=False)
+    normal, height = local_vertical(pose.position, pose.rotation, R)
+    x_s, y_s = CAM.pixel_coordinates()
+    delta = 1e-5
+    for i, j in zip(rows[pick], cols[pick]):
+        a, b = x_s[0, j] / f, y_s[i, 0] / f
+        z = 1.0 / inverse_depth_sphere(np.array([[a]]), np.array([[b]]), normal, height)[0, 0]
+        world = pose.position + pose.rotation @ (z * np.array([a, b, 1.0]))  # a fixed surface point
+        xy = [CAM.project(camera_pose(rigid_motion(state, s * delta)).to_camera(world)) for s in (-1, 1)]
+        numeric = (xy[1] - xy[0]) / (2 * delta)
+        np.testing.assert_allclose(flow[i, j], numeric, rtol=1e-6, atol=1e-6 * np.abs(numeric).max())
+
+
+def reference_depth(a, b, normal, height):
+    """Near intersection of the ray (a, b, 1) with the sphere, in extended precision
+    (the textbook root: its cancellation costs little at 64-bit mantissa)."""
+    a, b = np.longdouble(a), np.longdouble(b)
+    n = [np.longdouble(c) for c in normal]
+    big = np.longdouble(R) + np.longdouble(height)
+    k = big * big - np.longdouble(R) ** 2
+    A = n[0] * a + n[1] * b + n[2]
+    s = a * a + b * b + 1
+    D = big * big * A * A - s * k
+    return (big * A - np.sqrt(D)) / s
+
+
+@pytest.mark.parametrize("height", [1.0, 10.0, 100.0, 1e3, 1e4, 1e5])
+def test_sphere_inverse_depth_against_ray_sphere_intersection(height):
+    # Boresight horizontal, camera y (rows) pointing down: A = b, the ray's tangent of
+    # depression. Rays from far below the horizon up to grazing it (delta -> 0).
+    normal = np.array([0.0, 1.0, 0.0])
+    k = height * (2 * R + height)
+    b_tangent = np.sqrt(k) / R  # D = 0
+    delta = np.concatenate([np.logspace(-8, 0, 33), [3.0, 30.0]])
+    b = (b_tangent * (1 + delta))[:, None]
+    a = np.array([[0.0, 0.05, -0.2]])
+    b_eff = b * np.sqrt(1 + a**2)  # keep every column grazing: D scales with s
+    ref = np.array([[1.0 / float(reference_depth(ai, bi, normal, height)) for ai, bi in zip(a[0], row)] for row in b_eff])
+    h64 = inverse_depth_sphere(np.broadcast_to(a, b_eff.shape), b_eff, normal, height)
+    err64 = np.abs(h64 / ref - 1)
+    assert (err64 <= 1e-12 * (1 + 1 / np.sqrt(delta))[:, None]).all(), err64.max()
+    # float32: compare with the exact answer for the float32-rounded rays. Arithmetic
+    # rounding is amplified near grazing by at most ~1/sqrt(delta); rays within ~1e-5 of
+    # the tangent may round to a miss (h = 0), which is as exact as float32 can say.
+    a32, b32 = np.broadcast_to(a, b_eff.shape).astype(np.float32), b_eff.astype(np.float32)
+    with np.errstate(invalid="ignore"):
+        ref32 = np.array([[1.0 / float(reference_depth(float(ai), float(bi), normal, height))
+                           for ai, bi in zip(ra, rb)] for ra, rb in zip(a32, b32)])
+    h32 = inverse_depth_sphere(a32, b32, normal, height)
+    eps = np.finfo(np.float32).eps
+    far = np.broadcast_to((delta >= 1e-5)[:, None], h32.shape)
+    assert (h32[far] > 0).all()
+    hits = (h32 > 0) & np.isfinite(ref32)  # both say hit (at the tangent, either answer is exact)
+    assert np.isfinite(ref32[far]).all()
+    err32 = np.abs(h32 / ref32 - 1)
+    bound = np.broadcast_to(40 * eps * (1 + 1 / np.sqrt(delta))[:, None], h32.shape)
+    assert (err32[hits] <= bound[hits]).all(), err32[hits].max()
+    assert (err32[far] <= 40 * eps * 320).all()  # never worse than ~1e-3, even 1e-5 from grazing
+
+
+@pytest.mark.parametrize("height, worst", [(1.0, 1e-2), (100.0, 1e-4)])
+def test_textbook_formula_loses_float32_precision_where_the_stable_one_does_not(height, worst):
+    normal = np.array([0.0, 0.0, 1.0])  # nadir-looking camera: no grazing rays at all
+    x_s, y_s = CAM.pixel_coordinates(np.float32)
+    a, b = x_s / np.float32(CAM.focal_px), y_s / np.float32(CAM.focal_px)
+    ref = inverse_depth_sphere(a.astype(np.float64), b.astype(np.float64), normal, height)
+    stable = inverse_depth_sphere(a, b, normal, height)
+    textbook = inverse_depth_sphere_textbook(a, b, normal, height)
+    assert np.abs(stable / ref - 1).max() < 4 * np.finfo(np.float32).eps
+    assert np.abs(textbook / ref - 1).max() > worst
+
+
+def test_sphere_agrees_with_plane_near_the_site_and_misses_above_the_horizon():
+    state = np.zeros(13)
+    state[2] = -500.0
+    pose = camera_pose(state)
+    x_s, y_s = CAM.pixel_coordinates()
+    a, b = x_s / CAM.focal_px, y_s / CAM.focal_px
+    sphere = inverse_depth_sphere(a, b, *local_vertical(pose.position, pose.rotation, R))
+    plane = inverse_depth_plane(a, b, *site_vertical(pose.position, pose.rotation))
+    np.testing.assert_allclose(sphere, plane, rtol=1e-3)  # curvature: 500 m vs R
+    up = inverse_depth_sphere(a, b, np.array([0.0, 0.0, -1.0]), 500.0)  # camera looking up
+    assert (up == 0).all()
+
+
+def test_local_vertical_differs_from_the_site_vertical_down_range():
+    position, rotation = np.array([-6000.0, 0.0, -2000.0]), np.eye(3)
+    n_sphere, h_sphere = local_vertical(position, rotation, R)
+    n_site, h_site = site_vertical(position, rotation)
+    angle = np.degrees(np.arccos(np.clip(n_sphere @ n_site, -1, 1)))
+    assert angle == pytest.approx(np.degrees(np.arctan(6000 / (R + 2000))), rel=1e-9)  # ~0.2 deg
+    assert h_sphere == pytest.approx(2000 + 6000**2 / (2 * R), rel=1e-3)
+
+
+def test_depth_map_inverse_depth_flags_sky():
+    depth = np.array([[10.0, np.inf], [0.0, np.nan]], dtype=np.float32)
+    np.testing.assert_array_equal(inverse_depth_from_depth(depth), np.array([[0.1, 0], [0, 0]], dtype=np.float32))
+
+
+def field(v_c=(0, 0, 0), omega=(0, 0, 0), h=0.01):
+    x_s, y_s = CAM.pixel_coordinates()
+    return motion_field(x_s, y_s, CAM.focal_px, np.full((CAM.height, CAM.width), h), np.array(v_c, float),
+                        np.array(omega, float))
+
+
+def test_descent_expands_about_the_principal_point():
+    u, v = field(v_c=(0, 0, 5.0))
+    x_s, y_s = CAM.pixel_coordinates()
+    assert (np.sign(u) == np.sign(x_s)).all() and (np.sign(v) == np.sign(y_s)).all()
+    np.testing.assert_allclose(u * y_s, v * x_s, atol=1e-9)  # radial
+
+
+def test_yaw_rotates_about_the_centre():
+    u, v = field(omega=(0, 0, 0.3))
+    x_s, y_s = CAM.pixel_coordinates()
+    np.testing.assert_allclose(u * x_s + v * y_s, 0, atol=1e-9)  # tangential
+    np.testing.assert_allclose(np.hypot(u, v), 0.3 * np.hypot(x_s, y_s))
+
+
+def test_forward_flight_at_nadir_moves_features_towards_column_zero():
+    u, v = field(v_c=(20.0, 0, 0))
+    assert (u < 0).all() and np.abs(v).max() == 0
+
+
+def test_sky_pixels_get_rotation_only_flow():
+    state = np.zeros(13)
+    state[2] = -1000.0
+    state[7] = np.radians(85)  # looking almost level: the top of the image is sky
+    state[3:6] = [50.0, 0, 5.0]
+    state[9:12] = [0.01, 0.02, 0.03]
+    flow, terrain = sphere_flow(CAM, state, dtype=np.float64)
+    assert terrain.any() and not terrain.all()
+    _, omega = camera_motion(state)
+    x_s, y_s = CAM.pixel_coordinates()
+    u, v = motion_field(x_s, y_s, CAM.focal_px, np.zeros((CAM.height, CAM.width)), np.zeros(3), omega)
+    np.testing.assert_allclose(flow[~terrain, 0], u[~terrain])
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_discrete_displacement_converges_to_field_times_dt_as_dt_squared(seed):
+    rng = np.random.default_rng(10 + seed)
+    state = random_state(rng, altitude=800.0)
+    flow, terrain = sphere_flow(CAM, state, dtype=np.float64)
+    errors = []
+    for dt in (0.02, 0.01):
+        disp, valid = sphere_displacement(CAM, state, rigid_motion(state, dt))
+        ok = valid & terrain
+        errors.append(np.abs(disp[ok] - flow[ok] * dt).max())  # px (relative to flow*dt it is O(dt))
+    assert errors[0] / errors[1] == pytest.approx(4.0, rel=0.2)
+    assert errors[1] < 1e-2 * np.abs(flow[terrain] * 0.01).max() * np.abs(flow[terrain] * 0.01).max()
+
+
+def test_zero_motion_gives_zero_displacement():
+    state = random_state(np.random.default_rng(3), 300.0)
+    disp, valid = sphere_displacement(CAM, state, state)
+    assert valid.any()
+    np.testing.assert_allclose(disp, 0, atol=1e-9)
