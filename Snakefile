@@ -3,7 +3,8 @@
 #   snakemake --cores 2                              # the default dataset (config/config.yaml)
 #   snakemake --cores 2 --configfile config/paper.yaml
 #
-# Stages so far: base solve per scenario -> continuation sampling -> camera poses.
+# Stages so far: base solve per scenario -> continuation sampling -> camera poses ->
+# motion-field ground truth.
 from snakemake.utils import min_version
 
 min_version("9.0")
@@ -14,6 +15,7 @@ configfile: "config/config.yaml"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/trajectories.smk"
+include: "workflow/rules/motion_field.smk"
 
 
 rule all:

@@ -61,3 +61,31 @@ def test_same_content_gives_same_bytes(tmp_path, solved30, vehicle):
     for p in paths:
         write_trajectory(p, (solved30.t, solved30.state, solved30.control), None, vehicle_attrs(vehicle))
     assert paths[0].read_bytes() == paths[1].read_bytes()
+
+
+def test_flo_round_trip_through_opencv_is_exact(tmp_path):
+    cv2 = pytest.importorskip("cv2")
+    rng = np.random.default_rng(0)
+    flow = rng.normal(scale=30, size=(7, 11, 2)).astype(np.float32)
+    flow[0, 0] = [np.float32(1e-38), -np.float32(3.4e38)]  # extremes survive too
+    path = tmp_path / "000001.flo"
+    from traj2events.io import read_flo, write_flo
+
+    write_flo(path, flow)
+    assert path.stat().st_size == 12 + flow.nbytes
+    read = cv2.readOpticalFlow(str(path))
+    assert read.dtype == np.float32 and read.shape == (7, 11, 2)
+    assert read.tobytes() == flow.tobytes()
+    assert read_flo(path).tobytes() == flow.tobytes()
+    cv2.writeOpticalFlow(str(tmp_path / "cv.flo"), flow)
+    assert (tmp_path / "cv.flo").read_bytes() == path.read_bytes()  # byte-identical to OpenCV's writer
+
+
+def test_flo_rejects_wrong_shape_and_magic(tmp_path):
+    from traj2events.io import read_flo, write_flo
+
+    with pytest.raises(ValueError, match="(H, W, 2)"):
+        write_flo(tmp_path / "x.flo", np.zeros((4, 4)))
+    (tmp_path / "bad.flo").write_bytes(b"\x00" * 20)
+    with pytest.raises(ValueError, match="magic"):
+        read_flo(tmp_path / "bad.flo")

@@ -207,3 +207,24 @@ def test_zero_motion_gives_zero_displacement():
     disp, valid = sphere_displacement(CAM, state, state)
     assert valid.any()
     np.testing.assert_allclose(disp, 0, atol=1e-9)
+
+
+@pytest.mark.parametrize("height", [0.0, -1e-9])
+def test_camera_on_the_ground_sees_no_terrain_and_stays_finite(height):
+    state = np.zeros(13)
+    state[2] = -height
+    flow, terrain = sphere_flow(CAM, state)
+    assert not terrain.any() and np.isfinite(flow).all()
+    a, b = CAM.pixel_coordinates()
+    assert (inverse_depth_plane(a, b, np.array([0, 0, 1.0]), height) == 0).all()
+
+
+def test_one_metre_altitude_is_exact():
+    state = np.zeros(13)
+    state[2] = -1.0
+    state[5] = 0.5  # descending at 0.5 m/s
+    flow, terrain = sphere_flow(CAM, state, dtype=np.float32)
+    assert terrain.all()
+    x_s, _ = CAM.pixel_coordinates()
+    # At 1 m over a (locally) flat surface, u = h x_s v_z with h = A / H = 1 / 1 m.
+    np.testing.assert_allclose(flow[CAM.height // 2, :, 0], x_s[0] * 0.5, rtol=1e-5)

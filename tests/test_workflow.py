@@ -61,6 +61,16 @@ def test_smoke_dataset_is_complete(built):
                 np.testing.assert_allclose(np.diff(t), 0.1, atol=1e-12)
                 assert f["poses/state"].shape == (len(t), 13)
                 assert abs(f["poses/state"][-1, 2]) < 0.5  # lands at the site
+    with h5py.File(results / "descent" / "0001" / "motion_field.h5") as f:
+        n = len(f["t"])
+        assert f["flow_sphere"].shape == (n, 32, 32, 2) and f["displacement_sphere"].shape == (n, 32, 32, 2)
+        assert f["valid"].shape == (n, 32, 32) and f["valid"][0].all()  # descent looks at the ground
+        assert f.attrs["focal_px"] == pytest.approx(16 / np.tan(np.radians(22.5)))
+        frames = f["frame_index"][()]
+        np.testing.assert_array_equal(frames, np.arange(n))  # every frame in the smoke config
+        flo = sorted((results / "descent" / "0001" / "flow").glob("*.flo"))
+        assert len(flo) == n and flo[0].name == "000000.flo"
+    assert (results / "descent" / "0001" / "motion_field.png").stat().st_size > 10_000
     index = pd.read_csv(results / "descent" / "index.csv")
     assert list(index["id"]) == [0, 1] and (index["n_poses"] > 10).all()
     assert (results / "figures" / "trajectories.png").stat().st_size > 10_000
@@ -112,7 +122,9 @@ def test_code_change_reruns_the_rules_that_use_it(built, tmp_path):
     assert jobs_in_dry_run(workdir, env) == {}
     figures = tmp_path / "src" / "traj2events" / "figures.py"
     figures.write_text(figures.read_text() + "\n# a change\n")
-    assert jobs_in_dry_run(workdir, env) == {"trajectory_summary": 1, "all": 1}
+    jobs = jobs_in_dry_run(workdir, env)
+    assert jobs["trajectory_summary"] == 1 and jobs["motion_field"] == 3  # both draw with figures.py
+    assert not {"base_solution", "sample_trajectories", "camera_poses"} & set(jobs)
     upsample = tmp_path / "src" / "traj2events" / "upsample.py"
     upsample.write_text(upsample.read_text() + "\n# a change\n")
     jobs = jobs_in_dry_run(workdir, env)

@@ -150,7 +150,7 @@ def cmd_index(args) -> int:
     from .io import atomic_output
 
     rows = []
-    for path in args.trajectories:
+    for path in [p for p in args.trajectories if Path(p).name == "trajectory.h5"]:
         with h5py.File(path, "r") as f:
             a = f.attrs
             rows.append({"scenario": a["scenario"], "id": int(a["id"]), "path": str(path), "tf_s": float(a["tf_s"]),
@@ -160,6 +160,62 @@ def cmd_index(args) -> int:
     with atomic_output(args.output) as tmp:
         pd.DataFrame(rows).to_csv(tmp, index=False, float_format="%.9g")
     _log(f"{args.output}: {len(rows)} trajectories")
+    return 0
+
+
+def paper_times(t: np.ndarray) -> list[int]:
+    """Pose indices nearest to the paper's five times t0, tf/4, tf/2, 3tf/4, tf."""
+    return [int(np.argmin(np.abs(t - frac * t[-1]))) for frac in (0.0, 0.25, 0.5, 0.75, 1.0)]
+
+
+def cmd_motion_field(args) -> int:
+    import shutil
+    import tempfile
+
+    from .camera import Camera
+    from .figures import motion_field_mosaic
+    from .io import atomic_output, read_trajectory, write_flo, write_motion_field
+    from .motion_field import sphere_displacement, sphere_flow
+
+    camera = Camera(args.width, args.height, args.fov_deg)
+    tr = read_trajectory(args.trajectory)
+    if tr.t is None or len(tr.t) < 2:
+        print(f"error: {args.trajectory}: expected poses/t with at least 2 poses", file=sys.stderr)
+        return 1
+    frames = np.arange(0, len(tr.t) - 1, args.every)  # each needs its next frame
+    n, h, w = len(frames), camera.height, camera.width
+    flow = np.empty((n, h, w, 2), np.float32)
+    displacement = np.empty((n, h, w, 2), np.float32)
+    valid = np.empty((n, h, w), bool)
+    _log(f"{args.trajectory}: {n} fields of {w} x {h} (every {args.every} of {len(tr.t)} poses)")
+    flo_dir = Path(args.flo_dir)
+    tmp_dir = Path(tempfile.mkdtemp(prefix=f".{flo_dir.name}.", suffix=".part", dir=flo_dir.parent))
+    try:
+        for i, k in enumerate(frames):
+            flow[i], _ = sphere_flow(camera, tr.state[k], args.moon_radius_m, np.float32)
+            disp, valid[i] = sphere_displacement(camera, tr.state[k], tr.state[k + 1], args.moon_radius_m)
+            displacement[i] = disp
+            write_flo(tmp_dir / f"{k:06d}.flo", displacement[i])
+            if (i + 1) % max(1, n // 10) == 0:
+                _log(f"  {i + 1}/{n} fields")
+        attrs = {"width": w, "height": h, "fov_deg": args.fov_deg, "focal_px": camera.focal_px,
+                 "moon_radius_m": args.moon_radius_m, "fps": float(tr.attrs["fps"]), "every_n_frames": args.every,
+                 "scenario": tr.attrs["scenario"], "id": int(tr.attrs["id"]), "traj2events_version": __version__}
+        write_motion_field(args.output, tr.t[frames], frames, {"flow_sphere": flow, "displacement_sphere": displacement,
+                                                               "valid": valid}, attrs)
+        shutil.rmtree(flo_dir, ignore_errors=True)
+        tmp_dir.rename(flo_dir)
+    except BaseException:
+        shutil.rmtree(tmp_dir, ignore_errors=True)
+        raise
+
+    picks = paper_times(tr.t)
+    fields = [sphere_flow(camera, tr.state[k], args.moon_radius_m, np.float32) for k in picks]
+    fig = motion_field_mosaic([float(tr.t[k]) for k in picks], [f for f, _ in fields], [m for _, m in fields],
+                              ["t0", "tf/4", "tf/2", "3tf/4", "tf"],
+                              f"{tr.attrs['scenario']} {int(tr.attrs['id']):04d}: motion field over the sphere (px/s)")
+    with atomic_output(args.figure) as tmp:
+        fig.savefig(tmp, format="png", dpi=100, metadata={"Software": None})
     return 0
 
 
@@ -199,6 +255,18 @@ def build_parser() -> argparse.ArgumentParser:
                    help="reintegrate the dynamics (exact, default) or the paper's cubic spline")
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
     p.set_defaults(func=cmd_upsample)
+
+    p = sub.add_parser("motion-field", help="ground-truth motion field of one trajectory over the Moon's sphere")
+    p.add_argument("trajectory", help="trajectory.h5 (poses)")
+    p.add_argument("--width", type=int, required=True, help="image width, px")
+    p.add_argument("--height", type=int, required=True, help="image height, px")
+    p.add_argument("--fov-deg", type=float, required=True, help="horizontal field of view, deg")
+    p.add_argument("--moon-radius-m", type=float, default=1_737_400.0, help="sphere radius, m (default 1737400)")
+    p.add_argument("--every", type=int, default=1, help="write every n-th frame's field (default 1)")
+    p.add_argument("--output", "-o", required=True, help="motion_field.h5")
+    p.add_argument("--flo-dir", required=True, help="folder for the Middlebury .flo displacements")
+    p.add_argument("--figure", required=True, help="PNG: colour wheel and quiver at t0, tf/4, tf/2, 3tf/4, tf")
+    p.set_defaults(func=cmd_motion_field)
 
     p = sub.add_parser("index", help="one CSV row per trajectory file of a scenario (the dataset index)")
     p.add_argument("trajectories", nargs="*", help="trajectory.h5 files")

@@ -76,3 +76,57 @@ def summary_table(solution_sets: list[dict], sample_tables: list[pd.DataFrame]) 
             "max_error_velocity_m_s": ok["error_velocity_m_s"].max(),
         })
     return pd.DataFrame(rows)
+
+
+def _colour_wheel() -> np.ndarray:
+    """The Middlebury colour wheel (Baker et al. 2007): 55 hues, RGB in [0, 1]."""
+    segments = [(15, (1, 0, 0), (1, 1, 0)), (6, (1, 1, 0), (0, 1, 0)), (4, (0, 1, 0), (0, 1, 1)),
+                (11, (0, 1, 1), (0, 0, 1)), (13, (0, 0, 1), (1, 0, 1)), (6, (1, 0, 1), (1, 0, 0))]
+    wheel = []
+    for n, start, end in segments:
+        s = np.arange(n)[:, None] / n
+        wheel.append((1 - s) * np.array(start) + s * np.array(end))
+    return np.vstack(wheel)
+
+
+def flow_to_colour(flow: np.ndarray, max_flow: float | None = None) -> np.ndarray:
+    """Flow (H, W, 2) -> RGB uint8 by the Baker et al. colour coding: hue = direction,
+    saturation = magnitude / max_flow (white = still); beyond max_flow, darkened."""
+    wheel = _colour_wheel()
+    u, v = flow[..., 0].astype(np.float64), flow[..., 1].astype(np.float64)
+    magnitude = np.hypot(u, v)
+    scale = max_flow if max_flow else max(float(magnitude.max()), 1e-12)
+    radius = magnitude / scale
+    position = (np.arctan2(-v, -u) / np.pi + 1) / 2 * (len(wheel) - 1)
+    k0 = np.floor(position).astype(int) % len(wheel)
+    k1 = (k0 + 1) % len(wheel)
+    frac = (position - np.floor(position))[..., None]
+    colour = (1 - frac) * wheel[k0] + frac * wheel[k1]
+    inside = (radius <= 1)[..., None]
+    colour = np.where(inside, 1 - radius[..., None] * (1 - colour), colour * 0.75)
+    return np.round(255 * colour).astype(np.uint8)
+
+
+def motion_field_mosaic(times: list[float], flows: list[np.ndarray], terrain: list[np.ndarray], labels: list[str],
+                        title: str, n_arrows: int = 16) -> plt.Figure:
+    """Colour-wheel image (top) and a sparse quiver plot (bottom) of each field, px/s."""
+    fig, axes = plt.subplots(2, len(flows), figsize=(3.0 * len(flows), 6.2), squeeze=False)
+    for col, (t, flow, ok, label) in enumerate(zip(times, flows, terrain, labels)):
+        speed = np.hypot(flow[..., 0], flow[..., 1])
+        top = float(np.percentile(speed, 99)) or 1.0
+        axes[0, col].imshow(flow_to_colour(flow, top))
+        axes[0, col].set_title(f"{label}: t = {t:.1f} s\n99th pct. {top:.3g} px/s", fontsize=9)
+        height, width = speed.shape
+        step = max(1, max(height, width) // n_arrows)
+        rows, cols = np.mgrid[step // 2:height:step, step // 2:width:step]
+        ax = axes[1, col]
+        ax.imshow(np.where(ok, 0.35, 0.0), cmap="gray", vmin=0, vmax=1)  # terrain grey, sky black
+        ax.quiver(cols, rows, flow[rows, cols, 0], flow[rows, cols, 1], color="tab:orange", angles="xy")
+        ax.set_xlim(-0.5, width - 0.5)
+        ax.set_ylim(height - 0.5, -0.5)
+        for a in axes[:, col]:
+            a.set_xticks([])
+            a.set_yticks([])
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig

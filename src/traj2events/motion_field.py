@@ -53,8 +53,11 @@ def _normal_dot_ray(a: np.ndarray, b: np.ndarray, normal: np.ndarray, dtype) -> 
 
 
 def inverse_depth_plane(a: np.ndarray, b: np.ndarray, normal: np.ndarray, height_m: float) -> np.ndarray:
-    """h = A / H on the plane H below the camera along `normal`; 0 where the ray misses it."""
+    """h = A / H on the plane H below the camera along `normal`; 0 where the ray misses it
+    (everywhere when H <= 0)."""
     dtype = np.result_type(a, b)
+    if not height_m > 0:
+        return np.zeros(np.broadcast_shapes(np.shape(a), np.shape(b)), dtype.type)
     A = _normal_dot_ray(a, b, normal, dtype.type)
     return np.where(A > 0, A / dtype.type(height_m), dtype.type(0))
 
@@ -70,9 +73,13 @@ def inverse_depth_sphere(
         D = (R+H)^2 A^2 - s K,   h = 1/Z = ((R+H) A + sqrt(D)) / K.
     The textbook Z = ((R+H) A - sqrt(D)) / s subtracts two numbers of size R: in float32
     it is 6 % off at 1 m altitude; this form stays at float32 rounding. h = 0 (sky)
-    where D < 0 or A <= 0. Computed in the dtype of a and b.
+    where D < 0 or A <= 0, and everywhere when the camera is not above the surface
+    (H <= 0: the trajectories end with the centre of mass, hence the camera, on the
+    ground). Computed in the dtype of a and b.
     """
     dtype = np.result_type(a, b).type
+    if not height_m > 0:
+        return np.zeros(np.broadcast_shapes(np.shape(a), np.shape(b)), dtype)
     r_plus_h = dtype(radius_m + height_m)
     k = dtype(height_m * (2.0 * radius_m + height_m))
     A = _normal_dot_ray(a, b, normal, dtype)

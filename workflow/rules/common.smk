@@ -49,9 +49,13 @@ def solved_ids(scenario):
     return [f"{i:04d}" for i in samples.loc[samples["success"], "id"]]
 
 
-def scenario_trajectories(wildcards):
-    """trajectory.h5 of every solved sample of one scenario (the index's inputs)."""
-    return expand("results/{scenario}/{id}/trajectory.h5", scenario=wildcards.scenario, id=solved_ids(wildcards.scenario))
+PER_TRAJECTORY = ["trajectory.h5", "motion_field.h5", "motion_field.png"]
+
+
+def scenario_outputs(wildcards):
+    """Every per-trajectory file of the solved samples of one scenario (the index's inputs)."""
+    ids = solved_ids(wildcards.scenario)
+    return [f"results/{wildcards.scenario}/{i}/{name}" for i in ids for name in PER_TRAJECTORY]
 
 
 def all_outputs(wildcards):

@@ -55,7 +55,7 @@ rule camera_poses:
 
 rule dataset_index:
     input:
-        scenario_trajectories,
+        scenario_outputs,
     output:
         "results/{scenario}/index.csv",
     params:
