@@ -20,3 +20,9 @@ def test_saturation_grows_with_magnitude():
     flow[0, :, 0] = [0.25, 0.5, 1.0]
     rgb = flow_to_colour(flow, max_flow=1.0).astype(int)
     assert rgb[0, 0, 1] > rgb[0, 1, 1] > rgb[0, 2, 1]  # green channel fades as red saturates
+
+
+def test_colour_is_continuous_across_plus_u():
+    flow = np.array([[[1.0, 1e-6], [1.0, -1e-6]]])
+    rgb = flow_to_colour(flow, max_flow=2.0).astype(int)
+    assert np.abs(rgb[0, 0] - rgb[0, 1]).max() <= 1

@@ -97,7 +97,9 @@ def flow_to_colour(flow: np.ndarray, max_flow: float | None = None) -> np.ndarra
     magnitude = np.hypot(u, v)
     scale = max_flow if max_flow else max(float(magnitude.max()), 1e-12)
     radius = magnitude / scale
-    position = (np.arctan2(-v, -u) / np.pi + 1) / 2 * (len(wheel) - 1)
+    # Hue over the whole wheel, so that it wraps continuously (scaling by len - 1, as the
+    # reference code does, leaves a seam wherever the flow points along +u).
+    position = (np.arctan2(-v, -u) / np.pi + 1) / 2 * len(wheel)
     k0 = np.floor(position).astype(int) % len(wheel)
     k1 = (k0 + 1) % len(wheel)
     frac = (position - np.floor(position))[..., None]
