@@ -228,3 +228,20 @@ def test_one_metre_altitude_is_exact():
     x_s, _ = CAM.pixel_coordinates()
     # At 1 m over a (locally) flat surface, u = h x_s v_z with h = A / H = 1 / 1 m.
     np.testing.assert_allclose(flow[CAM.height // 2, :, 0], x_s[0] * 0.5, rtol=1e-5)
+
+
+def test_depth_map_field_equals_the_analytic_field_for_the_same_surface():
+    # A rendered depth map of the plane must give the plane's field: the path the
+    # renderer's depth will take to the terrain-true motion field.
+    from traj2events.motion_field import depth_flow
+
+    state = random_state(np.random.default_rng(5), altitude=300.0)
+    pose = camera_pose(state)
+    x_s, y_s = CAM.pixel_coordinates()
+    h = inverse_depth_plane(x_s / CAM.focal_px, y_s / CAM.focal_px, *site_vertical(pose.position, pose.rotation))
+    depth = np.where(h > 0, 1.0 / np.where(h > 0, h, 1.0), np.inf)
+    flow, terrain = depth_flow(CAM, state, depth)
+    u, v = motion_field(x_s, y_s, CAM.focal_px, h, *camera_motion(state))
+    np.testing.assert_allclose(flow[..., 0], u, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(flow[..., 1], v, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(terrain, h > 0)

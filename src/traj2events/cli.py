@@ -129,11 +129,13 @@ def cmd_upsample(args) -> int:
 
 
 def cmd_summary(args) -> int:
+    import pandas as pd
+
     from .figures import dataset_figure, summary_table
     from .io import atomic_output, read_solution_set
 
     sets = [read_solution_set(p) for p in args.solutions]
-    tables = [__import__("pandas").read_csv(p) for p in args.tables]
+    tables = [pd.read_csv(p) for p in args.tables]
     table = summary_table(sets, tables)
     with atomic_output(args.table) as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")

@@ -52,6 +52,17 @@ def _normal_dot_ray(a: np.ndarray, b: np.ndarray, normal: np.ndarray, dtype) -> 
     return (alpha * a + gamma) + beta * b  # (H, W): one full-size add
 
 
+def _sphere_terms(a, b, normal, height_m, radius_m):
+    """(R+H, K, A, s, D, hit) of the ray-sphere quadratic s Z^2 - 2 (R+H) A Z + K = 0, in a's dtype."""
+    dtype = np.result_type(a, b).type
+    r_plus_h = dtype(radius_m + height_m)
+    k = dtype(height_m * (2.0 * radius_m + height_m))
+    A = _normal_dot_ray(a, b, normal, dtype)
+    s = (a * a + dtype(1)) + b * b  # separable: row + column
+    D = (r_plus_h * r_plus_h) * (A * A) - k * s
+    return r_plus_h, k, A, s, D, (D >= 0) & (A > 0)
+
+
 def inverse_depth_plane(a: np.ndarray, b: np.ndarray, normal: np.ndarray, height_m: float) -> np.ndarray:
     """h = A / H on the plane H below the camera along `normal`; 0 where the ray misses it
     (everywhere when H <= 0)."""
@@ -80,12 +91,7 @@ def inverse_depth_sphere(
     dtype = np.result_type(a, b).type
     if not height_m > 0:
         return np.zeros(np.broadcast_shapes(np.shape(a), np.shape(b)), dtype)
-    r_plus_h = dtype(radius_m + height_m)
-    k = dtype(height_m * (2.0 * radius_m + height_m))
-    A = _normal_dot_ray(a, b, normal, dtype)
-    s = (a * a + dtype(1)) + b * b  # separable: row + column
-    D = (r_plus_h * r_plus_h) * (A * A) - k * s
-    hit = (D >= 0) & (A > 0)
+    r_plus_h, k, A, s, D, hit = _sphere_terms(a, b, normal, height_m, radius_m)
     h = (r_plus_h * A + np.sqrt(np.maximum(D, dtype(0)))) / k
     return np.where(hit, h, dtype(0))
 
@@ -95,12 +101,7 @@ def inverse_depth_sphere_textbook(
 ) -> np.ndarray:
     """The cancellation-prone form 1/Z, Z = ((R+H) A - sqrt(D)) / s: for comparison only."""
     dtype = np.result_type(a, b).type
-    r_plus_h = dtype(radius_m + height_m)
-    k = dtype(height_m * (2.0 * radius_m + height_m))
-    A = _normal_dot_ray(a, b, normal, dtype)
-    s = (a * a + dtype(1)) + b * b
-    D = (r_plus_h * r_plus_h) * (A * A) - k * s
-    hit = (D >= 0) & (A > 0)
+    r_plus_h, k, A, s, D, hit = _sphere_terms(a, b, normal, height_m, radius_m)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(hit, s / (r_plus_h * A - np.sqrt(np.maximum(D, dtype(0)))), dtype(0))
 

@@ -103,9 +103,6 @@ class Solution:
     def tf_s(self) -> float:
         return float(self.t[-1])
 
-    def with_timing(self, iterations: int, solve_time_s: float) -> "Solution":
-        return replace(self, iterations=iterations, solve_time_s=solve_time_s)
-
 
 def split_controls(control: np.ndarray) -> np.ndarray:
     """Physical (N, 4) controls -> the optimiser's (N, 7) split (uT, u+, u-)."""
