@@ -118,3 +118,12 @@ def test_missing_or_broken_file_is_named(tmp_path):
     bad.write_text("seed: [1, 2\n")
     with pytest.raises(ConfigError, match="broken.yaml"):
         load_yaml(bad)
+
+
+def test_motion_field_cli_names_a_missing_trajectory(tmp_path):
+    run = subprocess.run([sys.executable, "-m", "traj2events.cli", "motion-field", str(tmp_path / "nope.h5"),
+                          "--width", "8", "--height", "8", "--fov-deg", "45", "--output", str(tmp_path / "m.h5"),
+                          "--flo-dir", str(tmp_path / "flow"), "--figure", str(tmp_path / "m.png")],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and "nope.h5" in run.stderr
+    assert not (tmp_path / "m.h5").exists() and not (tmp_path / "flow").exists()

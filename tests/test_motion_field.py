@@ -245,3 +245,14 @@ def test_depth_map_field_equals_the_analytic_field_for_the_same_surface():
     np.testing.assert_allclose(flow[..., 0], u, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(flow[..., 1], v, rtol=1e-12, atol=1e-12)
     np.testing.assert_array_equal(terrain, h > 0)
+
+
+def test_huge_time_step_keeps_valid_displacements_finite():
+    state = np.zeros(13)
+    state[2] = -200.0
+    state[3:6] = [40.0, 0.0, 15.0]  # 10 s later the camera is below the initial ground height
+    state[9:12] = [0.0, 0.3, 0.0]
+    later = rigid_motion(state, 10.0)
+    disp, valid = sphere_displacement(CAM, state, later)
+    assert np.isfinite(disp[valid]).all()
+    assert not valid.all()  # points behind the camera or the limb are flagged, not projected
