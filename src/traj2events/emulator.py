@@ -1,0 +1,225 @@
+"""Event-camera emulator: frames -> events (../shared/design/event-camera.md).
+
+Per pixel, per frame interval [t_k, t_k+1]:
+  1. log mapping (8-bit: linear below the 20 DN knee, ln above; continuous there);
+  2. first-order low-pass with intensity-dependent bandwidth, discretised exactly
+     (eps = 1 - exp(-2 pi f_c dt), f_c = cutoff_hz (I + 20) / 275);
+  3. frozen per-pixel thresholds N(theta, sigma) clipped at 0.01;
+  4. events wherever the filtered signal, linear between frames, crosses base +
+     theta_on or base - theta_off; each event timestamped where its own pixel crosses
+     (ESIM), base moved by one threshold per event;
+  5. refractory period: a crossing closer than T_ref to the pixel's last event is dropped
+     (base still moves: ESIM's choice);
+  6. leak: base drifts down by theta_on per leak period (per-pixel rate
+     R_leak 10^(0.1 N(0,1))), from a random initial phase;
+  7. shot noise: Poisson ON/OFF events at R_shot g(I) theta_nominal / theta(x), drawn by
+     thinning so the cost grows with the number of noise events; a noise event moves base;
+  8. hot pixels: a fraction of pixels firing ON at a fixed rate, whatever the input.
+
+Events are a numpy structured array (x, y, t, p) in tonic's convention: x column, y row
+(uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t. Streaming:
+`EventEmulator.process` takes any number of frames at a time and keeps only per-pixel
+state, and every random draw is keyed by (seed, frame interval), so the output is the
+same bytes however the video is chunked.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])
+KNEE_DN = 20.0  # lin-log knee of the 8-bit mapping
+
+
+@dataclass(frozen=True)
+class EmulatorParams:
+    theta_on: float = 0.25
+    theta_off: float = 0.25
+    sigma: float = 0.03  # threshold mismatch (std of the per-pixel thresholds)
+    cutoff_hz: float = 3.0  # photoreceptor bandwidth at full scale (255 DN); 0 disables
+    refractory_s: float = 0.0
+    leak_hz: float = 0.1
+    shot_noise_hz: float = 5.0
+    hot_pixel_fraction: float = 0.0
+    hot_pixel_hz: float = 0.0
+
+    def __post_init__(self) -> None:
+        for key, value in asdict(self).items():
+            if not value >= 0:
+                raise ValueError(f"emulator.{key}: expected >= 0, got {value}")
+        if self.theta_on < 0.01 or self.theta_off < 0.01:
+            raise ValueError("emulator.theta_on/theta_off: expected >= 0.01")
+        if self.hot_pixel_fraction > 1:
+            raise ValueError(f"emulator.hot_pixel_fraction: expected <= 1, got {self.hot_pixel_fraction}")
+
+
+PRESETS = {
+    # The paper's Table 2.
+    "paper": EmulatorParams(theta_on=0.25, theta_off=0.25, sigma=0.03, cutoff_hz=3.0, leak_hz=0.1, shot_noise_hz=5.0),
+    # No noise, no low-pass, no mismatch: events only where the log intensity crosses.
+    "clean": EmulatorParams(theta_on=0.25, theta_off=0.25, sigma=0.0, cutoff_hz=0.0, leak_hz=0.0, shot_noise_hz=0.0),
+}
+
+
+def log_intensity_8bit(frame_dn: np.ndarray) -> np.ndarray:
+    """8-bit DN -> log intensity: I ln(20)/20 up to the 20 DN knee, ln(I) above (float64)."""
+    i = np.asarray(frame_dn, dtype=np.float64)
+    return np.where(i <= KNEE_DN, i * (np.log(KNEE_DN) / KNEE_DN), np.log(np.maximum(i, KNEE_DN)))
+
+
+def lowpass_gain(intensity_dn: np.ndarray, cutoff_hz: float, dt_s: float) -> np.ndarray:
+    """Exact first-order step gain eps = 1 - exp(-2 pi f_c dt), f_c = cutoff (I + 20) / 275."""
+    if cutoff_hz <= 0:
+        return np.ones_like(intensity_dn, dtype=np.float64)
+    f_c = cutoff_hz * (np.asarray(intensity_dn, dtype=np.float64) + 20.0) / 275.0
+    return -np.expm1(-2.0 * np.pi * f_c * dt_s)
+
+
+def _rng(seed: int, *key: int) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence([seed, *key]))
+
+
+def _events(x, y, t_s, p) -> np.ndarray:
+    out = np.empty(len(t_s), EVENT_DTYPE)
+    out["x"], out["y"], out["t"], out["p"] = x, y, np.rint(np.asarray(t_s) * 1e6).astype(np.int64), p
+    return out
+
+
+class EventEmulator:
+    """Streaming emulator for frames of a fixed size; see the module docstring."""
+
+    def __init__(self, width: int, height: int, params: EmulatorParams = PRESETS["paper"], seed: int = 0) -> None:
+        self.width, self.height, self.params, self.seed = width, height, params, seed
+        n = width * height
+        rng = _rng(seed, 0)
+        self.theta_on = np.maximum(rng.normal(params.theta_on, params.sigma, n), 0.01) if params.sigma else np.full(n, params.theta_on)
+        self.theta_off = np.maximum(rng.normal(params.theta_off, params.sigma, n), 0.01) if params.sigma else np.full(n, params.theta_off)
+        self.leak_rate = params.leak_hz * 10.0 ** (0.1 * rng.standard_normal(n)) if params.leak_hz else np.zeros(n)
+        self.leak_phase = rng.uniform(0.0, 1.0, n)
+        hot = rng.uniform(size=n) < params.hot_pixel_fraction
+        self.hot_pixels = np.flatnonzero(hot)
+        self._filtered: np.ndarray | None = None  # low-passed log intensity at the last frame
+        self._intensity: np.ndarray | None = None  # input (DN) at the last frame
+        self._base: np.ndarray | None = None
+        self._last_event = np.full(n, -np.inf)  # s
+        self._t: float | None = None
+        self._interval = 0  # index of the next frame interval (keys the random draws)
+
+    def process(self, frames_dn: np.ndarray, times_s: np.ndarray) -> np.ndarray:
+        """Feed frames (K, H, W) 8-bit DN with their times (K,) in s; events up to the last one."""
+        frames = np.asarray(frames_dn)
+        times = np.asarray(times_s, dtype=np.float64)
+        if frames.ndim != 3 or frames.shape[1:] != (self.height, self.width) or len(times) != len(frames):
+            raise ValueError(f"frames: expected (K, {self.height}, {self.width}) with K timestamps, "
+                             f"got {frames.shape} and {times.shape}")
+        chunks = []
+        for frame, t in zip(frames, times):
+            intensity = frame.reshape(-1).astype(np.float64)
+            if self._t is None:
+                self._start(intensity, float(t))
+                continue
+            if not t > self._t:
+                raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
+            chunks.append(self._interval_events(intensity, float(t)))
+        return np.concatenate(chunks) if chunks else np.empty(0, EVENT_DTYPE)
+
+    def _start(self, intensity: np.ndarray, t: float) -> None:
+        log_i = log_intensity_8bit(intensity)
+        self._filtered, self._intensity, self._t = log_i, intensity, t
+        # Random leak phase: base starts a random fraction of theta_on below the signal.
+        self._base = log_i - self.leak_phase * self.theta_on * (self.leak_rate > 0)
+
+    def _interval_events(self, intensity: np.ndarray, t1: float) -> np.ndarray:
+        p = self.params
+        t0, dt = self._t, t1 - self._t
+        # Exact first-order low-pass, bandwidth from the interval's mean input.
+        gain = lowpass_gain(0.5 * (self._intensity + intensity), p.cutoff_hz, dt)
+        target = log_intensity_8bit(intensity)
+        filtered1 = self._filtered + gain * (target - self._filtered)
+        # x = signal - base, linear in t within the interval; the leak drifts base down.
+        x0 = self._filtered - self._base
+        self._base = self._base - self.theta_on * self.leak_rate * dt
+        x1 = filtered1 - self._base
+        events = [self._crossings(x0, x1, t0, dt)]
+        self._filtered, self._intensity, self._t = filtered1, intensity, t1
+        self._interval += 1
+        noise = self._shot_noise(intensity, t0, dt)
+        events += [noise, self._hot_pixel_events(t0, dt)]
+        out = np.concatenate(events)
+        return out[np.lexsort((out["p"], out["x"], out["y"], out["t"]))]
+
+    def _crossings(self, x0: np.ndarray, x1: np.ndarray, t0: float, dt: float) -> np.ndarray:
+        """Events of every pixel whose x crosses +theta_on or -theta_off; updates base."""
+        on = np.floor(x1 / self.theta_on).astype(np.int64)
+        off = np.floor(-x1 / self.theta_off).astype(np.int64)
+        count = np.where(x1 >= self.theta_on, on, np.where(-x1 >= self.theta_off, off, 0))
+        polarity = x1 > 0
+        step = np.where(polarity, self.theta_on, -self.theta_off)
+        # Base moves by every crossing, emitted or dropped by the refractory period.
+        self._base = self._base + count * step
+        pixels = np.flatnonzero(count)
+        if not len(pixels):
+            return np.empty(0, EVENT_DTYPE)
+        n = count[pixels]
+        j = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + 1  # 1..n within each pixel
+        pix = np.repeat(pixels, n)
+        slope = (x1 - x0)[pix]
+        level = j * step[pix]
+        # Where the line crosses each level; a level already passed at t0 (base moved by a
+        # noise event) fires at t0.
+        with np.errstate(divide="ignore", invalid="ignore"):
+            frac = np.where(slope != 0, (level - x0[pix]) / slope, 0.0)
+        t = t0 + dt * np.clip(frac, 0.0, 1.0)
+        keep = self._refractory(pix, t)
+        pix, t = pix[keep], t[keep]
+        return _events(pix % self.width, pix // self.width, t, polarity[pix])
+
+    def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
+        pixel's previous emitted event is dropped. `pix` grouped, `t` increasing per pixel."""
+        keep = np.ones(len(t), bool)
+        last = self._last_event
+        if self.params.refractory_s > 0:
+            for k in range(len(t)):  # sequential per pixel by nature
+                if t[k] - last[pix[k]] >= self.params.refractory_s:
+                    last[pix[k]] = t[k]
+                else:
+                    keep[k] = False
+        else:
+            np.maximum.at(last, pix, t)
+        return keep
+
+    def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> np.ndarray:
+        p = self.params
+        if p.shot_noise_hz <= 0:
+            return np.empty(0, EVENT_DTYPE)
+        rng = _rng(self.seed, 1, self._interval)
+        theta = 0.5 * (self.theta_on + self.theta_off)
+        g_max = 1.0 - 0.75 * 20.0 / 275.0  # darkest pixel
+        rate_max = p.shot_noise_hz * g_max * p.theta_on / theta.min()
+        n = rng.poisson(rate_max * dt * intensity.size)
+        pix = rng.integers(0, intensity.size, n)
+        t = t0 + dt * rng.uniform(size=n)
+        order = np.lexsort((t, pix))  # grouped by pixel, increasing time
+        pix, t = pix[order], t[order]
+        g = 1.0 - 0.75 * (intensity[pix] + 20.0) / 275.0
+        rate = p.shot_noise_hz * g * p.theta_on / theta[pix]
+        keep = rng.uniform(size=n) * rate_max < rate  # thinning
+        pix, t = pix[keep], t[keep]
+        on = rng.uniform(size=len(pix)) < 0.5
+        keep = self._refractory(pix, t)
+        pix, t, on = pix[keep], t[keep], on[keep]
+        # A noise event moves base like a real one (applied at the end of the interval).
+        np.add.at(self._base, pix, np.where(on, self.theta_on[pix], -self.theta_off[pix]))
+        return _events(pix % self.width, pix // self.width, t, on)
+
+    def _hot_pixel_events(self, t0: float, dt: float) -> np.ndarray:
+        p = self.params
+        if not len(self.hot_pixels) or p.hot_pixel_hz <= 0:
+            return np.empty(0, EVENT_DTYPE)
+        rng = _rng(self.seed, 2, self._interval)
+        counts = rng.poisson(p.hot_pixel_hz * dt, len(self.hot_pixels))
+        pix = np.repeat(self.hot_pixels, counts)
+        t = t0 + dt * rng.uniform(size=len(pix))
+        return _events(pix % self.width, pix // self.width, t, np.ones(len(pix), bool))
