@@ -13,7 +13,9 @@ Per pixel, per frame interval [t_k, t_k+1]:
   6. leak: base drifts down by theta_on per leak period (per-pixel rate
      R_leak 10^(0.1 N(0,1))), from a random initial phase;
   7. shot noise: Poisson ON/OFF events at R_shot g(I) theta_nominal / theta(x), drawn by
-     thinning so the cost grows with the number of noise events; a noise event moves base;
+     thinning so the cost grows with the number of noise events; a noise event resets the
+     pixel's reference to the current signal, as a real event does (shifting it by a
+     whole threshold instead would make every noise event fire a compensating one);
   8. hot pixels: a fraction of pixels firing ON at a fixed rate, whatever the input.
 
 Events are a numpy structured array (x, y, t, p) in tonic's convention: x column, y row
@@ -210,8 +212,9 @@ class EventEmulator:
         on = rng.uniform(size=len(pix)) < 0.5
         keep = self._refractory(pix, t)
         pix, t, on = pix[keep], t[keep], on[keep]
-        # A noise event moves base like a real one (applied at the end of the interval).
-        np.add.at(self._base, pix, np.where(on, self.theta_on[pix], -self.theta_off[pix]))
+        # A noise event resets the pixel like a real one: its reference jumps to the current
+        # signal (for a real crossing that is base +- theta). Applied at the interval's end.
+        self._base[pix] = self._filtered[pix]
         return _events(pix % self.width, pix // self.width, t, on)
 
     def _hot_pixel_events(self, t0: float, dt: float) -> np.ndarray:

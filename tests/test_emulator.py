@@ -1,0 +1,176 @@
+"""The emulator against the checks of event-camera.md (clean preset, 100 fps unless stated)."""
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from traj2events.emulator import PRESETS, EmulatorParams, EventEmulator, log_intensity_8bit, lowpass_gain
+
+CLEAN = PRESETS["clean"]
+FPS = 100.0
+
+
+def video(log_values: np.ndarray, h=2, w=3) -> np.ndarray:
+    """Frames (K, h, w) whose log intensity (above the knee) follows log_values."""
+    return np.broadcast_to(np.exp(log_values)[:, None, None], (len(log_values), h, w)).copy()
+
+
+def run(frames, params=CLEAN, seed=0, times=None):
+    times = np.arange(len(frames)) / FPS if times is None else times
+    emu = EventEmulator(frames.shape[2], frames.shape[1], params, seed)
+    return emu.process(frames, times)
+
+
+@pytest.mark.parametrize("params", [CLEAN, replace(CLEAN, cutoff_hz=3.0), replace(CLEAN, sigma=0.05),
+                                    replace(CLEAN, refractory_s=0.01)])
+def test_constant_input_gives_no_events(params):
+    frames = np.full((50, 4, 5), 120.0)
+    assert len(run(frames, params)) == 0
+
+
+@pytest.mark.parametrize("slope, duration", [(1.0, 1.0), (3.3, 0.5), (0.6, 2.0)])
+def test_log_ramp_event_count_and_times(slope, duration):
+    t = np.arange(int(duration * FPS) + 1) / FPS
+    ev = run(video(np.log(50.0) + slope * t))
+    per_pixel = ev[(ev["x"] == 0) & (ev["y"] == 0)]
+    n = int(np.floor(slope * duration / 0.25 + 1e-9))
+    assert len(per_pixel) == n and (per_pixel["p"] == 1).all()
+    expected_us = np.arange(1, n + 1) * 0.25 / slope * 1e6
+    assert np.abs(per_pixel["t"] - expected_us).max() <= 1  # within 1 us
+
+
+def test_up_then_down_ramp():
+    t = np.arange(101) / FPS
+    log_i = np.log(50.0) + np.where(t <= 0.5, 2.0 * t, 2.0 * (1.0 - t))
+    ev = run(video(log_i))
+    on, off = ev[ev["p"] == 1], ev[ev["p"] == 0]
+    assert len(on) == len(off) == 4 * 6  # floor(2 * 0.5 / 0.25) per pixel, 6 pixels
+    assert on["t"].max() < off["t"].min()
+
+
+def test_reconstruction_stays_within_a_threshold_on_random_videos():
+    rng = np.random.default_rng(1)
+    frames = rng.uniform(21, 255, size=(60, 6, 7))
+    params = replace(CLEAN, sigma=0.03)
+    emu = EventEmulator(7, 6, params, seed=2)
+    log_i = log_intensity_8bit(frames)
+    recon = log_i[0].reshape(-1).copy()
+    emu.process(frames[:1], [0.0])  # the first frame only sets the state
+    for k in range(1, len(frames)):
+        ev = emu.process(frames[k:k + 1], [k / FPS])
+        pix = ev["y"].astype(int) * 7 + ev["x"]
+        np.add.at(recon, pix, np.where(ev["p"] == 1, emu.theta_on[pix], -emu.theta_off[pix]))
+        bound = np.maximum(emu.theta_on, emu.theta_off)
+        assert (np.abs(recon - log_i[k].reshape(-1)) <= bound + 1e-12).all()
+
+
+@pytest.mark.parametrize("m, d", [(1, 0.1), (3, 0.0001), (5, 0.2)])
+def test_step_gives_exactly_m_events(m, d):
+    log_i = np.array([np.log(60.0), np.log(60.0) + m * 0.25 + d])
+    assert len(run(video(log_i, 1, 1))) == m
+
+
+def test_lin_log_ramp_below_the_knee():
+    a, b = 2.0, 18.0
+    frames = np.linspace(a, b, 101)[:, None, None]
+    ev = run(frames)
+    assert len(ev) == int(np.floor((b - a) * np.log(20) / (20 * 0.25)))
+
+
+def test_lowpass_lags_as_the_exact_first_order_response_and_bright_is_faster():
+    params = replace(CLEAN, cutoff_hz=3.0)
+    t = np.arange(201) / FPS
+    first = {}
+    for level in (30.0, 200.0):
+        frames = np.concatenate([np.full((1, 1, 1), level), np.full((200, 1, 1), level * np.e)])  # +1 in log
+        ev = run(frames, params)
+        f_c = 3.0 * (level * np.e + 20) / 275  # bandwidth while the input sits at the new level
+        # First-order response 1 - exp(-2 pi f_c t) reaches 0.25 (the first event) at:
+        predicted = -np.log(1 - 0.25) / (2 * np.pi * f_c)
+        first[level] = ev["t"].min() * 1e-6
+        assert first[level] == pytest.approx(predicted, abs=0.012)  # within about a frame
+    assert first[200.0] < first[30.0]
+
+
+def test_lowpass_gain_is_exact_not_euler():
+    gain = lowpass_gain(np.array([255.0]), 300.0, 0.01)
+    assert gain[0] == pytest.approx(1 - np.exp(-2 * np.pi * 300 * (275 / 275) * 0.01))
+    assert gain[0] < 1  # Euler would clip at 1
+
+
+def test_threshold_mismatch_statistics():
+    emu = EventEmulator(1000, 1000, replace(CLEAN, sigma=0.03), seed=3)
+    for theta in (emu.theta_on, emu.theta_off):
+        assert theta.mean() == pytest.approx(0.25, abs=0.001)
+        assert theta.std() == pytest.approx(0.03, abs=0.001)
+        assert theta.min() >= 0.01
+
+
+def test_shot_noise_rate_balance_and_exponential_intervals():
+    params = replace(CLEAN, shot_noise_hz=5.0)
+    h, w, seconds = 50, 60, 4.0
+    for level in (0.0, 255.0):
+        frames = np.full((int(seconds * FPS) + 1, h, w), level)
+        ev = run(frames, params, seed=4)
+        g = 1 - 0.75 * (level + 20) / 275
+        expected = 5.0 * g * h * w * seconds  # sigma = 0: theta = nominal
+        assert len(ev) == pytest.approx(expected, rel=0.03)
+        assert (ev["p"] == 1).sum() / (ev["p"] == 0).sum() == pytest.approx(1.0, abs=0.02)
+    # Merged stream of all pixels is Poisson: intervals exponential.
+    gaps = np.diff(np.sort(ev["t"])) * 1e-6
+    gaps = gaps[gaps > 0]
+    assert stats.kstest(gaps, "expon", args=(0, gaps.mean())).pvalue > 0.001
+
+
+def test_leak_is_on_only_at_the_expected_mean_rate():
+    params = replace(CLEAN, leak_hz=0.5)
+    h, w, seconds = 60, 60, 20.0
+    frames = np.full((int(seconds * 20) + 1, h, w), 100.0)
+    ev = run(frames, params, seed=5, times=np.arange(int(seconds * 20) + 1) / 20.0)
+    assert (ev["p"] == 1).all()
+    expected = 0.5 * np.mean(10 ** (0.1 * np.random.default_rng(0).standard_normal(10**6))) * h * w * seconds
+    assert len(ev) == pytest.approx(expected, rel=0.03)
+    assert ev["t"].min() < 0.5e6  # random phase: leak events from the start, not after 1/R
+
+
+def test_refractory_period_is_respected():
+    params = replace(CLEAN, refractory_s=0.05)
+    t = np.arange(101) / FPS
+    ev = run(video(np.log(50.0) + 10.0 * t, 2, 2), params)  # an event every 25 ms without T_ref
+    for x in range(2):
+        for y in range(2):
+            ts = ev[(ev["x"] == x) & (ev["y"] == y)]["t"]
+            assert len(ts) > 5 and np.diff(ts).min() >= 50_000
+
+
+def test_hot_pixels_fire_at_their_rate():
+    params = replace(CLEAN, hot_pixel_fraction=0.01, hot_pixel_hz=50.0)
+    frames = np.full((201, 100, 100), 80.0)
+    emu = EventEmulator(100, 100, params, seed=6)
+    ev = emu.process(frames, np.arange(201) / FPS)
+    assert len(emu.hot_pixels) > 50
+    assert len(ev) == pytest.approx(50.0 * 2.0 * len(emu.hot_pixels), rel=0.03)
+    assert set(np.unique(ev["y"].astype(int) * 100 + ev["x"])) <= set(emu.hot_pixels)
+
+
+def test_stream_invariants_and_chunking_does_not_change_a_byte():
+    rng = np.random.default_rng(7)
+    frames = rng.uniform(0, 255, size=(40, 12, 16)).round()
+    times = np.arange(40) / FPS
+    whole = EventEmulator(16, 12, PRESETS["paper"], seed=8).process(frames, times)
+    assert (np.diff(whole["t"]) >= 0).all()
+    assert whole["x"].max() < 16 and whole["y"].max() < 12 and set(np.unique(whole["p"])) <= {0, 1}
+    emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
+    parts = [emu.process(frames[a:b], times[a:b]) for a, b in ((0, 1), (1, 7), (7, 8), (8, 40))]
+    assert np.concatenate(parts).tobytes() == whole.tobytes()
+
+
+def test_bad_input_is_named():
+    emu = EventEmulator(4, 4, CLEAN)
+    with pytest.raises(ValueError, match="frames"):
+        emu.process(np.zeros((2, 3, 4)), [0, 1])
+    with pytest.raises(ValueError, match="increasing"):
+        emu.process(np.zeros((2, 4, 4)), [0.0, 0.0])
+    with pytest.raises(ValueError, match="sigma"):
+        EmulatorParams(sigma=-1)
