@@ -1,0 +1,60 @@
+"""Benchmark: event emulator speed, paper preset, one thread.
+
+  python bench/emulator.py [--frames 100]
+
+Input: an 8-bit texture (smoothed noise) translating at 2 px per frame at 100 fps, so
+edges everywhere produce events. Prints frames/s and events/s at 346 x 260 (DAVIS346) and
+1024 x 1024, and the peak resident memory. Goal (issue 5): >= 120 frames/s at
+1024 x 1024 and >= 1e7 events/s (v2e's own loop: ~6 frames/s at 1024 x 1024).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import resource
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+import numpy as np  # noqa: E402
+from scipy.ndimage import gaussian_filter  # noqa: E402
+
+from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
+
+
+def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    big = gaussian_filter(rng.uniform(0, 1, (height, width + 2 * n_frames + 2)), 3.0)
+    big = (big - big.min()) / (big.max() - big.min()) * 230 + 10
+    return np.stack([big[:, 2 * k:2 * k + width] for k in range(n_frames)]).round().astype(np.uint8)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--frames", type=int, default=100)
+    args = parser.parse_args()
+    print(f"# emulator, paper preset, 1 thread, on {platform.node()} ({os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}")
+    print("| size | frames | frames/s | events | events/s | events per pixel per frame |")
+    print("|---|---|---|---|---|---|")
+    for height, width in ((260, 346), (1024, 1024)):
+        frames = moving_texture(height, width, args.frames)
+        times = np.arange(args.frames) / 100.0
+        emu = EventEmulator(width, height, PRESETS["paper"], seed=1)
+        start = time.perf_counter()
+        n_events = 0
+        for k in range(0, args.frames, 10):  # streamed in chunks of 10 frames
+            n_events += len(emu.process(frames[k:k + 10], times[k:k + 10]))
+        elapsed = time.perf_counter() - start
+        fps = (args.frames - 1) / elapsed
+        print(f"| {width} x {height} | {args.frames} | {fps:.1f} | {n_events} | {n_events / elapsed:.3g} | "
+              f"{n_events / (args.frames - 1) / (width * height):.3f} |", flush=True)
+    print(f"peak resident memory: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB "
+          "(including the input video held in memory)")
+
+
+if __name__ == "__main__":
+    main()
