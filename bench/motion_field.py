@@ -26,12 +26,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
-from traj2events.camera import Camera, camera_motion, camera_pose  # noqa: E402
+from traj2events.camera import Camera, camera_pose  # noqa: E402
 from traj2events.motion_field import (  # noqa: E402
     inverse_depth_sphere,
     inverse_depth_sphere_textbook,
     local_vertical,
-    motion_field,
     sphere_displacement,
     sphere_flow,
 )

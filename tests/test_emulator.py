@@ -80,7 +80,6 @@ def test_lin_log_ramp_below_the_knee():
 
 def test_lowpass_lags_as_the_exact_first_order_response_and_bright_is_faster():
     params = replace(CLEAN, cutoff_hz=3.0)
-    t = np.arange(201) / FPS
     first = {}
     for level in (30.0, 200.0):
         frames = np.concatenate([np.full((1, 1, 1), level), np.full((200, 1, 1), level * np.e)])  # +1 in log

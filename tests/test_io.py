@@ -1,6 +1,4 @@
 """Files: atomic writes, self-describing trajectories, byte-reproducible HDF5."""
-import os
-from pathlib import Path
 
 import h5py
 import numpy as np

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from conftest import landing_bc
 
-from traj2events.dynamics import Dynamics, Vehicle
+from traj2events.dynamics import Vehicle
 from traj2events.ocp import FINAL_FIXED, LandingProblem, OcpSettings
 from traj2events.upsample import final_state_error, interpolate_controls
 
