@@ -99,6 +99,10 @@ class EventEmulator:
         self.theta_off = np.maximum(rng.normal(params.theta_off, params.sigma, n), 0.01) if params.sigma else np.full(n, params.theta_off)
         self.leak_rate = params.leak_hz * 10.0 ** (0.1 * rng.standard_normal(n)) if params.leak_hz else np.zeros(n)
         self.leak_phase = rng.uniform(0.0, 1.0, n)
+        # Shot noise per pixel scales with theta_nominal / theta(x) (frozen: computed once).
+        self._noise_theta = 0.5 * (self.theta_on + self.theta_off)
+        g_max = 1.0 - 0.75 * 20.0 / 275.0  # g(I) of the darkest pixel
+        self._noise_rate_max = params.shot_noise_hz * g_max * params.theta_on / self._noise_theta.min()
         hot = rng.uniform(size=n) < params.hot_pixel_fraction
         self.hot_pixels = np.flatnonzero(hot)
         self._filtered: np.ndarray | None = None  # low-passed log intensity at the last frame
@@ -181,15 +185,13 @@ class EventEmulator:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
         pixel's previous emitted event is dropped. `pix` grouped, `t` increasing per pixel."""
         keep = np.ones(len(t), bool)
-        last = self._last_event
-        if self.params.refractory_s > 0:
+        if self.params.refractory_s > 0:  # without one, the last event times are never needed
+            last = self._last_event
             for k in range(len(t)):  # sequential per pixel by nature
                 if t[k] - last[pix[k]] >= self.params.refractory_s:
                     last[pix[k]] = t[k]
                 else:
                     keep[k] = False
-        else:
-            np.maximum.at(last, pix, t)
         return keep
 
     def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> np.ndarray:
@@ -197,16 +199,14 @@ class EventEmulator:
         if p.shot_noise_hz <= 0:
             return np.empty(0, EVENT_DTYPE)
         rng = _rng(self.seed, 1, self._interval)
-        theta = 0.5 * (self.theta_on + self.theta_off)
-        g_max = 1.0 - 0.75 * 20.0 / 275.0  # darkest pixel
-        rate_max = p.shot_noise_hz * g_max * p.theta_on / theta.min()
+        rate_max = self._noise_rate_max
         n = rng.poisson(rate_max * dt * intensity.size)
         pix = rng.integers(0, intensity.size, n)
         t = t0 + dt * rng.uniform(size=n)
         order = np.lexsort((t, pix))  # grouped by pixel, increasing time
         pix, t = pix[order], t[order]
         g = 1.0 - 0.75 * (intensity[pix] + 20.0) / 275.0
-        rate = p.shot_noise_hz * g * p.theta_on / theta[pix]
+        rate = p.shot_noise_hz * g * p.theta_on / self._noise_theta[pix]
         keep = rng.uniform(size=n) * rate_max < rate  # thinning
         pix, t = pix[keep], t[keep]
         on = rng.uniform(size=len(pix)) < 0.5
