@@ -13,6 +13,8 @@ need_apt=()
 command -v python3 >/dev/null || need_apt+=(python3)
 python3 -c "import ensurepip, venv" 2>/dev/null || need_apt+=(python3-venv)
 command -v git >/dev/null || need_apt+=(git)
+command -v ffmpeg >/dev/null || need_apt+=(ffmpeg)                     # video (FFV1, H.264)
+{ ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || need_apt+=(libosmesa6)  # headless OpenGL for pyrender
 if ((${#need_apt[@]})); then
   echo "setup: installing system packages: ${need_apt[*]}"
   SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
@@ -23,11 +25,13 @@ fi
 [[ -x .venv/bin/python ]] || python3 -m venv .venv
 # Reinstall only when the package's requirements change.
 stamp=".venv/.traj2events-setup"
-want="$(sha256sum pyproject.toml | cut -d' ' -f1)$extras"
+want="$(cat pyproject.toml setup.sh | sha256sum | cut -d' ' -f1)$extras"
 if [[ "$(cat "$stamp" 2>/dev/null)" != "$want" ]]; then
   echo "setup: installing Python packages into .venv"
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e ".$extras"
+  # pyrender pins PyOpenGL==3.1.0, which cannot create an OSMesa context; 3.1.10 can.
+  .venv/bin/python -m pip install -q --no-deps "PyOpenGL==3.1.10"
   echo "$want" > "$stamp"
 fi
 .venv/bin/traj2events --version

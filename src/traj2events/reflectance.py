@@ -1,0 +1,94 @@
+"""Reflectance laws of the lunar regolith, as radiance factor I/F.
+
+Both laws exist twice: here in numpy (the reference, tested) and in
+`shaders/terrain.frag` (what the renderer runs); tests render a flat plane and compare.
+Angles: incidence i (Sun from the surface normal), emission e (camera from the normal),
+phase g (Sun to camera, seen from the surface); mu0 = cos i, mu = cos e.
+Radiance: L = (I/F) E_sun / pi  (W m^-2 sr^-1), with E_sun the Sun's irradiance.
+
+Hapke (Hapke 1981, 2002; the paper's choice), without the macroscopic-roughness
+correction (the terrain's relief is modelled as geometry instead):
+    I/F = (w / 4) mu0 / (mu0 + mu) [ (1 + B(g)) P(g) + H(mu0) H(mu) - 1 ]
+    B(g) = B0 / (1 + tan(g / 2) / h)                          (shadow-hiding opposition)
+    P(g) = (1 + c)/2 HG(b, g) + (1 - c)/2 HG(-b, g),  HG(b, g) = (1 - b^2) / (1 + 2 b cos g + b^2)^1.5
+           (c > 0 weights the backward lobe: HG(b, g) peaks at g = 0 for b > 0)
+    H(x) = 1 / (1 - w x (r0 + (1 - 2 r0 x)/2 ln((1 + x)/x))),  r0 = (1 - sqrt(1-w)) / (1 + sqrt(1-w))
+Lunar-Lambert (McEwen 1991, 1996):
+    I/F = A [ 2 L(g) mu0 / (mu0 + mu) + (1 - L(g)) mu0 ],
+    L(g) = 1 - 0.019 g + 2.42e-4 g^2 - 1.46e-6 g^3     (g in degrees; clipped to [0, 1],
+           the polynomial leaves it beyond ~110 deg where the fit has no data)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+MODELS = ("hapke", "lunar-lambert")
+
+
+@dataclass(frozen=True)
+class ReflectanceParams:
+    model: str = "hapke"
+    # Hapke: representative lunar values (w, b, c, B0, h after Helfenstein & Veverka 1987
+    # and Sato et al. 2014, LROC WAC; see docs/rendering.md).
+    single_scattering_albedo: float = 0.21
+    phase_b: float = 0.26
+    phase_c: float = 0.4
+    opposition_b0: float = 1.0
+    opposition_h: float = 0.07
+    # Lunar-Lambert: normal albedo of the maria-highland average.
+    albedo: float = 0.12
+
+    def __post_init__(self) -> None:
+        if self.model not in MODELS:
+            raise ValueError(f"render.reflectance.model: expected one of {MODELS}, got {self.model!r}")
+        if not 0 < self.single_scattering_albedo < 1:
+            raise ValueError("render.reflectance.single_scattering_albedo: expected 0 < w < 1")
+        if not 0 <= self.phase_b < 1:
+            raise ValueError("render.reflectance.phase_b: expected 0 <= b < 1")
+
+
+def chandrasekhar_h(x: np.ndarray, w: float) -> np.ndarray:
+    """Hapke (2002) approximation of Chandrasekhar's H function (error < 1 %)."""
+    x = np.asarray(x, dtype=float)
+    gamma = np.sqrt(1.0 - w)
+    r0 = (1.0 - gamma) / (1.0 + gamma)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_term = np.where(x > 0, np.log((1.0 + x) / np.maximum(x, 1e-300)), 0.0)
+    return 1.0 / (1.0 - w * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log_term))
+
+
+def henyey_greenstein(b: float, cos_g: np.ndarray) -> np.ndarray:
+    return (1.0 - b * b) / (1.0 + 2.0 * b * cos_g + b * b) ** 1.5
+
+
+def hapke_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams) -> np.ndarray:
+    mu0, mu, cos_g = (np.asarray(a, dtype=float) for a in (mu0, mu, cos_g))
+    w = p.single_scattering_albedo
+    g = np.arccos(np.clip(cos_g, -1.0, 1.0))
+    opposition = p.opposition_b0 / (1.0 + np.tan(g / 2.0) / p.opposition_h)
+    phase = 0.5 * (1 + p.phase_c) * henyey_greenstein(p.phase_b, cos_g) + 0.5 * (1 - p.phase_c) * henyey_greenstein(-p.phase_b, cos_g)
+    multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple)
+    return np.where((mu0 > 0) & (mu > 0), rf, 0.0)
+
+
+def lunar_lambert_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams) -> np.ndarray:
+    mu0, mu, cos_g = (np.asarray(a, dtype=float) for a in (mu0, mu, cos_g))
+    g = np.degrees(np.arccos(np.clip(cos_g, -1.0, 1.0)))
+    limb = np.clip(1.0 - 0.019 * g + 2.42e-4 * g**2 - 1.46e-6 * g**3, 0.0, 1.0)  # the fit turns negative past ~110 deg
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rf = p.albedo * (2.0 * limb * mu0 / (mu0 + mu) + (1.0 - limb) * mu0)
+    return np.where((mu0 > 0) & (mu > 0), rf, 0.0)
+
+
+def radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams) -> np.ndarray:
+    law = hapke_radiance_factor if p.model == "hapke" else lunar_lambert_radiance_factor
+    return law(mu0, mu, cos_g, p)
+
+
+def angles(normal: np.ndarray, to_sun: np.ndarray, to_camera: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(mu0, mu, cos g) from unit vectors (..., 3): surface normal, toward the Sun, toward the camera."""
+    return (np.sum(normal * to_sun, axis=-1), np.sum(normal * to_camera, axis=-1), np.sum(to_sun * to_camera, axis=-1))

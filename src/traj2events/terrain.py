@@ -1,0 +1,351 @@
+"""Lunar terrain: a seeded procedural height field, or a grid the user supplies.
+
+Heights `h` are metres *up* from the mean sphere through the landing site (radius R,
+centre at (0, 0, R) in the inertial frame, z down; geometry.md). A surface point at
+horizontal coordinates (x, y) of the site's tangent plane sits on the ray from the Moon's
+centre through (x, y, 0) (a gnomonic grid), at distance R + h from the centre.
+
+The procedural surface is a sum of
+  - craters from a cumulative power-law size-frequency distribution N(>D) = K D^-slope
+    per m^2, generated per size octave in square cells keyed by (seed, octave, cell), so
+    any patch can be evaluated on its own and neighbouring patches agree;
+  - a fraction of them fresh (parabolic bowl, depth/diameter ~0.2 rim to floor, raised
+    rim, ejecta blanket thinning as r^-3), the rest degraded (shallow, rimless cosine bowl);
+  - fractal roughness below the crater scale (value noise, one octave per halving of the
+    wavelength, amplitude ~ wavelength^hurst);
+  - a flat landing pad around the site, so the trajectories' touchdown point (z = 0) lies
+    on the surface.
+Evaluation takes the grid spacing: craters narrower than two spacings and roughness
+shorter than two spacings are left out, which is the level of detail (a coarse tile is
+a low-pass version of the fine one, not a different surface).
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class TerrainParams:
+    """Procedural terrain settings (config key `terrain`; sources in docs/rendering.md)."""
+
+    seed: int = 0
+    crater_density_k: float = 0.08  # K in N(>D) = K D^-slope per m^2 (D in m): Gault (1970) equilibrium ~10^-1.1
+    crater_slope: float = 2.0  # cumulative slope; 2 = equilibrium for small lunar craters
+    crater_diameter_min_m: float = 1.0
+    crater_diameter_max_m: float = 2000.0
+    depth_to_diameter: float = 0.2  # rim crest to floor, fresh simple craters (Pike 1977)
+    rim_height_to_diameter: float = 0.036  # Pike (1977): rim height ~ 0.036 D
+    fresh_fraction: float = 0.2  # the rest are degraded
+    roughness_m_at_1m: float = 0.02  # RMS height of the 1 m wavelength octave
+    roughness_hurst: float = 0.8  # amplitude ~ wavelength^hurst
+    roughness_wavelength_max_m: float = 64.0
+    site_radius_m: float = 30.0  # flat pad radius; blends to the terrain over the next radius
+
+    def __post_init__(self) -> None:
+        if not 0 < self.crater_diameter_min_m <= self.crater_diameter_max_m:
+            raise ValueError("terrain.crater_diameter_min_m/max_m: expected 0 < min <= max")
+        if not 0 <= self.fresh_fraction <= 1:
+            raise ValueError(f"terrain.fresh_fraction: expected 0..1, got {self.fresh_fraction}")
+
+
+class Terrain(Protocol):
+    def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
+        """Height (m, up) at horizontal points, resolved to features >= 2 spacings."""
+
+
+# --- crater shapes (functions of rho = r / crater radius) ----------------------------------
+
+EJECTA_EXTENT = 3.0  # ejecta reach 3 crater radii; beyond, the crater leaves the surface alone
+DEGRADED_EXTENT = 1.3
+
+
+def fresh_crater_profile(rho: np.ndarray, depth_m: float, rim_m: float) -> np.ndarray:
+    """Fresh simple crater: parabolic bowl from the rim crest (rim_m) down to rim_m - depth_m
+    at the centre; outside, an ejecta blanket rim_m * rho^-3 tapered to zero at 3 radii."""
+    rho = np.asarray(rho, dtype=float)
+    bowl = rim_m - depth_m * (1.0 - rho**2)
+    tail = 1.0 / EJECTA_EXTENT**3
+    ejecta = rim_m * (np.maximum(rho, 1.0) ** -3 - tail) / (1.0 - tail)
+    return np.where(rho < 1.0, bowl, np.where(rho < EJECTA_EXTENT, ejecta, 0.0))
+
+
+def degraded_crater_profile(rho: np.ndarray, depth_m: float) -> np.ndarray:
+    """Degraded crater: a rimless cosine bowl, slopes relaxed out to 1.3 radii."""
+    rho = np.asarray(rho, dtype=float)
+    return np.where(rho < DEGRADED_EXTENT, -0.5 * depth_m * (1.0 + np.cos(np.pi * rho / DEGRADED_EXTENT)), 0.0)
+
+
+# --- deterministic hashing (counter-based, so any patch is evaluated on its own) -----------
+
+_MASK64 = np.uint64(0xFFFFFFFFFFFFFFFF)
+
+
+def _mix64(z: np.ndarray) -> np.ndarray:
+    """splitmix64 finaliser: a bijective, well-mixed map of uint64."""
+    with np.errstate(over="ignore"):
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        return z ^ (z >> np.uint64(31))
+
+
+def _hash_uniform(seed: int, stream: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Uniform [0, 1) numbers keyed by (seed, stream, i, j), for integer lattice indices."""
+    with np.errstate(over="ignore"):
+        key = _mix64(np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream))
+        h = _mix64(key ^ (np.asarray(i).astype(np.int64).astype(np.uint64) * np.uint64(0xD1B54A32D192ED03)))
+        h = _mix64(h ^ (np.asarray(j).astype(np.int64).astype(np.uint64) * np.uint64(0x8CB92BA72F3D8DD7)))
+    return (h >> np.uint64(11)).astype(np.float64) * 2.0**-53
+
+
+# --- procedural terrain --------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Craters:
+    """A crater catalogue as arrays (one entry per crater)."""
+
+    x_m: np.ndarray
+    y_m: np.ndarray
+    diameter_m: np.ndarray
+    fresh: np.ndarray  # bool
+    depth_m: np.ndarray  # rim crest to floor (fresh) or below the surface (degraded)
+    rim_m: np.ndarray
+
+    @property
+    def reach_m(self) -> np.ndarray:
+        return 0.5 * self.diameter_m * np.where(self.fresh, EJECTA_EXTENT, DEGRADED_EXTENT)
+
+    def __len__(self) -> int:
+        return len(self.x_m)
+
+
+class ProceduralTerrain:
+    """The seeded procedural surface (see the module docstring)."""
+
+    def __init__(self, params: TerrainParams):
+        self.params = params
+        n = int(np.ceil(np.log2(params.crater_diameter_max_m / params.crater_diameter_min_m)))
+        self.octave_diameters_m = params.crater_diameter_min_m * 2.0 ** np.arange(max(n, 1))
+
+    def craters_in(self, x_range: tuple[float, float], y_range: tuple[float, float],
+                   min_diameter_m: float = 0.0) -> Craters:
+        """Every crater (diameter >= min_diameter_m) whose shape reaches into the box."""
+        p = self.params
+        parts = []
+        for k, d_lo in enumerate(self.octave_diameters_m):
+            d_hi = min(2 * d_lo, p.crater_diameter_max_m)
+            if d_hi < min_diameter_m or d_hi <= d_lo:
+                continue
+            cell = 4.0 * d_lo
+            reach = EJECTA_EXTENT * d_hi / 2
+            ix = np.arange(np.floor((x_range[0] - reach) / cell), np.floor((x_range[1] + reach) / cell) + 1)
+            iy = np.arange(np.floor((y_range[0] - reach) / cell), np.floor((y_range[1] + reach) / cell) + 1)
+            ii, jj = (a.ravel() for a in np.meshgrid(ix, iy, indexing="ij"))
+            lam = p.crater_density_k * (d_lo**-p.crater_slope - d_hi**-p.crater_slope) * cell**2
+            counts = _poisson_from_uniform(lam, _hash_uniform(p.seed, 8 * k, ii, jj))
+            ci, cj = np.repeat(ii, counts), np.repeat(jj, counts)
+            # m-th crater of its cell: a distinct key per (cell, m) for its four uniforms.
+            m = np.arange(len(ci)) - np.repeat(np.cumsum(counts) - counts, counts)
+            u, v, w, z = (_hash_uniform(p.seed, 8 * k + 1 + s, ci * 256 + m, cj) for s in range(4))
+            parts.append(self._craters(ci, cj, cell, d_lo, d_hi, u, v, w, z))
+        if not parts:
+            return Craters(*(np.empty(0) for _ in range(3)), np.empty(0, bool), np.empty(0), np.empty(0))
+        c = Craters(*(np.concatenate([getattr(q, f) for q in parts])
+                      for f in ("x_m", "y_m", "diameter_m", "fresh", "depth_m", "rim_m")))
+        r = c.reach_m
+        keep = ((c.diameter_m >= min_diameter_m) & (c.x_m + r >= x_range[0]) & (c.x_m - r <= x_range[1])
+                & (c.y_m + r >= y_range[0]) & (c.y_m - r <= y_range[1]))
+        return Craters(*(getattr(c, f)[keep] for f in ("x_m", "y_m", "diameter_m", "fresh", "depth_m", "rim_m")))
+
+    def _craters(self, i, j, cell, d_lo, d_hi, u, v, w, z) -> Craters:
+        p = self.params
+        # Diameter from the power law restricted to [d_lo, d_hi), by inverse transform.
+        s = p.crater_slope
+        diameter = (d_lo**-s - w * (d_lo**-s - d_hi**-s)) ** (-1.0 / s)
+        fresh = z < p.fresh_fraction
+        # Degraded craters keep 10-60 % of a fresh crater's depth below the surface (z spreads it evenly).
+        keep = 0.6 - 0.5 * (z - p.fresh_fraction) / max(1 - p.fresh_fraction, 1e-9)
+        depth = np.where(fresh, p.depth_to_diameter, keep * (p.depth_to_diameter - p.rim_height_to_diameter)) * diameter
+        rim = np.where(fresh, p.rim_height_to_diameter * diameter, 0.0)
+        return Craters((i + u) * cell, (j + v) * cell, diameter, fresh, depth, rim)
+
+    def crater_relief_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
+        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        h = np.zeros(x_m.shape)
+        if x_m.size == 0:
+            return h
+        craters = self.craters_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()), min_diameter_m=2 * spacing_m)
+        flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
+        grid = _as_regular_grid(x_m, y_m)
+        for cx, cy, d, fresh, depth, rim, reach in zip(craters.x_m, craters.y_m, craters.diameter_m, craters.fresh,
+                                                       craters.depth_m, craters.rim_m, craters.reach_m):
+            idx = _points_near(grid, flat_x, flat_y, cx, cy, reach)
+            rho = np.hypot(flat_x[idx] - cx, flat_y[idx] - cy) / (d / 2)
+            flat_h[idx] += fresh_crater_profile(rho, depth, rim) if fresh else degraded_crater_profile(rho, depth)
+        return flat_h.reshape(x_m.shape)
+
+    def roughness_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
+        p = self.params
+        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        h = np.zeros(x_m.shape)
+        wavelength = p.roughness_wavelength_max_m
+        octave = 0
+        while wavelength >= 2 * spacing_m and p.roughness_m_at_1m > 0:
+            # Value noise: uniform values on a lattice, smooth (quintic) interpolation.
+            amplitude = p.roughness_m_at_1m * wavelength**p.roughness_hurst * np.sqrt(12.0)
+            h += amplitude * (_value_noise(p.seed, 1000 + octave, x_m / wavelength, y_m / wavelength) - 0.5)
+            wavelength /= 2
+            octave += 1
+        return h
+
+    def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
+        h = self.crater_relief_m(x_m, y_m, spacing_m) + self.roughness_m(x_m, y_m, spacing_m)
+        return h * site_pad_weight(x_m, y_m, self.params.site_radius_m)
+
+
+def _poisson_from_uniform(lam: float, u: np.ndarray) -> np.ndarray:
+    """Poisson(lam) variates by inversion of uniforms u (vectorised over u)."""
+    counts = np.zeros(u.shape, dtype=np.int64)
+    term = np.exp(-lam)
+    cdf = np.full(u.shape, term)
+    k = 0
+    while True:
+        below = u >= cdf
+        if not below.any() or k > 50:
+            return counts
+        counts += below
+        k += 1
+        term *= lam / k
+        cdf = cdf + term
+
+
+def _value_noise(seed: int, stream: int, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    i0, j0 = np.floor(u), np.floor(v)
+    fu, fv = u - i0, v - j0
+    su = fu * fu * fu * (fu * (fu * 6 - 15) + 10)
+    sv = fv * fv * fv * (fv * (fv * 6 - 15) + 10)
+    c00 = _hash_uniform(seed, stream, i0, j0)
+    c10 = _hash_uniform(seed, stream, i0 + 1, j0)
+    c01 = _hash_uniform(seed, stream, i0, j0 + 1)
+    c11 = _hash_uniform(seed, stream, i0 + 1, j0 + 1)
+    return (c00 * (1 - su) + c10 * su) * (1 - sv) + (c01 * (1 - su) + c11 * su) * sv
+
+
+def _as_regular_grid(x: np.ndarray, y: np.ndarray):
+    """(x0, dx, nx, y0, dy, ny) if the points form an 'ij' grid (x varies along axis 0),
+    so that a crater only touches the sub-block it reaches; else None."""
+    if x.ndim != 2 or x.shape[0] < 2 or x.shape[1] < 2:
+        return None
+    dx, dy = x[1, 0] - x[0, 0], y[0, 1] - y[0, 0]
+    if dx <= 0 or dy <= 0 or not (np.all(x[:, :1] == x[:, -1:]) and np.all(y[:1, :] == y[-1:, :])):
+        return None
+    return x[0, 0], dx, x.shape[0], y[0, 0], dy, x.shape[1]
+
+
+def _points_near(grid, flat_x, flat_y, cx, cy, reach):
+    if grid is None:
+        return np.flatnonzero((np.abs(flat_x - cx) <= reach) & (np.abs(flat_y - cy) <= reach))
+    x0, dx, nx, y0, dy, ny = grid
+    i0, i1 = max(int(np.floor((cx - reach - x0) / dx)), 0), min(int(np.ceil((cx + reach - x0) / dx)) + 1, nx)
+    j0, j1 = max(int(np.floor((cy - reach - y0) / dy)), 0), min(int(np.ceil((cy + reach - y0) / dy)) + 1, ny)
+    if i0 >= i1 or j0 >= j1:
+        return np.empty(0, dtype=np.int64)
+    return (np.arange(i0, i1)[:, None] * ny + np.arange(j0, j1)[None, :]).ravel()
+
+
+def site_pad_weight(x_m: np.ndarray, y_m: np.ndarray, radius_m: float) -> np.ndarray:
+    """0 on the landing pad (r < radius), smoothly 1 beyond 2 radii."""
+    if radius_m <= 0:
+        return np.ones(np.broadcast(x_m, y_m).shape)
+    s = np.clip(np.hypot(x_m, y_m) / radius_m - 1.0, 0.0, 1.0)
+    return s * s * (3 - 2 * s)
+
+
+# --- a user-supplied elevation grid --------------------------------------------------------
+
+@dataclass(frozen=True)
+class GridTerrain:
+    """Heights on a regular grid (rows along x, columns along y), bilinear in between and
+    0 (the mean sphere) outside. `origin_m` is the (x, y) of heights[0, 0]."""
+
+    heights_m: np.ndarray
+    spacing_m: float
+    origin_m: tuple[float, float]
+
+    def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
+        u = (np.asarray(x_m, float) - self.origin_m[0]) / self.spacing_m
+        v = (np.asarray(y_m, float) - self.origin_m[1]) / self.spacing_m
+        n0, n1 = self.heights_m.shape
+        inside = (u >= 0) & (u <= n0 - 1) & (v >= 0) & (v <= n1 - 1)
+        i = np.clip(np.floor(u).astype(np.int64), 0, max(n0 - 2, 0))
+        j = np.clip(np.floor(v).astype(np.int64), 0, max(n1 - 2, 0))
+        fu, fv = np.clip(u - i, 0, 1), np.clip(v - j, 0, 1)
+        h = self.heights_m
+        i1, j1 = np.minimum(i + 1, n0 - 1), np.minimum(j + 1, n1 - 1)
+        val = (h[i, j] * (1 - fu) + h[i1, j] * fu) * (1 - fv) + (h[i, j1] * (1 - fu) + h[i1, j1] * fu) * fv
+        return np.where(inside, val, 0.0)
+
+
+def load_elevation_grid(path: str | os.PathLike, spacing_m: float | None = None,
+                        origin_m: tuple[float, float] | None = None) -> GridTerrain:
+    """A user elevation grid: `.npy` (heights; spacing_m required), `.npz` (keys
+    `heights_m`, `spacing_m`, optional `origin_m`) or GeoTIFF (spacing from the
+    ModelPixelScale tag when not given). Centred on the site unless origin_m is given."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"terrain.elevation_grid: {path} does not exist")
+    suffix = path.suffix.lower()
+    if suffix == ".npy":
+        heights = np.load(path)
+    elif suffix == ".npz":
+        with np.load(path) as data:
+            if "heights_m" not in data:
+                raise ValueError(f"terrain.elevation_grid: {path} has no array 'heights_m'")
+            heights = data["heights_m"]
+            spacing_m = float(data["spacing_m"]) if spacing_m is None and "spacing_m" in data else spacing_m
+            if origin_m is None and "origin_m" in data:
+                origin_m = tuple(float(v) for v in data["origin_m"])
+    elif suffix in (".tif", ".tiff"):
+        import tifffile
+
+        with tifffile.TiffFile(path) as tif:
+            page = tif.pages[0]
+            heights = page.asarray()
+            scale = page.tags.get("ModelPixelScaleTag")
+            if spacing_m is None and scale is not None:
+                spacing_m = float(scale.value[0])
+    else:
+        raise ValueError(f"terrain.elevation_grid: {path}: expected .npy, .npz, .tif or .tiff")
+    heights = np.asarray(heights, dtype=np.float64)
+    if heights.ndim != 2 or min(heights.shape) < 2 or not np.all(np.isfinite(heights)):
+        raise ValueError(f"terrain.elevation_grid: {path}: expected a finite 2-D array of heights, "
+                         f"got shape {heights.shape}")
+    if spacing_m is None or not spacing_m > 0:
+        raise ValueError(f"terrain.elevation_grid: {path}: grid spacing unknown; give terrain.grid_spacing_m > 0")
+    if origin_m is None:
+        origin_m = (-(heights.shape[0] - 1) * spacing_m / 2, -(heights.shape[1] - 1) * spacing_m / 2)
+    return GridTerrain(heights, float(spacing_m), (float(origin_m[0]), float(origin_m[1])))
+
+
+# --- geometry on the curved Moon -----------------------------------------------------------
+
+def surface_points(x_m: np.ndarray, y_m: np.ndarray, height_m: np.ndarray, radius_m: float) -> np.ndarray:
+    """Inertial positions (..., 3) of terrain points: on the ray from the Moon's centre
+    (0, 0, R) through (x, y, 0), at distance R + h from the centre (z down)."""
+    x_m, y_m, height_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float), np.asarray(height_m, float))
+    norm = np.sqrt(x_m**2 + y_m**2 + radius_m**2)
+    scale = (radius_m + height_m) / norm
+    # z = R - (R + h) R / norm, written without cancelling R - R for small x, y, h.
+    z = (radius_m * (norm - radius_m) - height_m * radius_m) / norm
+    return np.stack([x_m * scale, y_m * scale, z], axis=-1)
+
+
+def horizon_distance_m(altitude_m: float, relief_m: float, radius_m: float) -> float:
+    """Ground range beyond which terrain of height <= relief_m is hidden from a camera at
+    altitude_m: the two tangent distances to the sphere, camera's and the peaks'."""
+    a, r = max(altitude_m, 0.0), max(relief_m, 0.0)
+    return float(np.sqrt(a * (2 * radius_m + a)) + np.sqrt(r * (2 * radius_m + r)))

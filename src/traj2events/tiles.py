@@ -1,0 +1,210 @@
+"""Level of detail: a quadtree of terrain tiles, chosen per frame.
+
+The root tile is a square of the site's tangent plane, centred on the site, wide enough
+to reach the horizon seen from the scenario's highest camera. A tile at level l has side
+2 E / 2^l and `cells` x `cells` grid cells; its heights are evaluated at its own spacing
+(features below two spacings left out), so a tile is a low-pass version of its children.
+
+Per frame, from the root down: a tile outside the view frustum or beyond the horizon is
+dropped (with everything under it); a tile whose grid spacing, seen from the camera at
+its nearest point, covers more than `pixels_per_cell` pixels is split into its four
+children (down to `min_spacing_m`); otherwise it is drawn. Neighbours at different levels
+meet with skirts (a strip hanging below each tile edge) instead of cracks.
+
+Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
+grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights
+beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
+and nearby fine relief at the tile's own.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .camera import Camera, CameraPose
+from .illumination import ShadowField, no_obstruction, shadow_field
+from .terrain import Terrain, surface_points
+
+TileKey = tuple[int, int, int]  # (level, i, j); i along x, j along y, 0..2^level - 1
+
+
+@dataclass
+class Tile:
+    key: TileKey
+    spacing_m: float
+    centre: np.ndarray  # (3,) inertial, m
+    radius_m: float  # bounding sphere
+    vertices: np.ndarray  # (n, 3) inertial minus centre, m
+    normals: np.ndarray  # (n, 3) unit
+    lit: np.ndarray  # (n,) 0..1
+    faces: np.ndarray  # (m, 3) int
+    shadow: ShadowField = field(repr=False)
+    heights_m: np.ndarray = field(repr=False)  # (cells + 1, cells + 1), the tile's own grid
+
+
+@dataclass(frozen=True)
+class LodSettings:
+    cells: int = 32
+    margin: int = 32  # cells of extra grid toward the Sun for the shadow march
+    pixels_per_cell: float = 2.0
+    min_spacing_m: float = 0.05
+    skirt_cells: float = 2.0  # skirt depth in cells of the tile
+
+
+class TileSet:
+    def __init__(self, terrain: Terrain, sun_dir: np.ndarray, radius_m: float, half_extent_m: float,
+                 lod: LodSettings = LodSettings()):
+        self.terrain = terrain
+        self.sun_dir = np.asarray(sun_dir, float)
+        self.radius_m = radius_m
+        self.half_extent_m = half_extent_m
+        self.lod = lod
+        self._cache: dict[TileKey, Tile] = {}
+        self.faces = _grid_faces(lod.cells + 1)
+
+    # --- geometry ---------------------------------------------------------------------
+
+    def tile_spacing_m(self, level: int) -> float:
+        return 2 * self.half_extent_m / 2**level / self.lod.cells
+
+    def max_level(self) -> int:
+        level = 0
+        while self.tile_spacing_m(level + 1) >= self.lod.min_spacing_m:
+            level += 1
+        return level
+
+    def tile(self, key: TileKey) -> Tile:
+        if key not in self._cache:
+            self._cache[key] = self._build(key)
+        return self._cache[key]
+
+    def evict(self, keep: set[TileKey]) -> None:
+        """Drop cached tiles not in `keep` (their ancestors stay: children need them)."""
+        needed = set()
+        for level, i, j in keep:
+            for up in range(level + 1):
+                needed.add((level - up, i >> up, j >> up))
+        for key in list(self._cache):
+            if key not in needed:
+                del self._cache[key]
+
+    def _build(self, key: TileKey) -> Tile:
+        level, i, j = key
+        n = self.lod.cells
+        spacing = self.tile_spacing_m(level)
+        x0 = -self.half_extent_m + i * n * spacing
+        y0 = -self.half_extent_m + j * n * spacing
+        # Extended grid: one cell around (for normals), `margin` more toward the Sun.
+        m = self.lod.margin
+        lo_x, hi_x = (1, 1 + m) if self.sun_dir[0] > 0 else (1 + m, 1)
+        lo_y, hi_y = (1, 1 + m) if self.sun_dir[1] > 0 else (1 + m, 1)
+        if level == 0:
+            lo_x = hi_x = lo_y = hi_y = 1
+        x = x0 + spacing * np.arange(-lo_x, n + 1 + hi_x)
+        y = y0 + spacing * np.arange(-lo_y, n + 1 + hi_y)
+        xx, yy = np.meshgrid(x, y, indexing="ij")
+        h = self.terrain.height_m(xx, yy, spacing)
+        beyond = no_obstruction if level == 0 else self.tile((level - 1, i >> 1, j >> 1)).shadow.obstruction_at
+        shadow = shadow_field(x, y, h, self.sun_dir, self.radius_m, beyond)
+        points = surface_points(xx, yy, h, self.radius_m)
+        # Normals by central differences of the surface points (outward = toward -z near the site).
+        d_dx = points[2:, 1:-1] - points[:-2, 1:-1]
+        d_dy = points[1:-1, 2:] - points[1:-1, :-2]
+        normals = np.cross(d_dy, d_dx)
+        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+        core = (slice(lo_x, lo_x + n + 1), slice(lo_y, lo_y + n + 1))
+        inner = (slice(lo_x - 1, lo_x - 1 + n + 1), slice(lo_y - 1, lo_y - 1 + n + 1))
+        verts = points[core].reshape(-1, 3)
+        norms = normals[inner].reshape(-1, 3)
+        lit = shadow.lit[core].reshape(-1)
+        verts, norms, lit, faces = _add_skirts(verts, norms, lit, self.faces, n + 1,
+                                               self.lod.skirt_cells * spacing, self.radius_m)
+        centre = verts[: (n + 1) ** 2].mean(axis=0)
+        radius = float(np.max(np.linalg.norm(verts - centre, axis=1)))
+        return Tile(key, spacing, centre, radius, verts - centre, norms, lit, faces, shadow, h[core])
+
+    # --- selection --------------------------------------------------------------------
+
+    def select(self, pose: CameraPose, camera: Camera) -> list[TileKey]:
+        """Tiles to draw for this camera: in view, above the horizon, at the needed detail."""
+        planes = _frustum_planes(camera)
+        cam = np.asarray(pose.position, float)
+        horizon = _line_of_sight_limit(cam, self.radius_m, self._relief_bound())
+        max_level = self.max_level()
+        chosen: list[TileKey] = []
+        stack: list[TileKey] = [(0, 0, 0)]
+        while stack:
+            key = stack.pop()
+            t = self.tile(key)
+            offset = t.centre - cam
+            dist = float(np.linalg.norm(offset))
+            if dist - t.radius_m > horizon:
+                continue
+            centre_cam = pose.rotation.T @ offset
+            if np.any(planes @ centre_cam < -t.radius_m):
+                continue
+            nearest = max(dist - t.radius_m, 1e-3)
+            if t.spacing_m * camera.focal_px / nearest > self.lod.pixels_per_cell and key[0] < max_level:
+                level, i, j = key
+                stack.extend((level + 1, 2 * i + a, 2 * j + b) for a in (0, 1) for b in (0, 1))
+            else:
+                chosen.append(key)
+        return chosen
+
+    def _relief_bound(self) -> float:
+        root = self.tile((0, 0, 0))
+        return float(max(np.max(np.abs(root.heights_m)) * 2.0, 100.0))
+
+    def depth_range(self, keys: list[TileKey], pose: CameraPose, camera: Camera) -> tuple[float, float]:
+        """(znear, zfar) that bracket every drawn tile: near from the closest bounding
+        sphere (a point at distance d inside the frustum has depth >= d cos(half diagonal))."""
+        cam = np.asarray(pose.position, float)
+        half_diag = np.arctan(np.hypot(camera.width, camera.height) / 2 / camera.focal_px)
+        dists = np.array([np.linalg.norm(self.tile(k).centre - cam) for k in keys])
+        radii = np.array([self.tile(k).radius_m for k in keys])
+        near = max(float(np.min(dists - radii)) * np.cos(half_diag) * 0.99, 1e-3)
+        far = float(np.max(dists + radii)) * 1.01 + 1.0
+        return near, far
+
+
+def _grid_faces(n: int) -> np.ndarray:
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel()
+    return np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)]).astype(np.uint32)
+
+
+def _add_skirts(verts, norms, lit, faces, n, depth_m, radius_m):
+    """A strip below each edge of the (n x n) grid, hanging toward the Moon's centre."""
+    idx = np.arange(n * n).reshape(n, n)
+    ring = np.concatenate([idx[0, :], idx[1:, -1], idx[-1, -2::-1], idx[-2:0:-1, 0]])
+    down = np.array([0.0, 0.0, radius_m]) - verts[ring]
+    down /= np.linalg.norm(down, axis=1, keepdims=True)
+    skirt = verts[ring] + depth_m * down
+    base = len(verts)
+    k = np.arange(len(ring))
+    k1 = (k + 1) % len(ring)
+    top0, top1, bot0, bot1 = ring[k], ring[k1], base + k, base + k1
+    skirt_faces = np.concatenate([np.stack([top0, bot0, bot1], 1), np.stack([top0, bot1, top1], 1)])
+    return (np.concatenate([verts, skirt]), np.concatenate([norms, norms[ring]]), np.concatenate([lit, lit[ring]]),
+            np.concatenate([faces, skirt_faces.astype(np.uint32)]))
+
+
+def _frustum_planes(camera: Camera) -> np.ndarray:
+    """Inward unit normals (4, 3) of the side planes, camera frame (X forward = columns,
+    Y right = rows, Z boresight); a point p is inside when planes @ p >= 0."""
+    hx = np.arctan(camera.width / 2 / camera.focal_px)
+    hy = np.arctan(camera.height / 2 / camera.focal_px)
+    return np.array([[np.cos(hx), 0, np.sin(hx)], [-np.cos(hx), 0, np.sin(hx)],
+                     [0, np.cos(hy), np.sin(hy)], [0, -np.cos(hy), np.sin(hy)]])
+
+
+def _line_of_sight_limit(cam: np.ndarray, radius_m: float, relief_m: float) -> float:
+    """Farthest distance at which terrain up to relief_m can be seen from cam (the two
+    tangent lengths to the sphere of the Moon: camera's and the peaks')."""
+    centre = np.array([0.0, 0.0, radius_m])
+    r_cam = float(np.linalg.norm(cam - centre))
+    r_low = radius_m - relief_m
+    cam_tangent = np.sqrt(max(r_cam**2 - r_low**2, 0.0))
+    peak_tangent = np.sqrt(max((radius_m + relief_m) ** 2 - r_low**2, 0.0))
+    return float(cam_tangent + peak_tangent)

@@ -1,0 +1,139 @@
+"""Rendering on OSMesa: depth against a ray cast on the mesh, a landmark where the camera
+model puts it, radiance on a flat plane against the reflectance law, determinism, sky."""
+import numpy as np
+import pytest
+
+from traj2events.camera import Camera, CameraPose, camera_pose
+from traj2events.illumination import Sun
+from traj2events.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.terrain import GridTerrain, ProceduralTerrain, TerrainParams, fresh_crater_profile, surface_points
+from traj2events.tiles import LodSettings, TileSet
+
+from traj2events.render import TerrainRenderer, _check_pyopengl  # noqa: E402  (sets PYOPENGL_PLATFORM first)
+
+R_MOON = 1737400.0
+SUN = Sun(1.496e11, 105.0, 7.0)
+
+
+def state(x=0.0, y=0.0, altitude=1000.0, roll=0.0, pitch=0.0, yaw=0.0):
+    s = np.zeros(13)
+    s[:3] = x, y, -altitude
+    s[6:9] = np.radians([roll, pitch, yaw])
+    s[12] = 1e4
+    return s
+
+
+def render(terrain, camera, pose, radius=R_MOON, half_extent=140e3, sun=SUN, reflectance=ReflectanceParams(),
+           lod=LodSettings()):
+    tiles = TileSet(terrain, sun.direction, radius, half_extent, lod)
+    with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
+        return renderer.render(pose), tiles
+
+
+def ray_cast(origin, directions, triangles):
+    """Moller-Trumbore in float64: distance along each unit direction to the nearest hit."""
+    v0, e1, e2 = triangles[:, 0], triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
+    out = np.full(len(directions), np.inf)
+    for k, d in enumerate(directions):
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        s = origin - v0
+        u = np.einsum("ij,ij->i", s, p) * inv
+        q = np.cross(s, e1)
+        v = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
+        if hit.any():
+            out[k] = t[hit].min()
+    return out
+
+
+def test_pyrender_workarounds_are_in_place(monkeypatch):
+    import os
+
+    import OpenGL
+
+    assert os.environ["PYOPENGL_PLATFORM"] == "osmesa"
+    assert np.infty == np.inf
+    _check_pyopengl()
+    monkeypatch.setattr(OpenGL, "__version__", "3.1.0")
+    with pytest.raises(RuntimeError, match="PyOpenGL>=3.1.5"):
+        _check_pyopengl()
+
+
+def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
+    camera = Camera(48, 48, 45.0)
+    pose = camera_pose(state(x=-3000.0, altitude=5000.0, pitch=20.0, roll=3.0, yaw=10.0))
+    frame, tiles = render(ProceduralTerrain(TerrainParams(seed=11)), camera, pose)
+    keys = tiles.select(pose, camera)
+    triangles = np.concatenate([tiles.tile(k).vertices[tiles.tile(k).faces] + tiles.tile(k).centre for k in keys])
+    rows, cols = np.meshgrid(np.arange(3, 48, 9), np.arange(3, 48, 9), indexing="ij")
+    x_s, y_s = cols.ravel() + 0.5 - 24, rows.ravel() + 0.5 - 24
+    rays_cam = camera.back_project(x_s, y_s)
+    dirs = rays_cam @ pose.rotation.T
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    distance = ray_cast(pose.position, dirs, triangles)
+    depth_cast = distance * (dirs @ pose.rotation[:, 2])
+    depth_render = frame.depth_m[rows.ravel(), cols.ravel()]
+    assert np.all(np.isfinite(depth_cast)) and depth_cast.min() > 4000
+    np.testing.assert_allclose(depth_render, depth_cast, rtol=1e-3)
+
+
+def test_a_crater_centre_appears_where_the_camera_model_puts_it():
+    spacing = 1.0
+    x = np.arange(-600.0, 600.0 + spacing / 2, spacing)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    centre = (150.0, 220.0)
+    rho = np.hypot(xx - centre[0], yy - centre[1]) / 40.0
+    crater = GridTerrain(fresh_crater_profile(rho, 16.0, 2.0), spacing, (x[0], x[0]))
+    flat = GridTerrain(np.zeros_like(xx), spacing, (x[0], x[0]))
+    camera = Camera(128, 128, 45.0)
+    pose = camera_pose(state(x=-300.0, y=100.0, altitude=900.0, pitch=25.0, roll=-8.0, yaw=15.0))
+    with_crater, _ = render(crater, camera, pose, half_extent=20e3)
+    without, _ = render(flat, camera, pose, half_extent=20e3)
+    deeper = np.clip(with_crater.depth_m - without.depth_m, 0.0, None)
+    bowl = deeper > 0.6 * deeper.max()
+    rows, cols = np.nonzero(bowl)
+    w = deeper[bowl]
+    seen = np.array([np.average(cols, weights=w), np.average(rows, weights=w)])
+    floor = surface_points(np.array(centre[0]), np.array(centre[1]), np.array(-14.0), R_MOON)
+    predicted = camera.to_pixel_index(camera.project(pose.to_camera(floor)))
+    assert np.all((predicted > 20) & (predicted < 108))  # well inside the image
+    np.testing.assert_allclose(seen, predicted, atol=0.5)
+
+
+@pytest.mark.parametrize("model", ["hapke", "lunar-lambert"])
+def test_flat_plane_radiance_follows_the_reflectance_law(model):
+    flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
+    sun = Sun(1.496e11, 30.0, 25.0)
+    reflectance = ReflectanceParams(model=model)
+    camera = Camera(64, 48, 60.0)
+    pose = camera_pose(state(altitude=100.0, pitch=40.0, yaw=20.0, roll=5.0))
+    frame, _ = render(flat, camera, pose, radius=1e12, half_extent=5e3, sun=sun, reflectance=reflectance)
+    x_s, y_s = camera.pixel_coordinates()
+    rays = camera.back_project(*np.broadcast_arrays(x_s, y_s))
+    points = pose.position + (rays * frame.depth_m[..., None]) @ pose.rotation.T
+    to_camera = pose.position - points
+    to_camera /= np.linalg.norm(to_camera, axis=-1, keepdims=True)
+    normal = np.broadcast_to([0.0, 0.0, -1.0], points.shape)
+    expected = radiance_factor(*angles(normal, np.broadcast_to(sun.direction, points.shape), to_camera),
+                               reflectance) * sun.irradiance_w_m2 / np.pi
+    ground = frame.depth_m > 0
+    assert ground.mean() > 0.9
+    assert np.all(frame.lit[ground] > 1 - 1e-6)  # no shadow (up to float32 interpolation)
+    np.testing.assert_allclose(frame.radiance[ground], expected[ground], rtol=2e-3, atol=1e-3 * expected.max())
+
+
+def test_same_seed_and_pose_same_pixels_and_sky_is_empty():
+    camera = Camera(32, 32, 45.0)
+    pose = camera_pose(state(x=-1500.0, altitude=800.0, pitch=50.0))
+    a, _ = render(ProceduralTerrain(TerrainParams(seed=2)), camera, pose)
+    b, _ = render(ProceduralTerrain(TerrainParams(seed=2)), camera, pose)
+    assert a.radiance.tobytes() == b.radiance.tobytes() and a.depth_m.tobytes() == b.depth_m.tobytes()
+    c, _ = render(ProceduralTerrain(TerrainParams(seed=3)), camera, pose)
+    assert not np.array_equal(a.radiance, c.radiance)
+    up = CameraPose(pose.position, camera_pose(state(pitch=180.0)).rotation)  # boresight to the zenith
+    sky, _ = render(ProceduralTerrain(TerrainParams(seed=2)), camera, up)
+    assert sky.n_tiles == 0 and not sky.radiance.any() and not sky.depth_m.any()

@@ -1,0 +1,119 @@
+"""Procedural terrain: crater shapes, size-frequency statistics, seeding, level of detail,
+user grids and the curved-Moon geometry."""
+import numpy as np
+import pytest
+
+from traj2events.terrain import (GridTerrain, ProceduralTerrain, TerrainParams, degraded_crater_profile,
+                                 fresh_crater_profile, horizon_distance_m, load_elevation_grid, site_pad_weight,
+                                 surface_points)
+
+R_MOON = 1737400.0
+
+
+def test_fresh_crater_depth_to_diameter_and_rim():
+    diameter = 100.0
+    depth, rim = 0.2 * diameter, 0.036 * diameter
+    rho = np.linspace(0, 3, 3001)
+    h = fresh_crater_profile(rho, depth, rim)
+    assert h.max() == pytest.approx(rim)  # crest at the rim
+    assert rho[np.argmax(h)] == pytest.approx(1.0, abs=1e-3)
+    assert (h.max() - h.min()) / diameter == pytest.approx(0.2)  # rim crest to floor
+    assert h[-1] == pytest.approx(0.0, abs=1e-12)  # ejecta end at 3 radii
+    assert np.all(np.diff(h[rho > 1]) <= 1e-12)  # and thin outward
+    assert degraded_crater_profile(np.array([0.0, 1.3, 2.0]), 5.0).tolist() == [-5.0, 0.0, 0.0]
+
+
+def test_crater_counts_follow_the_power_law():
+    p = TerrainParams(seed=7, crater_density_k=0.08, crater_slope=2.0, crater_diameter_min_m=2.0,
+                      crater_diameter_max_m=64.0)
+    terrain = ProceduralTerrain(p)
+    box = (0.0, 2000.0)
+    craters = terrain.craters_in(box, box)
+    inside = (craters.x_m >= 0) & (craters.x_m < 2000) & (craters.y_m >= 0) & (craters.y_m < 2000)
+    d = craters.diameter_m[inside]
+    for d_lo in (2.0, 8.0, 32.0):
+        expected = p.crater_density_k * (d_lo**-2 - 64.0**-2) * 2000.0**2
+        assert abs(np.sum(d >= d_lo) - expected) < 4 * np.sqrt(expected) + 1
+
+
+def test_same_seed_same_surface_and_patches_agree():
+    terrain = ProceduralTerrain(TerrainParams(seed=3))
+    x = np.arange(0, 200.0, 1.0)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    whole = terrain.height_m(xx, yy, 1.0)
+    again = ProceduralTerrain(TerrainParams(seed=3)).height_m(xx, yy, 1.0)
+    patch = terrain.height_m(xx[50:90, 120:170], yy[50:90, 120:170], 1.0)
+    np.testing.assert_array_equal(whole, again)
+    np.testing.assert_allclose(patch, whole[50:90, 120:170], atol=1e-9)
+    other = ProceduralTerrain(TerrainParams(seed=4)).height_m(xx, yy, 1.0)
+    assert np.abs(other - whole).mean() > 0.1
+
+
+def test_coarse_spacing_leaves_out_small_features():
+    terrain = ProceduralTerrain(TerrainParams(seed=5))
+    x = np.arange(0, 512.0, 1.0)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    fine = terrain.height_m(xx, yy, 1.0)
+    coarse = terrain.height_m(xx, yy, 16.0)
+    # Same large-scale surface (the low-pass part), less small-scale relief.
+    assert np.corrcoef(fine.ravel(), coarse.ravel())[0, 1] > 0.7
+    assert np.std(np.diff(coarse, 2, axis=0)) < 0.4 * np.std(np.diff(fine, 2, axis=0))  # less small-scale curvature
+    n_fine = len(terrain.craters_in((0, 512), (0, 512), 2.0))
+    n_coarse = len(terrain.craters_in((0, 512), (0, 512), 32.0))
+    assert n_coarse < n_fine / 50
+
+
+def test_landing_pad_is_flat_at_the_site():
+    terrain = ProceduralTerrain(TerrainParams(seed=1, site_radius_m=20.0))
+    r = np.linspace(0, 19.9, 50)
+    assert np.all(terrain.height_m(0.6 * r, 0.8 * r, 0.5) == 0.0)
+    assert site_pad_weight(np.array([40.0]), np.array([0.0]), 20.0)[0] == 1.0
+
+
+def test_surface_points_on_the_sphere_and_tangent_at_the_site():
+    x, y, h = np.array([0.0, 1.0, 5000.0, -80000.0]), np.array([0.0, 0.0, 300.0, 1000.0]), np.array([0.0, 2.0, -40.0, 10.0])
+    p = surface_points(x, y, h, R_MOON)
+    centre = np.array([0.0, 0.0, R_MOON])
+    np.testing.assert_allclose(np.linalg.norm(p - centre, axis=1), R_MOON + h, rtol=1e-13)
+    np.testing.assert_allclose(p[0], 0.0, atol=1e-12)
+    assert p[1, 2] == pytest.approx(-2.0 + 1.0 / (2 * R_MOON), abs=1e-9)  # 2 m up, a hair of curvature
+    assert p[3, 2] > 1800  # 80 km out, the surface has dropped ~1.8 km below the site's plane
+
+
+def test_horizon_distance():
+    assert horizon_distance_m(2000.0, 0.0, R_MOON) == pytest.approx(np.sqrt(2 * R_MOON * 2000 + 2000**2))
+    assert horizon_distance_m(2000.0, 100.0, R_MOON) > horizon_distance_m(2000.0, 0.0, R_MOON)
+
+
+def test_user_grids_load_and_interpolate(tmp_path):
+    heights = np.add.outer(np.arange(5.0), 10 * np.arange(4.0))
+    np.save(tmp_path / "dem.npy", heights)
+    grid = load_elevation_grid(tmp_path / "dem.npy", spacing_m=2.0, origin_m=(0.0, 0.0))
+    assert grid.height_m(np.array([3.0]), np.array([5.0]))[0] == pytest.approx(1.5 + 25.0)
+    assert grid.height_m(np.array([100.0]), np.array([0.0]))[0] == 0.0  # outside: the mean sphere
+    np.savez(tmp_path / "dem.npz", heights_m=heights, spacing_m=2.0)
+    centred = load_elevation_grid(tmp_path / "dem.npz")
+    assert centred.origin_m == (-4.0, -3.0)
+    tifffile = pytest.importorskip("tifffile")
+    tifffile.imwrite(tmp_path / "dem.tif", heights.astype(np.float32),
+                     extratags=[(33550, "d", 3, (2.0, 2.0, 0.0))])  # ModelPixelScaleTag
+    tif = load_elevation_grid(tmp_path / "dem.tif")
+    assert tif.spacing_m == 2.0 and isinstance(tif, GridTerrain)
+    np.testing.assert_allclose(tif.heights_m, heights)
+
+
+@pytest.mark.parametrize("name, content, message", [
+    ("missing.npy", None, "does not exist"),
+    ("dem.npy", np.zeros(5), "2-D array"),
+    ("dem.npy", np.zeros((3, 3)), "spacing unknown"),
+    ("dem.txt", "x", "expected .npy"),
+])
+def test_bad_grids_are_named(tmp_path, name, content, message):
+    path = tmp_path / name
+    if isinstance(content, np.ndarray):
+        np.save(path, content)
+    elif content is not None:
+        path.write_text(content)
+    with pytest.raises((ValueError, FileNotFoundError), match=message) as info:
+        load_elevation_grid(path)
+    assert "terrain.elevation_grid" in str(info.value)
