@@ -4,7 +4,7 @@
 #   snakemake --cores 2 --configfile config/paper.yaml
 #
 # Stages so far: base solve per scenario -> continuation sampling -> camera poses ->
-# motion-field ground truth.
+# rendering (frames, videos) -> motion-field ground truth (sphere and rendered terrain).
 from snakemake.utils import min_version
 
 min_version("9.0")
@@ -15,6 +15,7 @@ configfile: "config/config.yaml"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/trajectories.smk"
+include: "workflow/rules/render.smk"
 include: "workflow/rules/motion_field.smk"
 
 

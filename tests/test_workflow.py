@@ -70,7 +70,17 @@ def test_smoke_dataset_is_complete(built):
         np.testing.assert_array_equal(frames, np.arange(n))  # every frame in the smoke config
         flo = sorted((results / "descent" / "0001" / "flow").glob("*.flo"))
         assert len(flo) == n and flo[0].name == "000000.flo"
+        assert f["flow_terrain"].shape == (n, 32, 32, 2) and f["displacement_terrain"].shape == (n, 32, 32, 2)
+        assert np.isfinite(f["sphere_minus_terrain_rms_px_s"][0])
     assert (results / "descent" / "0001" / "motion_field.png").stat().st_size > 10_000
+    for name in ("video.mkv", "preview.mp4", "frames.png"):
+        assert (results / "descent" / "0001" / name).stat().st_size > 1000, name
+    assert not (results / "descent" / "0001" / "frames.h5").exists()  # temporary by default
+    from traj2events.video import read_video
+
+    with h5py.File(results / "descent" / "0001" / "trajectory.h5") as f:
+        n_poses = len(f["poses/t"])
+    assert read_video(results / "descent" / "0001" / "video.mkv").shape == (n_poses, 32, 32)
     index = pd.read_csv(results / "descent" / "index.csv")
     assert list(index["id"]) == [0, 1] and (index["n_poses"] > 10).all()
     assert (results / "figures" / "trajectories.png").stat().st_size > 10_000
@@ -98,7 +108,9 @@ def test_same_config_same_bytes(built, tmp_path):
                 if k != "solve_time_s":
                     va, vb = np.asarray(a.attrs[k]), np.asarray(b.attrs[k])
                     assert va.tobytes() == vb.tobytes(), k  # bitwise, NaN included
-    assert (built / "results/figures/trajectories.png").read_bytes() == (tmp_path / "results/figures/trajectories.png").read_bytes()
+    for rel in ("results/figures/trajectories.png", "results/descent/0001/video.mkv", "results/descent/0001/preview.mp4",
+                "results/descent/0001/frames.png", "results/descent/0001/motion_field.h5"):
+        assert (built / rel).read_bytes() == (tmp_path / rel).read_bytes(), rel
 
 
 def test_editing_one_scenario_reruns_only_its_jobs(built, tmp_path):
@@ -123,7 +135,8 @@ def test_code_change_reruns_the_rules_that_use_it(built, tmp_path):
     figures = tmp_path / "src" / "traj2events" / "figures.py"
     figures.write_text(figures.read_text() + "\n# a change\n")
     jobs = jobs_in_dry_run(workdir, env)
-    assert jobs["trajectory_summary"] == 1 and jobs["motion_field"] == 3  # both draw with figures.py
+    # All three draw with figures.py (motion_field also needs the temporary frames again).
+    assert jobs["trajectory_summary"] == 1 and jobs["motion_field"] == 3 and jobs["render"] == 3
     assert not {"base_solution", "sample_trajectories", "camera_poses"} & set(jobs)
     upsample = tmp_path / "src" / "traj2events" / "upsample.py"
     upsample.write_text(upsample.read_text() + "\n# a change\n")

@@ -174,37 +174,66 @@ def cmd_motion_field(args) -> int:
     import shutil
     import tempfile
 
+    import h5py
+
     from .camera import Camera
     from .figures import motion_field_mosaic
     from .io import atomic_output, read_trajectory, write_flo, write_motion_field
-    from .motion_field import sphere_displacement, sphere_flow
+    from .motion_field import depth_displacement, depth_flow, sphere_displacement, sphere_flow
 
     camera = Camera(args.width, args.height, args.fov_deg)
     tr = read_trajectory(args.trajectory)
     if tr.t is None or len(tr.t) < 2:
         print(f"error: {args.trajectory}: expected poses/t with at least 2 poses", file=sys.stderr)
         return 1
+    rendered = h5py.File(args.frames, "r") if args.frames else None
+    if rendered is not None and rendered["depth_m"].shape != (len(tr.t), camera.height, camera.width):
+        print(f"error: {args.frames}: depth_m has shape {rendered['depth_m'].shape}, expected "
+              f"({len(tr.t)}, {camera.height}, {camera.width}) to match {args.trajectory}", file=sys.stderr)
+        return 1
     frames = np.arange(0, len(tr.t) - 1, args.every)  # each needs its next frame
     n, h, w = len(frames), camera.height, camera.width
-    flow = np.empty((n, h, w, 2), np.float32)
-    displacement = np.empty((n, h, w, 2), np.float32)
-    valid = np.empty((n, h, w), bool)
-    _log(f"{args.trajectory}: {n} fields of {w} x {h} (every {args.every} of {len(tr.t)} poses)")
+    fields = {"flow_sphere": np.empty((n, h, w, 2), np.float32), "displacement_sphere": np.empty((n, h, w, 2), np.float32),
+              "valid": np.empty((n, h, w), bool)}
+    if rendered is not None:
+        fields.update({"flow_terrain": np.empty((n, h, w, 2), np.float32),
+                       "displacement_terrain": np.empty((n, h, w, 2), np.float32),
+                       "valid_terrain": np.empty((n, h, w), bool),
+                       "sphere_minus_terrain_mean_px_s": np.full((n, 2), np.nan, np.float32),
+                       "sphere_minus_terrain_rms_px_s": np.full(n, np.nan, np.float32)})
+    _log(f"{args.trajectory}: {n} fields of {w} x {h} (every {args.every} of {len(tr.t)} poses)"
+         + (f", terrain-true from {args.frames}" if rendered is not None else ""))
     flo_dir = Path(args.flo_dir)
     tmp_dir = Path(tempfile.mkdtemp(prefix=f".{flo_dir.name}.", suffix=".part", dir=flo_dir.parent))
     try:
         for i, k in enumerate(frames):
-            flow[i], _ = sphere_flow(camera, tr.state[k], args.moon_radius_m, np.float32)
-            disp, valid[i] = sphere_displacement(camera, tr.state[k], tr.state[k + 1], args.moon_radius_m)
-            displacement[i] = disp
-            write_flo(tmp_dir / f"{k:06d}.flo", displacement[i])
+            flow, on_sphere = sphere_flow(camera, tr.state[k], args.moon_radius_m, np.float32)
+            fields["flow_sphere"][i] = flow
+            disp, fields["valid"][i] = sphere_displacement(camera, tr.state[k], tr.state[k + 1], args.moon_radius_m)
+            fields["displacement_sphere"][i] = disp
+            write_flo(tmp_dir / f"{k:06d}.flo", fields["displacement_sphere"][i])
+            if rendered is not None:
+                depth = rendered["depth_m"][k]
+                terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
+                fields["flow_terrain"][i] = terrain_flow
+                disp, fields["valid_terrain"][i] = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth)
+                fields["displacement_terrain"][i] = disp
+                both = seen & on_sphere
+                if both.any():
+                    diff = (flow - terrain_flow)[both]
+                    fields["sphere_minus_terrain_mean_px_s"][i] = diff.mean(axis=0)
+                    fields["sphere_minus_terrain_rms_px_s"][i] = np.sqrt(np.mean(np.sum(diff**2, axis=1)))
             if (i + 1) % max(1, n // 10) == 0:
                 _log(f"  {i + 1}/{n} fields")
         attrs = {"width": w, "height": h, "fov_deg": args.fov_deg, "focal_px": camera.focal_px,
                  "moon_radius_m": args.moon_radius_m, "fps": float(tr.attrs["fps"]), "every_n_frames": args.every,
                  "scenario": tr.attrs["scenario"], "id": int(tr.attrs["id"]), "traj2events_version": __version__}
-        write_motion_field(args.output, tr.t[frames], frames, {"flow_sphere": flow, "displacement_sphere": displacement,
-                                                               "valid": valid}, attrs)
+        if rendered is not None:
+            rms = fields["sphere_minus_terrain_rms_px_s"]
+            attrs["sphere_minus_terrain_rms_px_s_median"] = float(np.nanmedian(rms)) if np.isfinite(rms).any() else np.nan
+            _log(f"sphere minus terrain-true field: median RMS {attrs['sphere_minus_terrain_rms_px_s_median']:.3g} px/s, "
+                 f"mean offset {np.nanmean(fields['sphere_minus_terrain_mean_px_s'], axis=0)} px/s")
+        write_motion_field(args.output, tr.t[frames], frames, fields, attrs)
         shutil.rmtree(flo_dir, ignore_errors=True)
         tmp_dir.rename(flo_dir)
     except BaseException:
@@ -213,11 +242,81 @@ def cmd_motion_field(args) -> int:
 
     picks = paper_times(tr.t)
     fields = [sphere_flow(camera, tr.state[k], args.moon_radius_m, np.float32) for k in picks]
+    backgrounds = None
+    if rendered is not None:
+        from .video import display_frame
+
+        white, gamma = float(rendered.attrs["display_white_w_m2_sr"]), float(rendered.attrs["display_gamma"])
+        backgrounds = [display_frame(rendered["radiance"][k], white, gamma) for k in picks]
+        rendered.close()
     fig = motion_field_mosaic([float(tr.t[k]) for k in picks], [f for f, _ in fields], [m for _, m in fields],
                               ["t0", "tf/4", "tf/2", "3tf/4", "tf"],
-                              f"{tr.attrs['scenario']} {int(tr.attrs['id']):04d}: motion field over the sphere (px/s)")
+                              f"{tr.attrs['scenario']} {int(tr.attrs['id']):04d}: motion field over the sphere (px/s)",
+                              backgrounds=backgrounds)
     with atomic_output(args.figure) as tmp:
         fig.savefig(tmp, format="png", dpi=100, metadata={"Software": None})
+    return 0
+
+
+def cmd_render(args) -> int:
+    from .camera import camera_pose
+    from .config import RenderSettings
+    from .io import FramesWriter, atomic_output, read_trajectory
+    from .render import TerrainRenderer
+    from .video import VideoWriter, display_frame
+
+    text = Path(args.settings[1:]).read_text() if args.settings.startswith("@") else args.settings
+    s = RenderSettings.from_json(text)
+    tr = read_trajectory(args.trajectory)
+    if tr.t is None or len(tr.t) < 1:
+        print(f"error: {args.trajectory}: expected poses/t with at least one pose", file=sys.stderr)
+        return 1
+    camera, tiles, sun, reflectance = s.build()
+    fps = float(tr.attrs["fps"])
+    n = len(tr.t)
+    attrs = {"width": s.width, "height": s.height, "fov_deg": s.fov_deg, "focal_px": camera.focal_px, "fps": fps,
+             "moon_radius_m": s.moon_radius_m, "sun_range_m": sun.range_m, "sun_azimuth_deg": sun.azimuth_deg,
+             "sun_elevation_deg": sun.elevation_deg, "sun_irradiance_w_m2": sun.irradiance_w_m2,
+             "reflectance": s.reflectance, "terrain": s.terrain, "lod": s.lod, "terrain_half_extent_m": s.half_extent_m,
+             "display_white_w_m2_sr": s.display_white_w_m2_sr, "display_gamma": s.display_gamma,
+             "scenario": tr.attrs["scenario"], "id": int(tr.attrs["id"]), "traj2events_version": __version__}
+    _log(f"{args.trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {sun.azimuth_deg} deg, "
+         f"el {sun.elevation_deg} deg, {s.reflectance['model']})")
+    start = time.perf_counter()
+    triangles = tiles_drawn = reused = 0
+    picks = paper_times(tr.t)
+    mosaic = {}
+    with TerrainRenderer(tiles, camera, sun, reflectance) as renderer, \
+            FramesWriter(args.frames, tr.t, np.arange(n), s.height, s.width, attrs) as frames, \
+            VideoWriter(args.video, s.width, s.height, fps, "ffv1") as video, \
+            VideoWriter(args.preview, s.width, s.height, fps, "h264") as preview:
+        frame = None
+        for k in range(n):
+            # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
+            if frame is None or not np.array_equal(tr.state[k, :9], tr.state[k - 1, :9]):
+                frame = renderer.render(camera_pose(tr.state[k]))
+                triangles += frame.n_triangles
+                tiles_drawn += frame.n_tiles
+            else:
+                reused += 1
+            frames.write(k, frame.radiance, frame.depth_m)
+            shown = display_frame(frame.radiance, s.display_white_w_m2_sr, s.display_gamma)
+            video.write(shown)
+            preview.write(shown)
+            if k in picks:
+                mosaic[k] = shown
+            if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
+                elapsed = time.perf_counter() - start
+                _log(f"  {k + 1}/{n} frames, {elapsed / (k + 1) * 1e3:.1f} ms/frame, "
+                     f"{len(tiles._cache)} tiles cached, {triangles / max(k + 1 - reused, 1):.0f} triangles/frame")
+    _log(f"{n} frames in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
+    if args.mosaic:
+        from .figures import frame_mosaic
+
+        fig = frame_mosaic([float(tr.t[k]) for k in picks], [mosaic[k] for k in picks],
+                           ["t0", "tf/4", "tf/2", "3tf/4", "tf"], f"{tr.attrs['scenario']} {int(tr.attrs['id']):04d}")
+        with atomic_output(args.mosaic) as tmp:
+            fig.savefig(tmp, format="png", dpi=100, metadata={"Software": None})
     return 0
 
 
@@ -265,10 +364,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--fov-deg", type=float, required=True, help="horizontal field of view, deg")
     p.add_argument("--moon-radius-m", type=float, default=1_737_400.0, help="sphere radius, m (default 1737400)")
     p.add_argument("--every", type=int, default=1, help="write every n-th frame's field (default 1)")
+    p.add_argument("--frames", help="frames.h5 from `traj2events render`: adds the terrain-true field from its depth")
     p.add_argument("--output", "-o", required=True, help="motion_field.h5")
     p.add_argument("--flo-dir", required=True, help="folder for the Middlebury .flo displacements")
     p.add_argument("--figure", required=True, help="PNG: colour wheel and quiver at t0, tf/4, tf/2, 3tf/4, tf")
     p.set_defaults(func=cmd_motion_field)
+
+    p = sub.add_parser("render", help="render the lunar surface from every pose of a trajectory (radiance, depth, videos)")
+    p.add_argument("trajectory", help="trajectory.h5 (poses)")
+    p.add_argument("--settings", required=True, help="render settings as JSON (or @file): camera, terrain, sun, "
+                   "reflectance, lod, display (the workflow builds it from the config)")
+    p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
+    p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
+    p.add_argument("--preview", required=True, help="preview.mp4: H.264 of the same, to look at")
+    p.add_argument("--mosaic", help="PNG: the frames at t0, tf/4, tf/2, 3tf/4, tf")
+    p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("index", help="one CSV row per trajectory file of a scenario (the dataset index)")
     p.add_argument("trajectories", nargs="*", help="trajectory.h5 files")

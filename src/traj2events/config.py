@@ -128,3 +128,60 @@ class ScenarioSettings:
                             {k: tuple(v) for k, v in sc["ranges"].items()})
         vehicle = dict(d["vehicle"], inertia_kgm2=tuple(d["vehicle"]["inertia_kgm2"]))
         return cls(Vehicle(**vehicle), OcpSettings(**d["ocp"]), scenario, int(d["seed"]))
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """Everything one scenario's rendering depends on (the render rule's `params`):
+    camera, terrain, Sun, reflectance, level of detail, display mapping."""
+
+    scenario: str
+    width: int
+    height: int
+    fov_deg: float
+    moon_radius_m: float
+    terrain: dict
+    sun: dict
+    reflectance: dict
+    lod: dict
+    half_extent_m: float
+    display_white_w_m2_sr: float
+    display_gamma: float
+
+    @classmethod
+    def from_config(cls, config: dict, name: str) -> "RenderSettings":
+        from .terrain import horizon_distance_m
+
+        sc = config["scenarios"][name]
+        radius = float(config["motion_field"]["moon_radius_m"])
+        # Out to the horizon of the scenario's highest camera (with a margin for climbs
+        # and relief), from the farthest start point.
+        reach = max(abs(v) for v in sc["downrange_m"]) + max(abs(v) for v in sc["crossrange_m"])
+        horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
+        r = config["render"]
+        return cls(name, int(config["camera"]["width"]), int(config["camera"]["height"]),
+                   float(config["camera"]["fov_deg"]), radius, dict(config["terrain"]), dict(sc["sun"]),
+                   dict(r["reflectance"]), dict(r["lod"]), float(reach + horizon),
+                   float(r["display_white_w_m2_sr"]), float(r["display_gamma"]))
+
+    def to_json(self) -> str:
+        return json.dumps(self.__dict__, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> "RenderSettings":
+        return cls(**json.loads(text))
+
+    def build(self):
+        """(camera, tiles, sun, reflectance) ready for render.TerrainRenderer."""
+        from .camera import Camera
+        from .illumination import Sun
+        from .reflectance import ReflectanceParams
+        from .terrain import ProceduralTerrain, TerrainParams, load_elevation_grid
+        from .tiles import LodSettings, TileSet
+
+        t = dict(self.terrain)
+        grid, spacing = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None)
+        terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
+        sun = Sun(**self.sun)
+        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, LodSettings(**self.lod))
+        return Camera(self.width, self.height, self.fov_deg), tiles, sun, ReflectanceParams(**self.reflectance)

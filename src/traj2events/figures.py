@@ -110,8 +110,9 @@ def flow_to_colour(flow: np.ndarray, max_flow: float | None = None) -> np.ndarra
 
 
 def motion_field_mosaic(times: list[float], flows: list[np.ndarray], terrain: list[np.ndarray], labels: list[str],
-                        title: str, n_arrows: int = 16) -> plt.Figure:
-    """Colour-wheel image (top) and a sparse quiver plot (bottom) of each field, px/s."""
+                        title: str, n_arrows: int = 16, backgrounds: list[np.ndarray] | None = None) -> plt.Figure:
+    """Colour-wheel image (top) and a sparse quiver plot (bottom) of each field, px/s,
+    drawn over the rendered frame when `backgrounds` (8-bit images) are given."""
     fig, axes = plt.subplots(2, len(flows), figsize=(3.0 * len(flows), 6.2), squeeze=False)
     for col, (t, flow, ok, label) in enumerate(zip(times, flows, terrain, labels)):
         speed = np.hypot(flow[..., 0], flow[..., 1])
@@ -122,13 +123,29 @@ def motion_field_mosaic(times: list[float], flows: list[np.ndarray], terrain: li
         step = max(1, max(height, width) // n_arrows)
         rows, cols = np.mgrid[step // 2:height:step, step // 2:width:step]
         ax = axes[1, col]
-        ax.imshow(np.where(ok, 0.35, 0.0), cmap="gray", vmin=0, vmax=1)  # terrain grey, sky black
+        if backgrounds is not None:
+            ax.imshow(backgrounds[col], cmap="gray", vmin=0, vmax=255)
+        else:
+            ax.imshow(np.where(ok, 0.35, 0.0), cmap="gray", vmin=0, vmax=1)  # terrain grey, sky black
         ax.quiver(cols, rows, flow[rows, cols, 0], flow[rows, cols, 1], color="tab:orange", angles="xy")
         ax.set_xlim(-0.5, width - 0.5)
         ax.set_ylim(height - 0.5, -0.5)
         for a in axes[:, col]:
             a.set_xticks([])
             a.set_yticks([])
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def frame_mosaic(times: list[float], frames: list[np.ndarray], labels: list[str], title: str) -> plt.Figure:
+    """The paper's frame mosaic: rendered display frames (8-bit) side by side."""
+    fig, axes = plt.subplots(1, len(frames), figsize=(3.0 * len(frames), 3.4), squeeze=False)
+    for ax, t, frame, label in zip(axes[0], times, frames, labels):
+        ax.imshow(frame, cmap="gray", vmin=0, vmax=255, interpolation="nearest")
+        ax.set_title(f"{label}: t = {t:.1f} s", fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
     fig.suptitle(title)
     fig.tight_layout()
     return fig

@@ -211,3 +211,45 @@ def write_motion_field(path: str | os.PathLike, t: np.ndarray, frame_index: np.n
             f.create_dataset(name, data=data, chunks=chunks, compression="gzip", compression_opts=4, shuffle=True,
                              track_times=False)
         _set_attrs(f, attrs)
+
+
+def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
+    """float32 rounded to `bits` significant bits (relative step 2^-bits): values keep far
+    more than 12 bits at any brightness, and the dropped low bits compress to nothing."""
+    a = np.ascontiguousarray(x, dtype=np.float32)
+    drop = 24 - bits
+    u = a.view(np.uint32)
+    rounded = (u + np.uint32(1 << (drop - 1))) & np.uint32((0xFFFFFFFF << drop) & 0xFFFFFFFF)
+    finite = np.isfinite(a)
+    return np.where(finite, rounded.view(np.float32), a)
+
+
+class FramesWriter:
+    """frames.h5, one frame at a time: t (n,) s, frame_index (n,), radiance (n, H, W)
+    float32 W m^-2 sr^-1, depth_m (n, H, W) float32 along the boresight (0 = sky); both
+    rounded to 16 significant bits and compressed one frame per chunk."""
+
+    def __init__(self, path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, height: int, width: int,
+                 attrs: dict):
+        self._context = atomic_output(path)
+        tmp = self._context.__enter__()
+        self._file = _h5_file(tmp)
+        _dataset(self._file, "t", np.asarray(t, float))
+        _dataset(self._file, "frame_index", np.asarray(frame_index, np.int64))
+        n = len(t)
+        self._sets = {name: self._file.create_dataset(name, shape=(n, height, width), dtype=np.float32,
+                                                      chunks=(1, height, width), compression="gzip",
+                                                      compression_opts=1, shuffle=True, track_times=False)
+                      for name in ("radiance", "depth_m")}
+        _set_attrs(self._file, attrs)
+
+    def write(self, i: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
+        self._sets["radiance"][i] = round_mantissa(radiance)
+        self._sets["depth_m"][i] = round_mantissa(depth_m)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self._file.close()
+        return self._context.__exit__(*exc)

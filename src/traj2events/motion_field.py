@@ -159,8 +159,30 @@ def sphere_displacement(camera: Camera, state_k: np.ndarray, state_next: np.ndar
     normal, height = local_vertical(pose_k.position, pose_k.rotation, radius_m)
     x_s, y_s = camera.pixel_coordinates(np.float64)
     f = camera.focal_px
+    h = inverse_depth_sphere(x_s / f, y_s / f, normal, height, radius_m)
+    displacement, in_front, point_world = _displace(camera, pose_k, pose_next, h)
+    centre = np.array([0.0, 0.0, radius_m])
+    outward = point_world + pose_next.position - centre  # surface point - centre
+    facing = np.einsum("hwk,hwk->hw", outward, -point_world) > 0  # camera k+1 above its tangent plane
+    return displacement, (h > 0) & in_front & facing
+
+
+def depth_displacement(camera: Camera, state_k: np.ndarray, state_next: np.ndarray,
+                       depth_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Exact displacement (H, W, 2) in px from frame k to k+1 of the surface seen in a
+    depth map (metric depth along the boresight at k; 0 = sky, moved as a direction), and
+    the mask of terrain pixels in front of camera k+1. Occlusion at k+1 is not checked. float64."""
+    h = inverse_depth_from_depth(np.asarray(depth_m, dtype=np.float64))
+    displacement, in_front, _ = _displace(camera, camera_pose(state_k), camera_pose(state_next), h)
+    return displacement, (h > 0) & in_front
+
+
+def _displace(camera: Camera, pose_k, pose_next, h: np.ndarray):
+    """Pixels of frame k with inverse depth h (0: at infinity) -> centred coordinates in
+    frame k+1; returns (displacement, in front of camera k+1, points relative to camera k+1)."""
+    x_s, y_s = camera.pixel_coordinates(np.float64)
+    f = camera.focal_px
     a, b = x_s / f, y_s / f
-    h = inverse_depth_sphere(a, b, normal, height, radius_m)
     hit = h > 0
     ray = np.stack(np.broadcast_arrays(a, b, np.ones_like(h)), axis=-1)  # (H, W, 3)
     # Positions relative to camera k+1 (small numbers: no loss to the Moon's radius).
@@ -170,13 +192,7 @@ def sphere_displacement(camera: Camera, state_k: np.ndarray, state_next: np.ndar
     point_world = np.where(hit[..., None], depth * point_world + shift, point_world)
     point_next = point_world @ pose_next.rotation  # R_next^T p, camera frame k+1
     z = point_next[..., 2]
-    in_front = z > 0
     with np.errstate(divide="ignore", invalid="ignore"):
         x_next = f * point_next[..., 0] / z
         y_next = f * point_next[..., 1] / z
-    centre = np.array([0.0, 0.0, radius_m])
-    outward = point_world + pose_next.position - centre  # surface point - centre
-    facing = np.einsum("hwk,hwk->hw", outward, -point_world) > 0  # camera k+1 above its tangent plane
-    valid = hit & in_front & facing
-    displacement = np.stack([x_next - x_s, y_next - y_s], axis=-1)
-    return displacement, valid
+    return np.stack([x_next - x_s, y_next - y_s], axis=-1), z > 0, point_world

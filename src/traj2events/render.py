@@ -67,6 +67,7 @@ def _make_float_renderer_class(pyrender):
         """pyrender.Renderer with a float32, single-sample framebuffer and a terrain pass."""
 
         uniforms: dict = {}
+        draw_order: list = []  # mesh nodes, nearest first (a fixed order: same frame, same bytes)
 
         def _configure_main_framebuffer(self):
             if self._main_fb is not None and (self.viewport_width, self.viewport_height) != self._main_fb_dims:
@@ -109,9 +110,7 @@ def _make_float_renderer_class(pyrender):
             V, P = self._get_camera_matrices(scene)
             cam_pos = self.uniforms["cam_pos"]
             program = None
-            for node in scene.mesh_nodes:
-                if not node.mesh.is_visible:
-                    continue
+            for node in self.draw_order:
                 for primitive in node.mesh.primitives:
                     if program is None:
                         program = self._program_cache.get_program(
@@ -194,6 +193,11 @@ class TerrainRenderer:
         for key, node in self._nodes.items():
             node.mesh.is_visible = key in visible
         self._evict()
+        # Front to back: the depth test then rejects hidden fragments early, and the order
+        # (hence which of two coincident surfaces wins) does not depend on Python's hashing.
+        cam = np.asarray(pose.position, float)
+        order = sorted(keys, key=lambda k: (float(np.linalg.norm(self.tiles.tile(k).centre - cam)), k))
+        self._renderer.draw_order = [self._nodes[k] for k in order]
         if keys:
             near, far = self.tiles.depth_range(keys, pose, self.camera)
         else:

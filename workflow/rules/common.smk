@@ -9,7 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 import traj2events
-from traj2events.config import ConfigError, ScenarioSettings, load_yaml, validate_config
+from traj2events.config import ConfigError, RenderSettings, ScenarioSettings, load_yaml, validate_config
 
 try:
     validate_config(config, load_yaml(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
@@ -34,12 +34,31 @@ def source_hash(*modules):
     digest = hashlib.sha256()
     for module in sorted({*modules, "__init__", "cli", "config", "io"}):
         digest.update((PACKAGE_DIR / f"{module}.py").read_bytes())
+    if "render" in modules:  # the GLSL the renderer compiles
+        for shader in sorted((PACKAGE_DIR / "shaders").glob("*.*")):
+            digest.update(shader.read_bytes())
     return digest.hexdigest()[:16]
 
 
 def scenario_settings(wildcards):
     """Everything the solves of one scenario depend on, as JSON (vehicle, ocp, ranges, seed)."""
     return ScenarioSettings.from_config(config, wildcards.scenario).to_json()
+
+
+def render_settings(wildcards):
+    """Everything one scenario's frames depend on, as JSON (camera, terrain, Sun, reflectance, LOD)."""
+    return RenderSettings.from_config(config, wildcards.scenario).to_json()
+
+
+def elevation_grid(wildcards):
+    """The user's DEM file, when the config names one (so that editing it reruns rendering)."""
+    grid = config["terrain"].get("elevation_grid")
+    return [grid] if grid else []
+
+
+def frames_output(path):
+    """frames.h5 (linear radiance + depth) is large: temporary unless render.keep_frames."""
+    return path if config["render"]["keep_frames"] else temp(path)
 
 
 def solved_ids(scenario):
@@ -49,7 +68,7 @@ def solved_ids(scenario):
     return [f"{i:04d}" for i in samples.loc[samples["success"], "id"]]
 
 
-PER_TRAJECTORY = ["trajectory.h5", "motion_field.h5", "motion_field.png"]
+PER_TRAJECTORY = ["trajectory.h5", "video.mkv", "preview.mp4", "frames.png", "motion_field.h5", "motion_field.png"]
 
 
 def scenario_outputs(wildcards):

@@ -1,0 +1,80 @@
+"""Display frames and videos: 8-bit tone mapping, lossless FFV1 and an H.264 preview,
+through ffmpeg (ffmpeg-python builds the command lines)."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+
+def display_frame(radiance: np.ndarray, white_w_m2_sr: float, gamma: float) -> np.ndarray:
+    """Linear radiance -> 8-bit display values: 255 (L / white)^(1/gamma), clipped."""
+    x = np.clip(np.asarray(radiance, dtype=np.float64) / white_w_m2_sr, 0.0, 1.0)
+    return np.round(255.0 * x ** (1.0 / gamma)).astype(np.uint8)
+
+
+class VideoWriter:
+    """Streams 8-bit grey frames into a video file; written under a temporary name and
+    renamed on close, so an interrupted run leaves nothing behind.
+
+    kind 'ffv1': lossless FFV1 in Matroska (what the emulator reads back exactly);
+    kind 'h264': H.264 in MP4 (yuv420p, CRF 18) to look at."""
+
+    def __init__(self, path: str | os.PathLike, width: int, height: int, fps: float, kind: str = "ffv1"):
+        import ffmpeg
+
+        self.path = Path(path)
+        self.tmp = self.path.with_name(f".{self.path.name}.part")
+        self.width, self.height = width, height
+        source = ffmpeg.input("pipe:", format="rawvideo", pix_fmt="gray", s=f"{width}x{height}", framerate=fps)
+        common = {"fflags": "+bitexact", "flags:v": "+bitexact", "map_metadata": -1}
+        if kind == "ffv1":
+            out = source.output(str(self.tmp), format="matroska", vcodec="ffv1", level=3, pix_fmt="gray", **common)
+        elif kind == "h264":
+            out = source.output(str(self.tmp), format="mp4", vcodec="libx264", pix_fmt="yuv420p", crf=18,
+                                preset="veryfast", threads=1, vf="pad=ceil(iw/2)*2:ceil(ih/2)*2", **common)
+        else:
+            raise ValueError(f"video kind: expected 'ffv1' or 'h264', got {kind!r}")
+        self._process = out.overwrite_output().global_args("-loglevel", "error").run_async(pipe_stdin=True)
+        self.n_frames = 0
+
+    def write(self, frame: np.ndarray) -> None:
+        frame = np.ascontiguousarray(frame, dtype=np.uint8)
+        if frame.shape != (self.height, self.width):
+            raise ValueError(f"{self.path}: expected a {self.height} x {self.width} frame, got {frame.shape}")
+        self._process.stdin.write(frame.tobytes())
+        self.n_frames += 1
+
+    def close(self, keep: bool = True) -> None:
+        self._process.stdin.close()
+        code = self._process.wait()
+        if code != 0 or not keep:
+            self.tmp.unlink(missing_ok=True)
+            if code != 0:
+                raise RuntimeError(f"ffmpeg failed writing {self.path} (exit {code})")
+            return
+        os.replace(self.tmp, self.path)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, exc_type, *exc):
+        self.close(keep=exc_type is None)
+
+
+def read_video(path: str | os.PathLike, frames: list[int] | None = None) -> np.ndarray:
+    """Decode a video to (n, H, W) uint8 grey; only the listed frame indices if given."""
+    import ffmpeg
+
+    probe = ffmpeg.probe(str(path))
+    stream = next(s for s in probe["streams"] if s["codec_type"] == "video")
+    width, height = int(stream["width"]), int(stream["height"])
+    source = ffmpeg.input(str(path))
+    if frames is not None:
+        source = source.filter("select", "+".join(f"eq(n,{k})" for k in frames))  # ffmpeg-python escapes the commas
+        out = source.output("pipe:", format="rawvideo", pix_fmt="gray", fps_mode="passthrough")
+    else:
+        out = source.output("pipe:", format="rawvideo", pix_fmt="gray")
+    data, _ = out.global_args("-loglevel", "error").run(capture_stdout=True)
+    return np.frombuffer(data, np.uint8).reshape(-1, height, width)

@@ -1,0 +1,28 @@
+# Stages 4-5: render the lunar surface from every pose (linear radiance + depth), and the
+# videos (lossless FFV1, H.264 preview) and frame mosaic made from the same frames.
+
+
+rule render:
+    input:
+        trajectory="results/{scenario}/{id}/trajectory.h5",
+        dem=elevation_grid,
+    output:
+        frames=frames_output("results/{scenario}/{id}/frames.h5"),
+        video="results/{scenario}/{id}/video.mkv",
+        preview="results/{scenario}/{id}/preview.mp4",
+        mosaic=report(
+            "results/{scenario}/{id}/frames.png",
+            caption="../report/frames.rst",
+            category="Frames",
+            subcategory="{scenario}",
+        ),
+    params:
+        settings=render_settings,
+        code=source_hash("render", "tiles", "terrain", "illumination", "reflectance", "camera", "video", "figures"),
+    log:
+        "results/logs/{scenario}/{id}/render.log",
+    conda:
+        ENV
+    shell:
+        "traj2events render {input.trajectory} --settings '{params.settings}' --frames {output.frames} "
+        "--video {output.video} --preview {output.preview} --mosaic {output.mosaic} 2> {log}"
