@@ -137,3 +137,26 @@ def test_same_seed_and_pose_same_pixels_and_sky_is_empty():
     up = CameraPose(pose.position, camera_pose(state(pitch=180.0)).rotation)  # boresight to the zenith
     sky, _ = render(ProceduralTerrain(TerrainParams(seed=2)), camera, up)
     assert sky.n_tiles == 0 and not sky.radiance.any() and not sky.depth_m.any()
+
+
+def test_one_metre_above_the_pad_sees_it_one_metre_away():
+    camera = Camera(32, 32, 45.0)
+    pose = camera_pose(state(x=2.0, altitude=1.0))
+    frame, _ = render(ProceduralTerrain(TerrainParams(seed=4, site_radius_m=30.0)), camera, pose)
+    assert frame.depth_m.min() > 0
+    np.testing.assert_allclose(frame.depth_m[14:18, 14:18], 1.0, rtol=1e-4)  # the pad is flat and level
+    assert np.all(np.isfinite(frame.radiance)) and frame.radiance.min() >= 0
+
+
+def test_horizon_at_the_tilt_limit_splits_sky_and_ground():
+    # Pitched 80 deg at 2 km: the camera looks just below the horizon (3.0 deg down at
+    # 2 km on this Moon); rows above it are sky, those below terrain at grazing incidence.
+    camera = Camera(64, 64, 45.0)
+    pose = camera_pose(state(x=-5000.0, altitude=2000.0, pitch=80.0))
+    frame, _ = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose)
+    ground = frame.depth_m > 0
+    assert 0.05 < ground.mean() < 0.95
+    # Columns run along body-forward: with the camera pitched up the horizon crosses the
+    # image column-wise; far terrain sits at tens of km, never negative or NaN.
+    assert np.all(np.isfinite(frame.depth_m)) and frame.depth_m.max() < 200e3
+    assert np.all(frame.radiance[~ground] == 0)

@@ -22,7 +22,7 @@ rule render:
     log:
         "results/logs/{scenario}/{id}/render.log",
     conda:
-        ENV
+        "../../envs/render.yaml"
     shell:
         "traj2events render {input.trajectory} --settings '{params.settings}' --frames {output.frames} "
         "--video {output.video} --preview {output.preview} --mosaic {output.mosaic} 2> {log}"
