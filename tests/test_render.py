@@ -160,3 +160,13 @@ def test_horizon_at_the_tilt_limit_splits_sky_and_ground():
     # image column-wise; far terrain sits at tens of km, never negative or NaN.
     assert np.all(np.isfinite(frame.depth_m)) and frame.depth_m.max() < 200e3
     assert np.all(frame.radiance[~ground] == 0)
+
+
+def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
+    camera = Camera(32, 32, 45.0)
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, LodSettings())
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20) as renderer:
+        for x in (-3000.0, -1500.0, 0.0):
+            frame = renderer.render(camera_pose(state(x=x, altitude=300.0, pitch=30.0)))
+            assert frame.n_tiles > 0
+            assert len(renderer._nodes) <= max(20, frame.n_tiles)

@@ -223,10 +223,12 @@ class TerrainRenderer:
         return Frame(image[..., 0], image[..., 1], image[..., 2], len(keys), n_tri)
 
     def _evict(self) -> None:
+        """Drop the least recently drawn tiles beyond the cap (never this frame's)."""
         if len(self._nodes) <= self.max_cached_tiles:
             return
-        by_age = sorted(self._nodes, key=lambda k: self._last_used.get(k, 0))
-        for key in by_age[: len(self._nodes) - self.max_cached_tiles]:
+        old = sorted((k for k in self._nodes if self._last_used.get(k, 0) < self._frame_count),
+                     key=lambda k: (self._last_used.get(k, 0), k))
+        for key in old[: len(self._nodes) - self.max_cached_tiles]:
             self._scene.remove_node(self._nodes.pop(key))
             self._last_used.pop(key, None)
         self.tiles.evict(set(self._nodes))
