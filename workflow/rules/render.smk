@@ -19,10 +19,12 @@ rule render:
     params:
         settings=render_settings,
         code=source_hash("render", "tiles", "terrain", "illumination", "reflectance", "camera", "video", "figures"),
+    threads: 1
     log:
         "results/logs/{scenario}/{id}/render.log",
     conda:
         "../../envs/render.yaml"
     shell:
-        "traj2events render {input.trajectory} --settings '{params.settings}' --frames {output.frames} "
+        # llvmpipe would start a thread per core in every job; one job = one core.
+        "LP_NUM_THREADS={threads} traj2events render {input.trajectory} --settings '{params.settings}' --frames {output.frames} "
         "--video {output.video} --preview {output.preview} --mosaic {output.mosaic} 2> {log}"
