@@ -8,8 +8,9 @@ that adapts pyrender 0.1.45 to that setting (tested in tests/test_render.py):
   - pyrender uses `np.infty`, gone in NumPy 2: the alias is restored before import;
   - pyrender's main framebuffer is 8-bit RGBA with 4x multisampling; the renderer here
     replaces it with a single-sample float32 one and its own forward pass (one program,
-    uniforms set once per frame), reading back radiance (W m^-2 sr^-1), depth along the
-    boresight (m, computed in the shader, 0 for sky) and the lit fraction as float32.
+    uniforms set once per frame, tiles drawn relative to the camera), reading back
+    radiance (W m^-2 sr^-1) and depth along the boresight (m, computed in the shader,
+    0 for sky) as float32 (a two-channel buffer: half the bytes of RGBA).
 """
 from __future__ import annotations
 
@@ -55,7 +56,6 @@ def _import_pyrender():
 class Frame:
     radiance: np.ndarray  # (H, W) float32, W m^-2 sr^-1
     depth_m: np.ndarray  # (H, W) float32, along the boresight; 0 = sky
-    lit: np.ndarray  # (H, W) float32, 0..1 (0 also for sky)
     n_tiles: int
     n_triangles: int
 
@@ -75,7 +75,7 @@ def _make_float_renderer_class(pyrender):
             if self._main_fb is None:
                 self._main_cb, self._main_db = gl.glGenRenderbuffers(2)
                 gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self._main_cb)
-                gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RGBA32F, self.viewport_width, self.viewport_height)
+                gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RG32F, self.viewport_width, self.viewport_height)
                 gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self._main_db)
                 gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT32F, self.viewport_width,
                                          self.viewport_height)
@@ -108,8 +108,13 @@ def _make_float_renderer_class(pyrender):
             gl.glDisable(gl.GL_CULL_FACE)
             gl.glPolygonMode(gl.GL_FRONT_AND_BACK, gl.GL_FILL)
             V, P = self._get_camera_matrices(scene)
+            # Camera-relative rendering: the view rotation only, and per tile its offset
+            # from the camera (float64 on the CPU, small float32 numbers on the GPU).
+            V = V.copy()
+            V[:3, 3] = 0.0
             cam_pos = self.uniforms["cam_pos"]
             program = None
+            offset_loc = -1
             for node in self.draw_order:
                 for primitive in node.mesh.primitives:
                     if program is None:
@@ -124,23 +129,25 @@ def _make_float_renderer_class(pyrender):
                         for name, value in self.uniforms.items():
                             if name != "cam_pos":
                                 program.set_uniform(name, value)
-                    pose = scene.get_pose(node)
-                    program.set_uniform("M", pose)
-                    program.set_uniform("cam_offset_from_origin", (pose[:3, 3] - cam_pos).astype(np.float32))
+                        offset_loc = gl.glGetUniformLocation(program._program_id, "tile_offset")
+                    offset = node.translation - cam_pos
+                    gl.glUniform3f(offset_loc, float(offset[0]), float(offset[1]), float(offset[2]))
                     primitive._bind()
-                    gl.glDrawElementsInstanced(primitive.mode, primitive.indices.size, gl.GL_UNSIGNED_INT, None, 1)
-                    primitive._unbind()
+                    gl.glDrawElements(primitive.mode, primitive.indices.size, gl.GL_UNSIGNED_INT, None)
             if program is not None:
                 program._unbind()
             gl.glFlush()
             return self._read_main_framebuffer(scene, flags)
 
         def _read_main_framebuffer(self, scene, flags):
+            from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels
+
             width, height = self._main_fb_dims
             gl.glBindFramebuffer(gl.GL_READ_FRAMEBUFFER, self._main_fb)
-            buf = gl.glReadPixels(0, 0, width, height, gl.GL_RGBA, gl.GL_FLOAT)
-            image = np.frombuffer(buf, dtype=np.float32).reshape(height, width, 4)
-            return np.flip(image, axis=0).copy()  # OpenGL's first row is the bottom one
+            image = np.empty((height, width, 2), dtype=np.float32)
+            # The raw entry point: PyOpenGL's wrapper knows no GL_RG, and this one fills our array.
+            raw_read_pixels(0, 0, width, height, gl.GL_RG, gl.GL_FLOAT, image)
+            return image[::-1]  # OpenGL's first row is the bottom one (a view: no copy)
 
     return FloatRenderer
 
@@ -220,7 +227,7 @@ class TerrainRenderer:
         self._platform.make_current()
         image = self._renderer.render(self._scene, self._pyrender.RenderFlags.OFFSCREEN)
         n_tri = sum(len(self.tiles.tile(k).faces) for k in keys)
-        return Frame(image[..., 0], image[..., 1], image[..., 2], len(keys), n_tri)
+        return Frame(image[..., 0], image[..., 1], len(keys), n_tri)
 
     def _evict(self) -> None:
         """Drop the least recently drawn tiles beyond the cap (never this frame's)."""

@@ -6,9 +6,11 @@ to reach the horizon seen from the scenario's highest camera. A tile at level l 
 (features below two spacings left out), so a tile is a low-pass version of its children.
 
 Per frame, from the root down: a tile outside the view frustum or beyond the horizon is
-dropped (with everything under it); a tile whose grid spacing, seen from the camera at
-its nearest point, covers more than `pixels_per_cell` pixels is split into its four
-children (down to `min_spacing_m`); otherwise it is drawn. Neighbours at different levels
+dropped (with everything under it); a tile whose grid cell, seen from the camera at its
+nearest point, covers more than `pixels_per_cell` pixels is split into its four children
+(down to `min_spacing_m`); otherwise it is drawn. A cell seen obliquely is measured by the
+geometric mean of its projected sides (`foreshortening`), for tiles farther than their
+own size. Neighbours at different levels
 meet with skirts (a strip hanging below each tile edge) instead of cracks.
 
 Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
@@ -50,6 +52,7 @@ class LodSettings:
     pixels_per_cell: float = 2.0
     min_spacing_m: float = 0.05
     skirt_cells: float = 2.0  # skirt depth in cells of the tile
+    foreshortening: bool = True  # measure a cell by its projected area, not its width
 
 
 class TileSet:
@@ -127,29 +130,36 @@ class TileSet:
     # --- selection --------------------------------------------------------------------
 
     def select(self, pose: CameraPose, camera: Camera) -> list[TileKey]:
-        """Tiles to draw for this camera: in view, above the horizon, at the needed detail."""
+        """Tiles to draw for this camera: in view, above the horizon, at the needed detail.
+        Level by level, each level's tests on arrays."""
         planes = _frustum_planes(camera)
         cam = np.asarray(pose.position, float)
         horizon = _line_of_sight_limit(cam, self.radius_m, self._relief_bound())
         max_level = self.max_level()
+        moon_centre = np.array([0.0, 0.0, self.radius_m])
         chosen: list[TileKey] = []
-        stack: list[TileKey] = [(0, 0, 0)]
-        while stack:
-            key = stack.pop()
-            t = self.tile(key)
-            offset = t.centre - cam
-            dist = float(np.linalg.norm(offset))
-            if dist - t.radius_m > horizon:
-                continue
-            centre_cam = pose.rotation.T @ offset
-            if np.any(planes @ centre_cam < -t.radius_m):
-                continue
-            nearest = max(dist - t.radius_m, 1e-3)
-            if t.spacing_m * camera.focal_px / nearest > self.lod.pixels_per_cell and key[0] < max_level:
-                level, i, j = key
-                stack.extend((level + 1, 2 * i + a, 2 * j + b) for a in (0, 1) for b in (0, 1))
-            else:
-                chosen.append(key)
+        frontier: list[TileKey] = [(0, 0, 0)]
+        while frontier:
+            tiles = [self.tile(k) for k in frontier]
+            centres = np.array([t.centre for t in tiles])
+            radii = np.array([t.radius_m for t in tiles])
+            offset = centres - cam
+            dist = np.linalg.norm(offset, axis=1)
+            inside = (dist - radii <= horizon) & np.all((offset @ pose.rotation) @ planes.T >= -radii[:, None], axis=1)
+            nearest = np.maximum(dist - radii, 1e-3)
+            cell_px = tiles[0].spacing_m * camera.focal_px / nearest  # one level: one spacing
+            if self.lod.foreshortening:
+                # Seen obliquely a cell shrinks along the line of sight: use the geometric
+                # mean of its two projected sides (sqrt of the cosine to the local up), for
+                # tiles farther than their own size.
+                up = centres - moon_centre
+                cos_view = np.abs(np.sum(up * offset, axis=1)) / (np.linalg.norm(up, axis=1) * np.maximum(dist, 1e-9))
+                far = dist > 2 * radii
+                cell_px = np.where(far, cell_px * np.sqrt(np.maximum(cos_view, 0.05)), cell_px)
+            split = inside & (cell_px > self.lod.pixels_per_cell) & (frontier[0][0] < max_level)
+            chosen.extend(k for k, keep, s in zip(frontier, inside, split) if keep and not s)
+            frontier = [(level + 1, 2 * i + a, 2 * j + b) for (level, i, j), s in zip(frontier, split) if s
+                        for a in (0, 1) for b in (0, 1)]
         return chosen
 
     def _relief_bound(self) -> float:

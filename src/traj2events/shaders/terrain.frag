@@ -1,60 +1,15 @@
 #version 330 core
-// traj2events terrain: linear radiance (W m^-2 sr^-1) and depth along the boresight (m).
-// The reflectance laws mirror reflectance.py (the numpy reference the tests compare with).
+// traj2events terrain, fragment stage: radiance (W m^-2 sr^-1) times the lit fraction,
+// and depth along the boresight (m), into a two-channel float32 buffer.
 in vec3 frag_offset;
-in vec3 frag_normal;
+in float frag_radiance;
 in float frag_lit;
 
-uniform vec3 sun_dir;        // unit, toward the Sun (world)
 uniform vec3 boresight;      // unit, camera +z (world)
-uniform float irradiance;    // W/m^2 at the Moon
-uniform int model;           // 0 Hapke, 1 Lunar-Lambert
-uniform float w;             // Hapke single-scattering albedo
-uniform float b;
-uniform float c;
-uniform float b0;
-uniform float hw;            // opposition width h
-uniform float albedo;        // Lunar-Lambert
 
-out vec4 frag_color;         // (radiance, depth, lit, 1)
-
-const float PI = 3.14159265358979;
-
-float chandrasekhar_h(float x, float w_)
-{
-    float gamma = sqrt(1.0 - w_);
-    float r0 = (1.0 - gamma) / (1.0 + gamma);
-    float log_term = x > 0.0 ? log((1.0 + x) / x) : 0.0;
-    return 1.0 / (1.0 - w_ * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log_term));
-}
-
-float hg(float b_, float cos_g)
-{
-    return (1.0 - b_ * b_) / pow(1.0 + 2.0 * b_ * cos_g + b_ * b_, 1.5);
-}
+out vec4 frag_color;         // (radiance, depth, -, -): only R and G are stored
 
 void main()
 {
-    float distance = length(frag_offset);
-    vec3 to_camera = -frag_offset / distance;
-    vec3 n = normalize(frag_normal);
-    float mu0 = dot(n, sun_dir);
-    float mu = dot(n, to_camera);
-    float cos_g = clamp(dot(sun_dir, to_camera), -1.0, 1.0);
-    float rf = 0.0;
-    if (mu0 > 0.0 && mu > 0.0) {
-        if (model == 0) {
-            float g = acos(cos_g);
-            float opposition = b0 / (1.0 + tan(0.5 * g) / hw);
-            float phase = 0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g);
-            float multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0;
-            rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple);
-        } else {
-            float g = degrees(acos(cos_g));
-            float limb = clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
-            rf = albedo * (2.0 * limb * mu0 / (mu0 + mu) + (1.0 - limb) * mu0);
-        }
-    }
-    float lit = clamp(frag_lit, 0.0, 1.0);
-    frag_color = vec4(rf * lit * irradiance / PI, dot(frag_offset, boresight), lit, 1.0);
+    frag_color = vec4(frag_radiance * frag_lit, dot(frag_offset, boresight), 0.0, 1.0);
 }

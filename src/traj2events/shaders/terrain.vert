@@ -1,24 +1,68 @@
 #version 330 core
-// traj2events terrain: world position, normal and lit fraction to the fragment shader.
+// traj2events terrain, vertex stage: the reflectance law per vertex (cells are a few
+// pixels, so interpolating radiance across a triangle changes it by < 1e-3 and saves
+// evaluating Hapke for every pixel), and positions relative to the camera.
+// The laws mirror reflectance.py (the numpy reference the tests compare with).
 layout(location = 0) in vec3 position;
 layout(location = NORMAL_LOC) in vec3 normal;
 layout(location = TEXCOORD_0_LOC) in vec2 texcoord_0;   // x: lit fraction (0..1) from the horizon march
-layout(location = INST_M_LOC) in mat4 inst_m;
 
-uniform mat4 M;
-uniform mat4 V;
+uniform mat4 V;            // the view rotation only (camera at the origin)
 uniform mat4 P;
+uniform vec3 tile_offset;  // the tile's origin minus the camera position (m)
 
 out vec3 frag_offset;   // world position minus camera position (m), kept small for precision
-out vec3 frag_normal;
+out float frag_radiance;
 out float frag_lit;
-uniform vec3 cam_offset_from_origin;  // M's translation minus the camera position (m)
+
+uniform vec3 sun_dir;        // unit, toward the Sun (world)
+uniform float irradiance;    // W/m^2 at the Moon
+uniform int model;           // 0 Hapke, 1 Lunar-Lambert
+uniform float w;             // Hapke single-scattering albedo
+uniform float b;
+uniform float c;
+uniform float b0;
+uniform float hw;            // opposition width h
+uniform float albedo;        // Lunar-Lambert
+
+const float PI = 3.14159265358979;
+
+float chandrasekhar_h(float x, float w_)
+{
+    float gamma = sqrt(1.0 - w_);
+    float r0 = (1.0 - gamma) / (1.0 + gamma);
+    float log_term = x > 0.0 ? log((1.0 + x) / x) : 0.0;
+    return 1.0 / (1.0 - w_ * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log_term));
+}
+
+float hg(float b_, float cos_g)
+{
+    return (1.0 - b_ * b_) / pow(1.0 + 2.0 * b_ * cos_g + b_ * b_, 1.5);
+}
 
 void main()
 {
-    vec4 local = inst_m * vec4(position, 1.0);
-    frag_offset = mat3(M) * local.xyz + cam_offset_from_origin;
-    frag_normal = normalize(mat3(M) * mat3(inst_m) * normal);
-    frag_lit = texcoord_0.x;
-    gl_Position = P * V * M * local;
+    frag_offset = position + tile_offset;   // tiles are only translated
+    vec3 n = normalize(normal);
+    vec3 to_camera = -normalize(frag_offset);
+    float mu0 = dot(n, sun_dir);
+    float mu = dot(n, to_camera);
+    float cos_g = clamp(dot(sun_dir, to_camera), -1.0, 1.0);
+    float rf = 0.0;
+    if (mu0 > 0.0 && mu > 0.0) {
+        if (model == 0) {
+            float g = acos(cos_g);
+            float opposition = b0 / (1.0 + tan(0.5 * g) / hw);
+            float phase = 0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g);
+            float multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0;
+            rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple);
+        } else {
+            float g = degrees(acos(cos_g));
+            float limb = clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
+            rf = albedo * (2.0 * limb * mu0 / (mu0 + mu) + (1.0 - limb) * mu0);
+        }
+    }
+    frag_radiance = rf * irradiance / PI;
+    frag_lit = clamp(texcoord_0.x, 0.0, 1.0);
+    gl_Position = P * V * vec4(frag_offset, 1.0);
 }
