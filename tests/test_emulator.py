@@ -143,6 +143,45 @@ def test_refractory_period_is_respected():
             assert len(ts) > 5 and np.diff(ts).min() >= 50_000
 
 
+def test_deferred_refractory_moves_events_to_the_end_of_the_period():
+    # Events every 25 ms without T_ref; T_ref = 40 ms: "drop" loses crossings, "defer"
+    # keeps them pending and fires them at the first frame time after the period.
+    t = np.arange(101) / FPS
+    frames = video(np.log(50.0) + 10.0 * t, 1, 1)
+    dropped = run(frames, replace(CLEAN, refractory_s=0.04))
+    deferred = run(frames, replace(CLEAN, refractory_s=0.04, refractory_mode="defer"))
+    gaps = np.diff(deferred["t"])
+    assert gaps.min() >= 40_000
+    # The crossing at 50 ms is suppressed (25 ms after the first) and fires at the first
+    # frame time after the period ends (65 ms): 70 ms.
+    assert deferred["t"][1] == 70_000 and dropped["t"][1] == 75_000
+    assert len(deferred) > len(dropped)
+    # Nothing is lost: hold the final value for a second and the pending crossings fire,
+    # one per T_ref, until every level of the ramp (10 / 0.25 = 40) has its event.
+    held = np.concatenate([frames, np.repeat(frames[-1:], 100, axis=0)])
+    caught_up = run(held, replace(CLEAN, refractory_s=0.04, refractory_mode="defer"), times=np.arange(201) / FPS)
+    assert len(caught_up) == 40
+    assert np.all(np.diff(deferred["t"]) >= 0)
+    with pytest.raises(ValueError, match="refractory_mode"):
+        replace(CLEAN, refractory_mode="wait")
+
+
+def test_linear_radiance_input_keeps_the_model_in_dn():
+    # 255 L / white: a radiance ramp in log space gives the same events as the same
+    # ramp in DN, and values above white (HDR) are fine.
+    from traj2events.emulator import radiance_to_dn
+
+    t = np.arange(51) / FPS
+    radiance = 40.0 * np.exp(2.0 * t) * 1.5  # up to 1.5 x 40 x e (beyond white = 40)
+    frames = video(np.log(radiance), 1, 2)
+    dn = radiance_to_dn(frames, 40.0)
+    assert dn.max() > 255
+    ev = run(dn, PRESETS["paper"], seed=3)
+    assert len(ev) > 0 and np.all(np.isfinite(ev["t"].astype(float)))
+    clean = run(dn, CLEAN)
+    assert len(clean) == 2 * int(np.floor(2.0 * 0.5 / 0.25 + 1e-9))
+
+
 def test_hot_pixels_fire_at_their_rate():
     params = replace(CLEAN, hot_pixel_fraction=0.01, hot_pixel_hz=50.0)
     frames = np.full((201, 100, 100), 80.0)

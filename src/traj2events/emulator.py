@@ -9,7 +9,9 @@ Per pixel, per frame interval [t_k, t_k+1]:
      theta_on or base - theta_off; each event timestamped where its own pixel crosses
      (ESIM), base moved by one threshold per event;
   5. refractory period: a crossing closer than T_ref to the pixel's last event is dropped
-     (base still moves: ESIM's choice);
+     and base still moves (ESIM's choice, `refractory_mode="drop"`), or it stays pending:
+     base does not move, so it fires at the first frame time after the period if the
+     signal is still beyond the level then (v2e's choice, "defer");
   6. leak: base drifts down by theta_on per leak period (per-pixel rate
      R_leak 10^(0.1 N(0,1))), from a random initial phase;
   7. shot noise: Poisson ON/OFF events at R_shot g(I) theta_nominal / theta(x), drawn by
@@ -45,9 +47,14 @@ class EmulatorParams:
     shot_noise_hz: float = 5.0
     hot_pixel_fraction: float = 0.0
     hot_pixel_hz: float = 0.0
+    refractory_mode: str = "drop"  # "drop" (ESIM) or "defer" (v2e): see _refractory
 
     def __post_init__(self) -> None:
+        if self.refractory_mode not in ("drop", "defer"):
+            raise ValueError(f"emulator.refractory_mode: expected 'drop' or 'defer', got {self.refractory_mode!r}")
         for key, value in asdict(self).items():
+            if key == "refractory_mode":
+                continue
             if not value >= 0:
                 raise ValueError(f"emulator.{key}: expected >= 0, got {value}")
         if self.theta_on < 0.01 or self.theta_off < 0.01:
@@ -76,6 +83,14 @@ def lowpass_gain(intensity_dn: np.ndarray, cutoff_hz: float, dt_s: float) -> np.
         return np.ones_like(intensity_dn, dtype=np.float64)
     f_c = cutoff_hz * (np.asarray(intensity_dn, dtype=np.float64) + 20.0) / 275.0
     return -np.expm1(-2.0 * np.pi * f_c * dt_s)
+
+
+def radiance_to_dn(radiance: np.ndarray, white: float) -> np.ndarray:
+    """Linear radiance -> linear 8-bit-equivalent DN, 255 L / white, neither clipped nor
+    quantised: the HDR input path. The model's DN-based constants (the 20 DN lin-log knee,
+    the bandwidth and noise laws) then keep their meaning, with `white` the radiance at
+    full scale (the renderer's display white)."""
+    return np.asarray(radiance, dtype=np.float64) * (255.0 / white)
 
 
 def _rng(seed: int, *key: int) -> np.random.Generator:
@@ -113,7 +128,8 @@ class EventEmulator:
         self._interval = 0  # index of the next frame interval (keys the random draws)
 
     def process(self, frames_dn: np.ndarray, times_s: np.ndarray) -> np.ndarray:
-        """Feed frames (K, H, W) 8-bit DN with their times (K,) in s; events up to the last one."""
+        """Feed frames (K, H, W) in DN (8-bit values, or float DN-equivalents from
+        `radiance_to_dn`) with their times (K,) in s; events up to the last one."""
         frames = np.asarray(frames_dn)
         times = np.asarray(times_s, dtype=np.float64)
         if frames.ndim != 3 or frames.shape[1:] != (self.height, self.width) or len(times) != len(frames):
@@ -162,8 +178,6 @@ class EventEmulator:
         count = np.where(x1 >= self.theta_on, on, np.where(-x1 >= self.theta_off, off, 0))
         polarity = x1 > 0
         step = np.where(polarity, self.theta_on, -self.theta_off)
-        # Base moves by every crossing, emitted or dropped by the refractory period.
-        self._base = self._base + count * step
         pixels = np.flatnonzero(count)
         if not len(pixels):
             return np.empty(0, EVENT_DTYPE)
@@ -173,17 +187,23 @@ class EventEmulator:
         slope = (x1 - x0)[pix]
         level = j * step[pix]
         # Where the line crosses each level; a level already passed at t0 (base moved by a
-        # noise event) fires at t0.
+        # noise event, or a deferred crossing) fires at t0.
         with np.errstate(divide="ignore", invalid="ignore"):
             frac = np.where(slope != 0, (level - x0[pix]) / slope, 0.0)
         t = t0 + dt * np.clip(frac, 0.0, 1.0)
         keep = self._refractory(pix, t)
+        if self.params.refractory_mode == "defer":
+            # Only emitted crossings move base; suppressed ones stay pending.
+            self._base = self._base + np.bincount(pix[keep], minlength=len(x1)) * step
+        else:
+            # Base moves by every crossing, emitted or dropped.
+            self._base = self._base + count * step
         pix, t = pix[keep], t[keep]
         return _events(pix % self.width, pix // self.width, t, polarity[pix])
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
-        pixel's previous emitted event is dropped. `pix` grouped, `t` increasing per pixel."""
+        pixel's previous emitted event is suppressed. `pix` grouped, `t` increasing per pixel."""
         keep = np.ones(len(t), bool)
         if self.params.refractory_s > 0:  # without one, the last event times are never needed
             last = self._last_event
@@ -205,7 +225,7 @@ class EventEmulator:
         t = t0 + dt * rng.uniform(size=n)
         order = np.lexsort((t, pix))  # grouped by pixel, increasing time
         pix, t = pix[order], t[order]
-        g = 1.0 - 0.75 * (intensity[pix] + 20.0) / 275.0
+        g = np.maximum(1.0 - 0.75 * (intensity[pix] + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
         rate = p.shot_noise_hz * g * p.theta_on / self._noise_theta[pix]
         keep = rng.uniform(size=n) * rate_max < rate  # thinning
         pix, t = pix[keep], t[keep]
