@@ -4,7 +4,8 @@
 #   snakemake --cores 2 --configfile config/paper.yaml
 #
 # Stages so far: base solve per scenario -> continuation sampling -> camera poses ->
-# rendering (frames, videos) -> motion-field ground truth (sphere and rendered terrain).
+# rendering (frames, videos) -> motion-field ground truth (sphere and rendered terrain)
+# -> events (and their exports).
 from snakemake.utils import min_version
 
 min_version("9.0")
@@ -17,6 +18,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/trajectories.smk"
 include: "workflow/rules/render.smk"
 include: "workflow/rules/motion_field.smk"
+include: "workflow/rules/events.smk"
 
 
 rule all:

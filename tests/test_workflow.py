@@ -73,7 +73,8 @@ def test_smoke_dataset_is_complete(built):
         assert f["flow_terrain"].shape == (n, 32, 32, 2) and f["displacement_terrain"].shape == (n, 32, 32, 2)
         assert np.isfinite(f["sphere_minus_terrain_rms_px_s"][0])
     assert (results / "descent" / "0001" / "motion_field.png").stat().st_size > 10_000
-    for name in ("video.mkv", "preview.mp4", "frames.png"):
+    for name in ("video.mkv", "preview.mp4", "frames.png", "events.h5", "events.png", "events.npz", "events.raw",
+                 "events.aedat4"):
         assert (results / "descent" / "0001" / name).stat().st_size > 1000, name
     assert not (results / "descent" / "0001" / "frames.h5").exists()  # temporary by default
     from traj2events.video import read_video
@@ -81,6 +82,11 @@ def test_smoke_dataset_is_complete(built):
     with h5py.File(results / "descent" / "0001" / "trajectory.h5") as f:
         n_poses = len(f["poses/t"])
     assert read_video(results / "descent" / "0001" / "video.mkv").shape == (n_poses, 32, 32)
+    from traj2events.io import read_events
+
+    events, attrs = read_events(results / "descent" / "0001" / "events.h5")
+    assert len(events) > 1000 and attrs["preset"] == "paper" and attrs["input_kind"].startswith("linear radiance")
+    assert events["t"].max() <= round((n_poses - 1) / 10.0 * 1e6)
     index = pd.read_csv(results / "descent" / "index.csv")
     assert list(index["id"]) == [0, 1] and (index["n_poses"] > 10).all()
     assert (results / "figures" / "trajectories.png").stat().st_size > 10_000
@@ -109,7 +115,8 @@ def test_same_config_same_bytes(built, tmp_path):
                     va, vb = np.asarray(a.attrs[k]), np.asarray(b.attrs[k])
                     assert va.tobytes() == vb.tobytes(), k  # bitwise, NaN included
     for rel in ("results/figures/trajectories.png", "results/descent/0001/video.mkv", "results/descent/0001/preview.mp4",
-                "results/descent/0001/frames.png", "results/descent/0001/motion_field.h5"):
+                "results/descent/0001/frames.png", "results/descent/0001/motion_field.h5",
+                "results/descent/0001/events.h5", "results/descent/0001/events.raw"):
         assert (built / rel).read_bytes() == (tmp_path / rel).read_bytes(), rel
 
 
@@ -135,8 +142,9 @@ def test_code_change_reruns_the_rules_that_use_it(built, tmp_path):
     figures = tmp_path / "src" / "traj2events" / "figures.py"
     figures.write_text(figures.read_text() + "\n# a change\n")
     jobs = jobs_in_dry_run(workdir, env)
-    # All three draw with figures.py (motion_field also needs the temporary frames again).
+    # All draw with figures.py (motion_field and events also need the temporary frames again).
     assert jobs["trajectory_summary"] == 1 and jobs["motion_field"] == 3 and jobs["render"] == 3
+    assert jobs["events"] == 3
     assert not {"base_solution", "sample_trajectories", "camera_poses"} & set(jobs)
     upsample = tmp_path / "src" / "traj2events" / "upsample.py"
     upsample.write_text(upsample.read_text() + "\n# a change\n")

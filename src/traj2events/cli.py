@@ -320,6 +320,132 @@ def cmd_render(args) -> int:
     return 0
 
 
+def _frame_source(args):
+    """(width, height, kind, times (s) or None, iterator of (frames in DN, times in s)) for the
+    events command's INPUT: frames.h5 (linear radiance: the HDR path), a video, or a folder
+    of images. Memory stays bounded by one chunk of frames."""
+    import h5py
+
+    from .emulator import radiance_to_dn
+    from .video import iter_video, video_info
+
+    path = Path(args.input)
+    chunk = args.chunk
+    if not path.exists():
+        raise FileNotFoundError(f"events INPUT: {path} does not exist")
+    if path.is_dir():
+        from PIL import Image
+
+        files = sorted(p for p in path.iterdir() if p.suffix.lower() in (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp"))
+        if not files:
+            raise ValueError(f"events INPUT: {path} holds no .png/.jpg/.tif/.bmp images")
+        if not args.fps:
+            raise ValueError("events: --fps is required for a folder of images")
+        width, height = Image.open(files[0]).size
+        times = np.arange(len(files)) / args.fps
+
+        def images():
+            for start in range(0, len(files), chunk):
+                batch = [np.asarray(Image.open(f).convert("L")) for f in files[start:start + chunk]]
+                if any(b.shape != (height, width) for b in batch):
+                    raise ValueError(f"events INPUT: images in {path} differ in size (expected {width} x {height})")
+                yield np.stack(batch), times[start:start + chunk]
+
+        return width, height, "images (8-bit)", times, images()
+    if path.suffix.lower() in (".h5", ".hdf5"):
+        f = h5py.File(path, "r")
+        if "radiance" not in f or "t" not in f:
+            raise ValueError(f"events INPUT: {path} is not a frames.h5 (expected datasets 'radiance' and 't')")
+        white = args.white or float(f.attrs.get("display_white_w_m2_sr", 0) or 0)
+        if not white > 0:
+            raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
+        times = f["t"][()]
+        n, height, width = f["radiance"].shape
+
+        def radiance():
+            with f:
+                for start in range(0, n, chunk):
+                    yield radiance_to_dn(f["radiance"][start:start + chunk], white), times[start:start + chunk]
+
+        return width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", times, radiance()
+    width, height, fps, _ = video_info(path)
+    fps = args.fps or fps
+    if not fps > 0:
+        raise ValueError(f"events: {path} gives no frame rate; give --fps")
+
+    def video():
+        k = 0
+        for frames in iter_video(path, chunk):
+            yield frames, (k + np.arange(len(frames))) / fps
+            k += len(frames)
+
+    return width, height, f"video (8-bit, {fps:g} fps)", None, video()
+
+
+def cmd_events(args) -> int:
+    from dataclasses import asdict, replace
+
+    from .emulator import PRESETS, EventEmulator
+    from .figures import event_frame, event_mosaic
+    from .io import EventsWriter, atomic_output
+
+    params = PRESETS[args.preset]
+    overrides = {k: v for k, v in (("refractory_s", args.refractory_s), ("refractory_mode", args.refractory_mode),
+                                   ("hot_pixel_fraction", args.hot_pixel_fraction), ("hot_pixel_hz", args.hot_pixel_hz))
+                 if v is not None}
+    params = replace(params, **overrides)
+    width, height, kind, _, source = _frame_source(args)
+    emulator = EventEmulator(width, height, params, seed=args.seed)
+    attrs = {"preset": args.preset, "seed": args.seed, "input": str(args.input), "input_kind": kind,
+             **{f"emulator_{k}": v for k, v in asdict(params).items()}, "traj2events_version": __version__}
+    _log(f"{args.input}: {width} x {height} {kind} -> {args.output} (preset {args.preset}, seed {args.seed})")
+    start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
+    writer = EventsWriter(args.output, width, height, attrs)
+    try:
+        for frames, times in source:
+            events = emulator.process(frames, times)
+            writer.append(events)
+            n_frames += len(frames)
+            n_events += len(events)
+            t_last = float(times[-1])
+            if n_frames % (args.chunk * 10) < len(frames):
+                _log(f"  {n_frames} frames, {n_events} events, {n_frames / (time.perf_counter() - start):.0f} frames/s")
+    except BaseException as exc:
+        writer.close(0, (type(exc), exc, exc.__traceback__))
+        raise
+    writer.close(int(round(t_last * 1e6)))
+    elapsed = time.perf_counter() - start
+    _log(f"{n_frames} frames, {n_events} events in {elapsed:.1f} s ({n_frames / elapsed:.0f} frames/s, "
+         f"{n_events / elapsed:.3g} events/s)")
+    if args.frames_png:
+        from .io import read_events_window
+
+        window_us = int(round(args.window_ms * 1000))
+        end_us = int(round(t_last * 1e6))
+        centres = [frac * t_last for frac in (0.0, 0.25, 0.5, 0.75, 1.0)]
+        images, counts = [], []
+        for c in centres:
+            # A 10 ms window centred on each time, shifted inside the recording at its ends.
+            lo = min(max(int(round(c * 1e6)) - window_us // 2, 0), max(end_us - window_us, 0))
+            window = read_events_window(args.output, lo, lo + window_us)
+            images.append(event_frame(window, width, height, lo, lo + window_us))
+            counts.append(len(window))
+        fig = event_mosaic(centres, images, counts, ["t0", "tf/4", "tf/2", "3tf/4", "tf"],
+                           args.title or str(args.output), args.window_ms)
+        with atomic_output(args.frames_png) as tmp:
+            fig.savefig(tmp, format="png", dpi=100, metadata={"Software": None})
+    if args.npz or args.evt3 or args.aedat4:
+        from .io import read_events, write_elope_npz, write_faery
+
+        stream, _ = read_events(args.output)  # the exports take the whole stream: ~13 bytes/event in memory
+        if args.npz:
+            write_elope_npz(args.npz, stream, args.trajectory, str(args.input) if Path(args.input).suffix == ".h5" else None)
+        for path in (args.evt3, args.aedat4):
+            if path:
+                write_faery(path, stream, width, height)
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="traj2events",
@@ -379,6 +505,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--preview", required=True, help="preview.mp4: H.264 of the same, to look at")
     p.add_argument("--mosaic", help="PNG: the frames at t0, tf/4, tf/2, 3tf/4, tf")
     p.set_defaults(func=cmd_render)
+
+    p = sub.add_parser("events", help="emulate an event camera on a video, a folder of images or frames.h5",
+                       description="Turn frames into the event stream of an event camera (the pixel model of "
+                       "docs/events.md). INPUT: frames.h5 from `traj2events render` (linear radiance, the HDR "
+                       "path), any video ffmpeg reads (8-bit grey, as v2e), or a folder of images (8-bit grey, "
+                       "sorted by name; needs --fps). Writes events.h5 in the DSEC layout.")
+    p.add_argument("input", help="frames.h5, a video file, or a folder of images")
+    p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc/zstd)")
+    p.add_argument("--preset", choices=("paper", "clean"), default="paper",
+                   help="paper: the paper's Table 2 (thresholds 0.25, sigma 0.03, 5 Hz shot noise, 0.1 Hz leak, "
+                   "3 Hz low-pass); clean: no noise, no low-pass, no mismatch (default paper)")
+    p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
+    p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
+    p.add_argument("--white", type=float, help="radiance at full scale for frames.h5 (default: its display white)")
+    p.add_argument("--refractory-s", type=float, help="refractory period, s (default: the preset's, 0)")
+    p.add_argument("--refractory-mode", choices=("drop", "defer"), help="suppressed crossings: dropped (ESIM) or pending (v2e)")
+    p.add_argument("--hot-pixel-fraction", type=float, help="fraction of hot pixels (default 0)")
+    p.add_argument("--hot-pixel-hz", type=float, help="rate of the hot pixels, Hz")
+    p.add_argument("--chunk", type=int, default=64, help="frames held in memory at once (default 64)")
+    p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
+    p.add_argument("--window-ms", type=float, default=10.0, help="event-frame window, ms (default 10)")
+    p.add_argument("--title", help="title of the event-frame figure")
+    p.add_argument("--npz", help="also write an ELOPE-style .npz (events, and with --trajectory: timestamps, traj, range_meter)")
+    p.add_argument("--trajectory", help="trajectory.h5, for the .npz's timestamps, traj and range_meter")
+    p.add_argument("--evt3", help="also write Prophesee EVT 3.0 .raw (via faery)")
+    p.add_argument("--aedat4", help="also write AEDAT4 (via faery)")
+    p.set_defaults(func=cmd_events)
 
     p = sub.add_parser("index", help="one CSV row per trajectory file of a scenario (the dataset index)")
     p.add_argument("trajectories", nargs="*", help="trajectory.h5 files")

@@ -149,3 +149,31 @@ def frame_mosaic(times: list[float], frames: list[np.ndarray], labels: list[str]
     fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+ON_COLOUR = np.array([0, 64, 255], np.uint8)  # blue, as in the paper
+OFF_COLOUR = np.array([230, 0, 0], np.uint8)  # red
+
+
+def event_frame(events: np.ndarray, width: int, height: int, t_start_us: int, t_end_us: int) -> np.ndarray:
+    """Events in [t_start, t_end) accumulated into an RGB image on white: a pixel is blue
+    if its last event there was ON, red if OFF."""
+    image = np.full((height, width, 3), 255, np.uint8)
+    window = events[(events["t"] >= t_start_us) & (events["t"] < t_end_us)]
+    # Sorted by t, so later events overwrite earlier ones at the same pixel.
+    image[window["y"], window["x"]] = np.where(window["p"][:, None] == 1, ON_COLOUR, OFF_COLOUR)
+    return image
+
+
+def event_mosaic(times_s: list[float], frames: list[np.ndarray], counts: list[int], labels: list[str], title: str,
+                 window_ms: float) -> plt.Figure:
+    """The paper's event-frame mosaic: one accumulated window per time, side by side."""
+    fig, axes = plt.subplots(1, len(frames), figsize=(3.0 * len(frames), 3.5), squeeze=False)
+    for ax, t, frame, count, label in zip(axes[0], times_s, frames, counts, labels):
+        ax.imshow(frame, interpolation="nearest")
+        ax.set_title(f"{label}: t = {t:.2f} s\n{count} events in {window_ms:g} ms", fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.suptitle(title + " (ON blue, OFF red)")
+    fig.tight_layout()
+    return fig

@@ -253,3 +253,142 @@ class FramesWriter:
     def __exit__(self, *exc):
         self._file.close()
         return self._context.__exit__(*exc)
+
+
+class EventsWriter:
+    """events.h5 in the DSEC layout, appended chunk by chunk (events sorted by t):
+    `events/x`, `events/y` (uint16), `events/t` (int64, us, relative to `t_offset`),
+    `events/p` (uint8, 1 = ON), `ms_to_idx` (uint64: index of the first event at or after
+    each millisecond), `t_offset` (int64, us). Event arrays are compressed with Blosc/zstd
+    through hdf5plugin (what DSEC uses); attributes hold the emulator's parameters."""
+
+    def __init__(self, path: str | os.PathLike, width: int, height: int, attrs: dict, t_offset_us: int = 0,
+                 chunk: int = 1 << 18):
+        import hdf5plugin
+
+        self._context = atomic_output(path)
+        tmp = self._context.__enter__()
+        self._file = _h5_file(tmp)
+        group = self._file.create_group("events")
+        compression = hdf5plugin.Blosc(cname="zstd", clevel=5, shuffle=hdf5plugin.Blosc.SHUFFLE)
+        self._sets = {name: group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,),
+                                                 track_times=False, **compression)
+                      for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1"))}
+        self._file.create_dataset("t_offset", data=np.int64(t_offset_us), track_times=False)
+        _set_attrs(self._file, {"width": width, "height": height, **attrs})
+        self.t_offset_us = t_offset_us
+        self.n = 0
+        self._ms_to_idx: list[np.ndarray] = []
+        self._next_ms = 0
+        self._last_t = np.iinfo(np.int64).min
+
+    def append(self, events: np.ndarray) -> None:
+        if not len(events):
+            return
+        t = events["t"].astype(np.int64) - self.t_offset_us
+        if t[0] < self._last_t or np.any(np.diff(t) < 0):
+            raise ValueError("events.h5: events must arrive sorted by t")
+        # ms_to_idx[m] = first index with t >= 1000 m, for every m up to this chunk's last event.
+        last_ms = int(t[-1] // 1000)
+        if last_ms >= self._next_ms:
+            ms = np.arange(self._next_ms, last_ms + 1, dtype=np.int64)
+            self._ms_to_idx.append(self.n + np.searchsorted(t, ms * 1000, side="left"))
+            self._next_ms = last_ms + 1
+        for name, values in (("x", events["x"]), ("y", events["y"]), ("t", t), ("p", events["p"])):
+            ds = self._sets[name]
+            ds.resize((self.n + len(t),))
+            ds[self.n:] = values
+        self.n += len(t)
+        self._last_t = int(t[-1])
+
+    def close(self, duration_us: int, exc=(None, None, None)) -> None:
+        if exc[0] is None:
+            # Milliseconds after the last event, up to the end of the recording, index past the end.
+            end_ms = int(max(duration_us - self.t_offset_us, 0) // 1000)
+            if end_ms >= self._next_ms:
+                self._ms_to_idx.append(np.full(end_ms - self._next_ms + 1, self.n, dtype=np.int64))
+            ms_to_idx = np.concatenate(self._ms_to_idx) if self._ms_to_idx else np.zeros(1, np.int64)
+            self._file.create_dataset("ms_to_idx", data=ms_to_idx.astype(np.uint64), track_times=False)
+        self._file.close()
+        self._context.__exit__(*exc)
+
+
+def read_events(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
+    """events.h5 -> (structured array x, y, t (absolute us), p; attributes)."""
+    import hdf5plugin  # noqa: F401  (registers the Blosc filter)
+
+    from .emulator import EVENT_DTYPE
+
+    with h5py.File(path, "r") as f:
+        g = f["events"]
+        out = np.empty(len(g["t"]), EVENT_DTYPE)
+        out["x"], out["y"], out["p"] = g["x"][()], g["y"][()], g["p"][()]
+        out["t"] = g["t"][()] + int(f["t_offset"][()])
+        return out, dict(f.attrs)
+
+
+def read_events_window(path: str | os.PathLike, t_start_us: int, t_end_us: int) -> np.ndarray:
+    """Events with t in [t_start, t_end) (absolute us), read through ms_to_idx: only that slice."""
+    import hdf5plugin  # noqa: F401
+
+    from .emulator import EVENT_DTYPE
+
+    with h5py.File(path, "r") as f:
+        offset = int(f["t_offset"][()])
+        ms_to_idx = f["ms_to_idx"]
+        n_ms = len(ms_to_idx)
+        lo_ms = min(max((t_start_us - offset) // 1000, 0), n_ms - 1)
+        hi_ms = (t_end_us - offset) // 1000 + 1
+        lo = int(ms_to_idx[lo_ms])
+        hi = int(ms_to_idx[hi_ms]) if hi_ms < n_ms else len(f["events/t"])
+        g = f["events"]
+        out = np.empty(hi - lo, EVENT_DTYPE)
+        out["x"], out["y"], out["p"] = g["x"][lo:hi], g["y"][lo:hi], g["p"][lo:hi]
+        out["t"] = g["t"][lo:hi] + offset
+    return out[(out["t"] >= t_start_us) & (out["t"] < t_end_us)]
+
+
+def write_elope_npz(path: str | os.PathLike, events: np.ndarray, trajectory: str | os.PathLike | None = None,
+                    frames: str | os.PathLike | None = None) -> None:
+    """An ELOPE-style .npz: `events` (structured x, y, p, t in us); with a trajectory.h5,
+    `timestamps` (s) and `traj` (N x 12: position (z negative above the site, our z-down
+    frame), velocity, roll/pitch/yaw, body rates); with frames.h5, `range_meter` (N x 2:
+    t, distance along the central pixel's ray from the rendered depth, 0 = sky)."""
+    elope = np.empty(len(events), [("x", "<u2"), ("y", "<u2"), ("p", "u1"), ("t", "<i8")])
+    for name in ("x", "y", "p", "t"):
+        elope[name] = events[name]
+    data = {"events": elope}
+    if trajectory is not None:
+        tr = read_trajectory(trajectory)
+        data["timestamps"] = tr.t
+        data["traj"] = tr.state[:, :12]
+    if frames is not None:
+        with h5py.File(frames, "r") as f:
+            depth = f["depth_m"]
+            n, h, w = depth.shape
+            i, j = h // 2, w // 2
+            focal = float(f.attrs["focal_px"])
+            ray = np.sqrt(1.0 + ((j + 0.5 - w / 2) / focal) ** 2 + ((i + 0.5 - h / 2) / focal) ** 2)
+            data["range_meter"] = np.stack([f["t"][()], depth[:, i, j] * ray], axis=1)
+    with atomic_output(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **data)
+
+
+def write_faery(path: str | os.PathLike, events: np.ndarray, width: int, height: int) -> None:
+    """EVT 3.0 (.raw) or AEDAT4 (.aedat4), by extension, written by faery; timestamps kept
+    as they are (not shifted to start at 0)."""
+    import faery
+
+    path = Path(path)
+    if path.suffix not in (".raw", ".aedat4"):
+        raise ValueError(f"{path}: expected a .raw (EVT 3.0) or .aedat4 file name")
+    stream = np.empty(len(events), faery.EVENTS_DTYPE)
+    stream["t"], stream["x"], stream["y"], stream["on"] = events["t"], events["x"], events["y"], events["p"] == 1
+    tmp = path.with_name(f".{path.stem}.part{path.suffix}")  # faery picks the format from the suffix
+    try:
+        kwargs = {"version": "evt3"} if path.suffix == ".raw" else {}
+        faery.events_stream_from_array(stream, (width, height)).to_file(str(tmp), zero_t0=False, **kwargs)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

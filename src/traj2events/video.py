@@ -78,3 +78,41 @@ def read_video(path: str | os.PathLike, frames: list[int] | None = None) -> np.n
         out = source.output("pipe:", format="rawvideo", pix_fmt="gray")
     data, _ = out.global_args("-loglevel", "error").run(capture_stdout=True)
     return np.frombuffer(data, np.uint8).reshape(-1, height, width)
+
+
+def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
+    """(width, height, frames per second, frame count if the container says) of a video."""
+    import ffmpeg
+
+    try:
+        probe = ffmpeg.probe(str(path))
+    except ffmpeg.Error as exc:
+        raise ValueError(f"{path}: not a video ffmpeg can read ({exc.stderr.decode(errors='replace').strip()[-200:]})") from None
+    stream = next((s for s in probe["streams"] if s["codec_type"] == "video"), None)
+    if stream is None:
+        raise ValueError(f"{path}: has no video stream")
+    num, den = (int(v) for v in stream.get("avg_frame_rate", "0/1").split("/"))
+    fps = num / den if den else 0.0
+    count = int(stream["nb_frames"]) if str(stream.get("nb_frames", "")).isdigit() else None
+    return int(stream["width"]), int(stream["height"]), fps, count
+
+
+def iter_video(path: str | os.PathLike, chunk: int = 64):
+    """Decode a video to 8-bit grey, yielding (k, H, W) uint8 chunks: memory bounded by
+    `chunk` frames, whatever the video's length."""
+    import ffmpeg
+
+    width, height, _, _ = video_info(path)
+    process = (ffmpeg.input(str(path)).output("pipe:", format="rawvideo", pix_fmt="gray")
+               .global_args("-loglevel", "error").run_async(pipe_stdout=True))
+    size = width * height
+    try:
+        while True:
+            data = process.stdout.read(size * chunk)
+            if not data:
+                break
+            n = len(data) // size
+            yield np.frombuffer(data[: n * size], np.uint8).reshape(n, height, width)
+    finally:
+        process.stdout.close()
+        process.wait()

@@ -61,6 +61,32 @@ def frames_output(path):
     return path if config["render"]["keep_frames"] else temp(path)
 
 
+EXPORT_FILES = {"npz": "events.npz", "evt3": "events.raw", "aedat4": "events.aedat4"}
+
+
+def export_outputs(folder):
+    """The event exports the config asks for, as named outputs."""
+    return {name: f"{folder}/{EXPORT_FILES[name]}" for name in config["events"]["exports"]}
+
+
+def export_flags(wildcards, output):
+    return " ".join(f"--{name} {output[name]}" for name in config["events"]["exports"])
+
+
+def event_options(wildcards):
+    """The emulator settings of the config as command-line options."""
+    e = config["events"]
+    return (f"--preset {e['preset']} --refractory-s {e['refractory_s']} --refractory-mode {e['refractory_mode']} "
+            f"--hot-pixel-fraction {e['hot_pixel_fraction']} --hot-pixel-hz {e['hot_pixel_hz']} "
+            f"--window-ms {e['window_ms']}")
+
+
+def event_seed(wildcards):
+    """One seed per trajectory, from the dataset's seed (same config, same events)."""
+    key = f"{config['seed']}/{wildcards.scenario}/{wildcards.id}".encode()
+    return int(hashlib.sha256(key).hexdigest()[:8], 16)
+
+
 def solved_ids(scenario):
     """Ids of the solved samples of a scenario (known once its checkpoint has run)."""
     table = checkpoints.sample_trajectories.get(scenario=scenario).output.table
@@ -68,7 +94,8 @@ def solved_ids(scenario):
     return [f"{i:04d}" for i in samples.loc[samples["success"], "id"]]
 
 
-PER_TRAJECTORY = ["trajectory.h5", "video.mkv", "preview.mp4", "frames.png", "motion_field.h5", "motion_field.png"]
+PER_TRAJECTORY = ["trajectory.h5", "video.mkv", "preview.mp4", "frames.png", "motion_field.h5", "motion_field.png",
+                  "events.h5", "events.png", *(EXPORT_FILES[name] for name in config["events"]["exports"])]
 
 
 def scenario_outputs(wildcards):
