@@ -4,7 +4,8 @@
 
 Input: an 8-bit texture (smoothed noise) translating at 2 px per frame at 100 fps, so
 edges everywhere produce events. Prints frames/s and events/s at 346 x 260 (DAVIS346) and
-1024 x 1024, and the peak resident memory. Goal (issue 5): >= 120 frames/s at
+1024 x 1024, the bytes per event of events.h5 (DSEC layout, Blosc/zstd) and the peak
+resident memory. Goal (issue 5): >= 120 frames/s at
 1024 x 1024 and >= 1e7 events/s (v2e's own loop: ~6 frames/s at 1024 x 1024).
 """
 from __future__ import annotations
@@ -24,6 +25,7 @@ import numpy as np  # noqa: E402
 from scipy.ndimage import gaussian_filter  # noqa: E402
 
 from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.io import EventsWriter  # noqa: E402
 
 
 def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.ndarray:
@@ -38,20 +40,29 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=100)
     args = parser.parse_args()
     print(f"# emulator, paper preset, 1 thread, on {platform.node()} ({os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}")
-    print("| size | frames | frames/s | events | events/s | events per pixel per frame |")
-    print("|---|---|---|---|---|---|")
+    print("| size | frames | frames/s | events | events/s | events per pixel per frame | bytes/event on disk |")
+    print("|---|---|---|---|---|---|---|")
+    out = Path(__file__).resolve().parent / "out"
+    out.mkdir(exist_ok=True)
     for height, width in ((260, 346), (1024, 1024)):
         frames = moving_texture(height, width, args.frames)
         times = np.arange(args.frames) / 100.0
         emu = EventEmulator(width, height, PRESETS["paper"], seed=1)
         start = time.perf_counter()
         n_events = 0
+        chunks = []
         for k in range(0, args.frames, 10):  # streamed in chunks of 10 frames
-            n_events += len(emu.process(frames[k:k + 10], times[k:k + 10]))
+            chunks.append(emu.process(frames[k:k + 10], times[k:k + 10]))
+            n_events += len(chunks[-1])
         elapsed = time.perf_counter() - start
+        writer = EventsWriter(out / "events.h5", width, height, {})
+        for c in chunks:
+            writer.append(c)
+        writer.close(int(times[-1] * 1e6))
+        per_event = (out / "events.h5").stat().st_size / max(n_events, 1)
         fps = (args.frames - 1) / elapsed
         print(f"| {width} x {height} | {args.frames} | {fps:.1f} | {n_events} | {n_events / elapsed:.3g} | "
-              f"{n_events / (args.frames - 1) / (width * height):.3f} |", flush=True)
+              f"{n_events / (args.frames - 1) / (width * height):.3f} | {per_event:.2f} |", flush=True)
     print(f"peak resident memory: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB "
           "(including the input video held in memory)")
 

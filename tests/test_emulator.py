@@ -212,3 +212,19 @@ def test_bad_input_is_named():
         emu.process(np.zeros((2, 4, 4)), [0.0, 0.0])
     with pytest.raises(ValueError, match="sigma"):
         EmulatorParams(sigma=-1)
+
+
+def test_stress_black_saturated_and_extreme_time_steps():
+    # Zero and saturated input: no signal events, finite noise for the paper preset.
+    for level in (0.0, 255.0):
+        frames = np.full((20, 4, 4), level)
+        assert len(run(frames, CLEAN)) == 0
+        ev = run(frames, PRESETS["paper"], seed=2)
+        assert np.all(np.diff(ev["t"]) >= 0)
+    # A 10 s gap and a 1 us gap: the ramp's events land inside their intervals, in order.
+    times = np.array([0.0, 10.0, 10.000001, 10.01])
+    frames = video(np.log(50.0) + np.array([0.0, 1.0, 1.0, 1.5]), 1, 1)
+    ev = run(frames, CLEAN, times=times)
+    assert len(ev) == 6  # 1.0 / 0.25 in the long interval, 0.5 / 0.25 in the last
+    assert np.all(ev["t"][:4] <= 10_000_000) and np.all(ev["t"][4:] > 10_000_001)
+    np.testing.assert_array_equal(ev["t"][:4], [2_500_000, 5_000_000, 7_500_000, 10_000_000])
