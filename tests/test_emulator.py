@@ -228,3 +228,11 @@ def test_stress_black_saturated_and_extreme_time_steps():
     assert len(ev) == 6  # 1.0 / 0.25 in the long interval, 0.5 / 0.25 in the last
     assert np.all(ev["t"][:4] <= 10_000_000) and np.all(ev["t"][4:] > 10_000_001)
     np.testing.assert_array_equal(ev["t"][:4], [2_500_000, 5_000_000, 7_500_000, 10_000_000])
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -1.0])
+def test_non_finite_or_negative_intensity_is_refused(bad):
+    frames = np.full((3, 2, 2), 50.0)
+    frames[2, 1, 0] = bad
+    with pytest.raises(ValueError, match="frame 2 of this chunk"):
+        run(frames, PRESETS["paper"])

@@ -78,6 +78,9 @@ def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
     depth_cast = distance * (dirs @ pose.rotation[:, 2])
     depth_render = frame.depth_m[rows.ravel(), cols.ravel()]
     assert np.all(np.isfinite(depth_cast)) and depth_cast.min() > 4000
+    # Radiance stays within what the law allows (the shader clamps sliver-triangle extrapolation).
+    from traj2events.reflectance import ReflectanceParams as Params, max_radiance_factor
+    assert 0 <= frame.radiance.min() and frame.radiance.max() <= max_radiance_factor(Params()) * SUN.irradiance_w_m2 / np.pi
     np.testing.assert_allclose(depth_render, depth_cast, rtol=1e-3)
 
 

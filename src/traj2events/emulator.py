@@ -31,6 +31,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from numba import njit
 
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])
 KNEE_DN = 20.0  # lin-log knee of the 8-bit mapping
@@ -103,6 +104,78 @@ def _events(x, y, t_s, p) -> np.ndarray:
     return out
 
 
+# --- compiled per-pixel kernels (numba): one pass over the frame, then one over the events --
+
+@njit(cache=True, nogil=True)
+def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_rate, cutoff_hz, dt,
+             count, x0, x1, active):
+    """Low-pass and log per pixel, the leak's drift of base, and the number of threshold
+    crossings (count > 0: ON, < 0: OFF). Updates filtered and base in place; lists the
+    pixels with crossings in `active`; returns how many."""
+    knee_slope = np.log(KNEE_DN) / KNEE_DN
+    two_pi_dt = 2.0 * np.pi * dt
+    n_active = 0
+    for i in range(intensity1.size):
+        i1 = intensity1[i]
+        target = i1 * knee_slope if i1 <= KNEE_DN else np.log(i1)
+        if cutoff_hz > 0.0:
+            f_c = cutoff_hz * (0.5 * (intensity0[i] + i1) + 20.0) / 275.0
+            gain = -np.expm1(-two_pi_dt * f_c)
+        else:
+            gain = 1.0
+        f0 = filtered[i]
+        f1 = f0 + gain * (target - f0)
+        a = f0 - base[i]
+        b = base[i] - theta_on[i] * leak_rate[i] * dt
+        x = f1 - b
+        filtered[i] = f1
+        base[i] = b
+        x0[i] = a
+        x1[i] = x
+        if x >= theta_on[i]:
+            count[i] = np.int64(np.floor(x / theta_on[i]))
+        elif -x >= theta_off[i]:
+            count[i] = -np.int64(np.floor(-x / theta_off[i]))
+        else:
+            count[i] = 0
+            continue
+        active[n_active] = i
+        n_active += 1
+    return n_active
+
+
+@njit(cache=True, nogil=True)
+def _emit(active, n_active, count, x0, x1, theta_on, theta_off, base, last_event, t0, dt, refractory_s, defer,
+          out_pix, out_t, out_p):
+    """Events of the active pixels: the j-th crossing of a pixel at the time its own line
+    x0 -> x1 reaches j thresholds (clipped to the interval: a level already passed fires at
+    t0), the refractory period applied in time order per pixel, base moved by every
+    crossing ("drop") or only by the emitted ones ("defer"). Returns the number emitted."""
+    k = 0
+    for a in range(n_active):
+        i = active[a]
+        n = count[i]
+        on = n > 0
+        step = theta_on[i] if on else -theta_off[i]
+        n = abs(n)
+        slope = x1[i] - x0[i]
+        emitted = 0
+        for j in range(1, n + 1):
+            frac = (j * step - x0[i]) / slope if slope != 0.0 else 0.0
+            t = t0 + dt * min(max(frac, 0.0), 1.0)
+            if refractory_s > 0.0:
+                if t - last_event[i] < refractory_s:
+                    continue
+                last_event[i] = t
+            out_pix[k] = i
+            out_t[k] = t
+            out_p[k] = on
+            k += 1
+            emitted += 1
+        base[i] += (emitted if defer else n) * step
+    return k
+
+
 class EventEmulator:
     """Streaming emulator for frames of a fixed size; see the module docstring."""
 
@@ -124,6 +197,11 @@ class EventEmulator:
         self._intensity: np.ndarray | None = None  # input (DN) at the last frame
         self._base: np.ndarray | None = None
         self._last_event = np.full(n, -np.inf)  # s
+        # Work arrays of the compiled kernels, reused every frame.
+        self._count = np.zeros(n, np.int64)
+        self._x0 = np.zeros(n)
+        self._x1 = np.zeros(n)
+        self._active = np.zeros(n, np.int64)
         self._t: float | None = None
         self._interval = 0  # index of the next frame interval (keys the random draws)
 
@@ -136,6 +214,10 @@ class EventEmulator:
             raise ValueError(f"frames: expected (K, {self.height}, {self.width}) with K timestamps, "
                              f"got {frames.shape} and {times.shape}")
         chunks = []
+        if frames.dtype.kind == "f" and not (np.all(np.isfinite(frames)) and frames.min(initial=0.0) >= 0):
+            bad = int(np.argmax(~np.isfinite(frames).reshape(len(frames), -1).all(axis=1) | (frames.reshape(len(frames), -1).min(axis=1) < 0)))
+            raise ValueError(f"frames: expected finite values >= 0 (intensity), frame {bad} of this chunk "
+                             f"(t = {times[bad]:.6f} s) has NaN, inf or negative values")
         for frame, t in zip(frames, times):
             intensity = frame.reshape(-1).astype(np.float64)
             if self._t is None:
@@ -148,58 +230,30 @@ class EventEmulator:
 
     def _start(self, intensity: np.ndarray, t: float) -> None:
         log_i = log_intensity_8bit(intensity)
-        self._filtered, self._intensity, self._t = log_i, intensity, t
+        self._filtered, self._intensity, self._t = log_i.copy(), intensity, t
         # Random leak phase: base starts a random fraction of theta_on below the signal.
         self._base = log_i - self.leak_phase * self.theta_on * (self.leak_rate > 0)
 
     def _interval_events(self, intensity: np.ndarray, t1: float) -> np.ndarray:
         p = self.params
         t0, dt = self._t, t1 - self._t
-        # Exact first-order low-pass, bandwidth from the interval's mean input.
-        gain = lowpass_gain(0.5 * (self._intensity + intensity), p.cutoff_hz, dt)
-        target = log_intensity_8bit(intensity)
-        filtered1 = self._filtered + gain * (target - self._filtered)
-        # x = signal - base, linear in t within the interval; the leak drifts base down.
-        x0 = self._filtered - self._base
-        self._base = self._base - self.theta_on * self.leak_rate * dt
-        x1 = filtered1 - self._base
-        events = [self._crossings(x0, x1, t0, dt)]
-        self._filtered, self._intensity, self._t = filtered1, intensity, t1
+        # x = signal - base, linear in t within the interval: low-pass (exact, bandwidth from
+        # the interval's mean input), log, the leak's drift of base, crossings.
+        n_active = _advance(self._intensity, intensity, self._filtered, self._base, self.theta_on, self.theta_off,
+                            self.leak_rate, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active)
+        n_events = int(np.abs(self._count[self._active[:n_active]]).sum())
+        pix = np.empty(n_events, np.int64)
+        t = np.empty(n_events, np.float64)
+        on = np.empty(n_events, np.bool_)
+        k = _emit(self._active, n_active, self._count, self._x0, self._x1, self.theta_on, self.theta_off, self._base,
+                  self._last_event, t0, dt, float(p.refractory_s), p.refractory_mode == "defer", pix, t, on)
+        events = [_events(pix[:k] % self.width, pix[:k] // self.width, t[:k], on[:k])]
+        self._intensity, self._t = intensity, t1
         self._interval += 1
         noise = self._shot_noise(intensity, t0, dt)
         events += [noise, self._hot_pixel_events(t0, dt)]
         out = np.concatenate(events)
         return out[np.lexsort((out["p"], out["x"], out["y"], out["t"]))]
-
-    def _crossings(self, x0: np.ndarray, x1: np.ndarray, t0: float, dt: float) -> np.ndarray:
-        """Events of every pixel whose x crosses +theta_on or -theta_off; updates base."""
-        on = np.floor(x1 / self.theta_on).astype(np.int64)
-        off = np.floor(-x1 / self.theta_off).astype(np.int64)
-        count = np.where(x1 >= self.theta_on, on, np.where(-x1 >= self.theta_off, off, 0))
-        polarity = x1 > 0
-        step = np.where(polarity, self.theta_on, -self.theta_off)
-        pixels = np.flatnonzero(count)
-        if not len(pixels):
-            return np.empty(0, EVENT_DTYPE)
-        n = count[pixels]
-        j = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + 1  # 1..n within each pixel
-        pix = np.repeat(pixels, n)
-        slope = (x1 - x0)[pix]
-        level = j * step[pix]
-        # Where the line crosses each level; a level already passed at t0 (base moved by a
-        # noise event, or a deferred crossing) fires at t0.
-        with np.errstate(divide="ignore", invalid="ignore"):
-            frac = np.where(slope != 0, (level - x0[pix]) / slope, 0.0)
-        t = t0 + dt * np.clip(frac, 0.0, 1.0)
-        keep = self._refractory(pix, t)
-        if self.params.refractory_mode == "defer":
-            # Only emitted crossings move base; suppressed ones stay pending.
-            self._base = self._base + np.bincount(pix[keep], minlength=len(x1)) * step
-        else:
-            # Base moves by every crossing, emitted or dropped.
-            self._base = self._base + count * step
-        pix, t = pix[keep], t[keep]
-        return _events(pix % self.width, pix // self.width, t, polarity[pix])
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its

@@ -92,3 +92,13 @@ def radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: Refle
 def angles(normal: np.ndarray, to_sun: np.ndarray, to_camera: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(mu0, mu, cos g) from unit vectors (..., 3): surface normal, toward the Sun, toward the camera."""
     return (np.sum(normal * to_sun, axis=-1), np.sum(normal * to_camera, axis=-1), np.sum(to_sun * to_camera, axis=-1))
+
+
+def max_radiance_factor(p: ReflectanceParams, n: int = 61) -> float:
+    """Largest I/F the law gives over incidence, emission and azimuth (a grid search with
+    5 % headroom): the renderer clamps interpolated radiance to it."""
+    angle = np.linspace(0.0, np.pi / 2 * 0.999, n)
+    azimuth = np.linspace(0.0, np.pi, n)
+    i, e, a = np.meshgrid(angle, angle, azimuth, indexing="ij")
+    cos_g = np.cos(i) * np.cos(e) + np.sin(i) * np.sin(e) * np.cos(a)
+    return 1.05 * float(np.max(radiance_factor(np.cos(i), np.cos(e), cos_g, p)))

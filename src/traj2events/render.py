@@ -22,7 +22,7 @@ import numpy as np
 
 from .camera import Camera, CameraPose, opengl_camera_to_world
 from .illumination import Sun
-from .reflectance import ReflectanceParams
+from .reflectance import ReflectanceParams, max_radiance_factor
 from .tiles import TileKey, TileSet
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
@@ -165,6 +165,7 @@ class TerrainRenderer:
         self._pyrender = pyrender
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
         self.max_cached_tiles = max_cached_tiles
+        self._radiance_max = float(max_radiance_factor(reflectance) * sun.irradiance_w_m2 / np.pi)
         self._platform = OSMesaPlatform(camera.width, camera.height)
         self._platform.init_context()
         self._platform.make_current()
@@ -223,6 +224,7 @@ class TerrainRenderer:
             "b0": self.reflectance.opposition_b0,
             "hw": self.reflectance.opposition_h,
             "albedo": self.reflectance.albedo,
+            "radiance_max": self._radiance_max,
         }
         self._platform.make_current()
         image = self._renderer.render(self._scene, self._pyrender.RenderFlags.OFFSCREEN)
