@@ -108,21 +108,28 @@ def _events(x, y, t_s, p) -> np.ndarray:
 
 @njit(cache=True, nogil=True)
 def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_rate, cutoff_hz, dt,
-             count, x0, x1, active):
+             count, x0, x1, active, log_lut, gain_lut):
     """Low-pass and log per pixel, the leak's drift of base, and the number of threshold
     crossings (count > 0: ON, < 0: OFF). Updates filtered and base in place; lists the
-    pixels with crossings in `active`; returns how many."""
+    pixels with crossings in `active`; returns how many. For 8-bit input the log and the
+    gain come from tables (`log_lut[I]`, `gain_lut[I0 + I1]`: every value they can take),
+    else (empty tables) they are computed per pixel."""
     knee_slope = np.log(KNEE_DN) / KNEE_DN
     two_pi_dt = 2.0 * np.pi * dt
+    tables = log_lut.size > 0
     n_active = 0
     for i in range(intensity1.size):
-        i1 = intensity1[i]
-        target = i1 * knee_slope if i1 <= KNEE_DN else np.log(i1)
-        if cutoff_hz > 0.0:
-            f_c = cutoff_hz * (0.5 * (intensity0[i] + i1) + 20.0) / 275.0
-            gain = -np.expm1(-two_pi_dt * f_c)
+        if tables:
+            target = log_lut[np.int64(intensity1[i])]
+            gain = gain_lut[np.int64(intensity0[i]) + np.int64(intensity1[i])]
         else:
-            gain = 1.0
+            i1 = np.float64(intensity1[i])
+            target = i1 * knee_slope if i1 <= KNEE_DN else np.log(i1)
+            if cutoff_hz > 0.0:
+                f_c = cutoff_hz * (0.5 * (intensity0[i] + i1) + 20.0) / 275.0
+                gain = -np.expm1(-two_pi_dt * f_c)
+            else:
+                gain = 1.0
         f0 = filtered[i]
         f1 = f0 + gain * (target - f0)
         a = f0 - base[i]
@@ -176,6 +183,10 @@ def _emit(active, n_active, count, x0, x1, theta_on, theta_off, base, last_event
     return k
 
 
+_LOG_LUT_8BIT = log_intensity_8bit(np.arange(256.0))
+_NO_TABLE = np.empty(0)
+
+
 class EventEmulator:
     """Streaming emulator for frames of a fixed size; see the module docstring."""
 
@@ -219,7 +230,8 @@ class EventEmulator:
             raise ValueError(f"frames: expected finite values >= 0 (intensity), frame {bad} of this chunk "
                              f"(t = {times[bad]:.6f} s) has NaN, inf or negative values")
         for frame, t in zip(frames, times):
-            intensity = frame.reshape(-1).astype(np.float64)
+            # 8-bit frames stay 8-bit (the kernel reads tables); anything else is float DN.
+            intensity = frame.reshape(-1).copy() if frame.dtype == np.uint8 else frame.reshape(-1).astype(np.float64)
             if self._t is None:
                 self._start(intensity, float(t))
                 continue
@@ -239,8 +251,16 @@ class EventEmulator:
         t0, dt = self._t, t1 - self._t
         # x = signal - base, linear in t within the interval: low-pass (exact, bandwidth from
         # the interval's mean input), log, the leak's drift of base, crossings.
+        if intensity.dtype != self._intensity.dtype:  # 8-bit and float frames mixed: all float
+            intensity, self._intensity = intensity.astype(np.float64), self._intensity.astype(np.float64)
+        if intensity.dtype == np.uint8:
+            log_lut = _LOG_LUT_8BIT
+            gain_lut = lowpass_gain(0.5 * np.arange(511.0), p.cutoff_hz, dt)  # by I0 + I1
+        else:
+            log_lut = gain_lut = _NO_TABLE
         n_active = _advance(self._intensity, intensity, self._filtered, self._base, self.theta_on, self.theta_off,
-                            self.leak_rate, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active)
+                            self.leak_rate, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active,
+                            log_lut, gain_lut)
         n_events = int(np.abs(self._count[self._active[:n_active]]).sum())
         pix = np.empty(n_events, np.int64)
         t = np.empty(n_events, np.float64)
@@ -253,7 +273,10 @@ class EventEmulator:
         noise = self._shot_noise(intensity, t0, dt)
         events += [noise, self._hot_pixel_events(t0, dt)]
         out = np.concatenate(events)
-        return out[np.lexsort((out["p"], out["x"], out["y"], out["t"]))]
+        # Sorted by (t, y, x, p) through one int64 key (one argsort instead of a 4-key lexsort).
+        n_pix = self.width * self.height
+        key = (out["t"] * (2 * n_pix) + (out["y"].astype(np.int64) * self.width + out["x"]) * 2 + out["p"])
+        return out[np.argsort(key, kind="stable")]
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
@@ -277,15 +300,16 @@ class EventEmulator:
         n = rng.poisson(rate_max * dt * intensity.size)
         pix = rng.integers(0, intensity.size, n)
         t = t0 + dt * rng.uniform(size=n)
-        order = np.lexsort((t, pix))  # grouped by pixel, increasing time
-        pix, t = pix[order], t[order]
         g = np.maximum(1.0 - 0.75 * (intensity[pix] + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
         rate = p.shot_noise_hz * g * p.theta_on / self._noise_theta[pix]
         keep = rng.uniform(size=n) * rate_max < rate  # thinning
         pix, t = pix[keep], t[keep]
         on = rng.uniform(size=len(pix)) < 0.5
-        keep = self._refractory(pix, t)
-        pix, t, on = pix[keep], t[keep], on[keep]
+        if p.refractory_s > 0:
+            order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
+            pix, t, on = pix[order], t[order], on[order]
+            keep = self._refractory(pix, t)
+            pix, t, on = pix[keep], t[keep], on[keep]
         # A noise event resets the pixel like a real one: its reference jumps to the current
         # signal (for a real crossing that is base +- theta). Applied at the interval's end.
         self._base[pix] = self._filtered[pix]
