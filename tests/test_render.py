@@ -172,3 +172,26 @@ def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
             frame = renderer.render(camera_pose(state(x=x, altitude=300.0, pitch=30.0)))
             assert frame.n_tiles > 0
             assert len(renderer._nodes) <= max(20, frame.n_tiles)
+
+
+def test_rendered_crater_shadow_has_the_analytic_length():
+    # Parabolic bowl (radius 50 m, depth 20 m), Sun from +x at 10 deg: the rim's shadow
+    # covers the floor from the rim at x = +50 m for 2R - R^2 tan(e) / d = 78 m.
+    spacing, radius, depth, elevation = 0.5, 50.0, 20.0, 10.0
+    x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    r = np.hypot(xx, yy)
+    bowl = GridTerrain(np.where(r < radius, depth * ((r / radius) ** 2 - 1), 0.0), spacing, (x[0], x[0]))
+    sun = Sun(1.496e11, 0.0, elevation)
+    camera = Camera(256, 256, 45.0)
+    pose = camera_pose(state(altitude=200.0))  # nadir: columns along +x, rows along +y
+    frame, _ = render(bowl, camera, pose, radius=1e12, half_extent=2e3, sun=sun,
+                      lod=LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0))
+    row = 128  # through the centre (y ~ 0)
+    x_s, _ = camera.pixel_coordinates()
+    ground_x = x_s[0] * frame.depth_m[row] / camera.focal_px  # camera X = inertial x at zero attitude
+    dark = (frame.radiance[row] < 1e-6) & (np.abs(ground_x) < radius)
+    length = ground_x[dark].max() - ground_x[dark].min()
+    expected = 2 * radius - radius**2 * np.tan(np.radians(elevation)) / depth
+    assert length == pytest.approx(expected, abs=2.0)  # a few cells and pixels
+    assert ground_x[dark].max() == pytest.approx(radius, abs=2.0)  # it starts at the Sun-side rim
