@@ -111,7 +111,8 @@ def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_r
              count, x0, x1, active, log_lut, gain_lut):
     """Low-pass and log per pixel, the leak's drift of base, and the number of threshold
     crossings (count > 0: ON, < 0: OFF). Updates filtered and base in place; lists the
-    pixels with crossings in `active`; returns how many. For 8-bit input the log and the
+    pixels with crossings in `active`, with their count, x0 and x1 in the same slots
+    (only those: less memory traffic than full frames); returns how many. For 8-bit input the log and the
     gain come from tables (`log_lut[I]`, `gain_lut[I0 + I1]`: every value they can take),
     else (empty tables) they are computed per pixel."""
     knee_slope = np.log(KNEE_DN) / KNEE_DN
@@ -137,16 +138,16 @@ def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_r
         x = f1 - b
         filtered[i] = f1
         base[i] = b
-        x0[i] = a
-        x1[i] = x
         if x >= theta_on[i]:
-            count[i] = np.int64(np.floor(x / theta_on[i]))
+            c = np.int64(np.floor(x / theta_on[i]))
         elif -x >= theta_off[i]:
-            count[i] = -np.int64(np.floor(-x / theta_off[i]))
+            c = -np.int64(np.floor(-x / theta_off[i]))
         else:
-            count[i] = 0
             continue
         active[n_active] = i
+        count[n_active] = c
+        x0[n_active] = a
+        x1[n_active] = x
         n_active += 1
     return n_active
 
@@ -161,14 +162,14 @@ def _emit(active, n_active, count, x0, x1, theta_on, theta_off, base, last_event
     k = 0
     for a in range(n_active):
         i = active[a]
-        n = count[i]
+        n = count[a]
         on = n > 0
         step = theta_on[i] if on else -theta_off[i]
         n = abs(n)
-        slope = x1[i] - x0[i]
+        slope = x1[a] - x0[a]
         emitted = 0
         for j in range(1, n + 1):
-            frac = (j * step - x0[i]) / slope if slope != 0.0 else 0.0
+            frac = (j * step - x0[a]) / slope if slope != 0.0 else 0.0
             t = t0 + dt * min(max(frac, 0.0), 1.0)
             if refractory_s > 0.0:
                 if t - last_event[i] < refractory_s:
@@ -180,6 +181,76 @@ def _emit(active, n_active, count, x0, x1, theta_on, theta_off, base, last_event
             k += 1
             emitted += 1
         base[i] += (emitted if defer else n) * step
+    return k
+
+
+@njit(cache=True, nogil=True)
+def _splitmix(state):
+    """splitmix64: (next state, 53-bit uniform in [0, 1)). Counter-based, so a frame
+    interval's noise depends only on (seed, interval)."""
+    state = (state + np.uint64(0x9E3779B97F4A7C15)) & np.uint64(0xFFFFFFFFFFFFFFFF)
+    z = state
+    z = ((z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)) & np.uint64(0xFFFFFFFFFFFFFFFF)
+    z = ((z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)) & np.uint64(0xFFFFFFFFFFFFFFFF)
+    z = z ^ (z >> np.uint64(31))
+    return state, np.float64(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(cache=True)
+def _alias_table(weights):
+    """Walker/Vose alias table: sample index i with probability weights[i] / sum in O(1)."""
+    n = weights.size
+    scaled = weights * (n / weights.sum())
+    prob = np.ones(n)
+    alias = np.arange(n)
+    small = np.empty(n, np.int64)
+    large = np.empty(n, np.int64)
+    ns = nl = 0
+    for i in range(n):
+        if scaled[i] < 1.0:
+            small[ns] = i
+            ns += 1
+        else:
+            large[nl] = i
+            nl += 1
+    while ns > 0 and nl > 0:
+        ns -= 1
+        s_i = small[ns]
+        nl -= 1
+        l_i = large[nl]
+        prob[s_i] = scaled[s_i]
+        alias[s_i] = l_i
+        scaled[l_i] = scaled[l_i] + scaled[s_i] - 1.0
+        if scaled[l_i] < 1.0:
+            small[ns] = l_i
+            ns += 1
+        else:
+            large[nl] = l_i
+            nl += 1
+    return prob, alias
+
+
+@njit(cache=True, nogil=True)
+def _noise_candidates(n, state, prob, alias, intensity, g_max, t0, dt, out_pix, out_t, out_p):
+    """Shot noise by thinning: n candidates at the majorant rate R g_max theta_nom/theta(x),
+    their pixel drawn in proportion to theta_nom/theta(x) (alias table), each kept with
+    probability g(I) / g_max; ON or OFF with equal odds."""
+    n_pixels = prob.size
+    k = 0
+    for _ in range(n):
+        state, u = _splitmix(state)
+        column = min(np.int64(u * n_pixels), n_pixels - 1)
+        state, u = _splitmix(state)
+        i = column if u < prob[column] else alias[column]
+        state, u_t = _splitmix(state)
+        state, u_keep = _splitmix(state)
+        state, u_on = _splitmix(state)
+        g = max(1.0 - 0.75 * (np.float64(intensity[i]) + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
+        if u_keep * g_max < g:
+            out_pix[k] = i
+            out_t[k] = t0 + dt * u_t
+            out_p[k] = u_on < 0.5
+            k += 1
     return k
 
 
@@ -200,8 +271,12 @@ class EventEmulator:
         self.leak_phase = rng.uniform(0.0, 1.0, n)
         # Shot noise per pixel scales with theta_nominal / theta(x) (frozen: computed once).
         self._noise_theta = 0.5 * (self.theta_on + self.theta_off)
-        g_max = 1.0 - 0.75 * 20.0 / 275.0  # g(I) of the darkest pixel
-        self._noise_rate_max = params.shot_noise_hz * g_max * params.theta_on / self._noise_theta.min()
+        # Thinning majorant: g(I) at its largest (I = 0) times each pixel's theta_nom / theta(x);
+        # candidates pick their pixel by that weight (alias table), so none is wasted on it.
+        self._g_max = 1.0 - 0.75 * 20.0 / 275.0
+        weights = params.theta_on / self._noise_theta
+        self._noise_rate_total = params.shot_noise_hz * self._g_max * float(weights.sum())
+        self._alias = _alias_table(weights) if params.shot_noise_hz > 0 else None
         hot = rng.uniform(size=n) < params.hot_pixel_fraction
         self.hot_pixels = np.flatnonzero(hot)
         self._filtered: np.ndarray | None = None  # low-passed log intensity at the last frame
@@ -261,7 +336,7 @@ class EventEmulator:
         n_active = _advance(self._intensity, intensity, self._filtered, self._base, self.theta_on, self.theta_off,
                             self.leak_rate, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active,
                             log_lut, gain_lut)
-        n_events = int(np.abs(self._count[self._active[:n_active]]).sum())
+        n_events = int(np.abs(self._count[:n_active]).sum())
         pix = np.empty(n_events, np.int64)
         t = np.empty(n_events, np.float64)
         on = np.empty(n_events, np.bool_)
@@ -276,7 +351,7 @@ class EventEmulator:
         # Sorted by (t, y, x, p) through one int64 key (one argsort instead of a 4-key lexsort).
         n_pix = self.width * self.height
         key = (out["t"] * (2 * n_pix) + (out["y"].astype(np.int64) * self.width + out["x"]) * 2 + out["p"])
-        return out[np.argsort(key, kind="stable")]
+        return out[np.argsort(key)]  # equal keys are identical events: order among them is moot
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
@@ -296,15 +371,13 @@ class EventEmulator:
         if p.shot_noise_hz <= 0:
             return np.empty(0, EVENT_DTYPE)
         rng = _rng(self.seed, 1, self._interval)
-        rate_max = self._noise_rate_max
-        n = rng.poisson(rate_max * dt * intensity.size)
-        pix = rng.integers(0, intensity.size, n)
-        t = t0 + dt * rng.uniform(size=n)
-        g = np.maximum(1.0 - 0.75 * (intensity[pix] + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
-        rate = p.shot_noise_hz * g * p.theta_on / self._noise_theta[pix]
-        keep = rng.uniform(size=n) * rate_max < rate  # thinning
-        pix, t = pix[keep], t[keep]
-        on = rng.uniform(size=len(pix)) < 0.5
+        n = int(rng.poisson(self._noise_rate_total * dt))
+        state = np.uint64(rng.integers(0, 2**63, dtype=np.int64))
+        pix = np.empty(n, np.int64)
+        t = np.empty(n, np.float64)
+        on = np.empty(n, np.bool_)
+        k = _noise_candidates(n, state, self._alias[0], self._alias[1], intensity, self._g_max, t0, dt, pix, t, on)
+        pix, t, on = pix[:k], t[:k], on[:k]
         if p.refractory_s > 0:
             order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
             pix, t, on = pix[order], t[order], on[order]
