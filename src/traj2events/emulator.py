@@ -107,7 +107,7 @@ def _events(x, y, t_s, p) -> np.ndarray:
 # --- compiled per-pixel kernels (numba): one pass over the frame, then one over the events --
 
 @njit(cache=True, nogil=True)
-def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_rate, cutoff_hz, dt,
+def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_step, cutoff_hz, dt,
              count, x0, x1, active, log_lut, gain_lut):
     """Low-pass and log per pixel, the leak's drift of base, and the number of threshold
     crossings (count > 0: ON, < 0: OFF). Updates filtered and base in place; lists the
@@ -134,7 +134,7 @@ def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_r
         f0 = filtered[i]
         f1 = f0 + gain * (target - f0)
         a = f0 - base[i]
-        b = base[i] - theta_on[i] * leak_rate[i] * dt
+        b = base[i] - leak_step[i] * dt
         x = f1 - b
         filtered[i] = f1
         base[i] = b
@@ -254,8 +254,42 @@ def _noise_candidates(n, state, prob, alias, intensity, g_max, t0, dt, out_pix, 
     return k
 
 
+@njit(cache=True, nogil=True)
+def _order_keys(pix, t_s, on, n_pixels):
+    """One int64 per event ordering (t rounded to us, y, x, p): t_us 2N + 2 pixel + p."""
+    key = np.empty(pix.size, np.int64)
+    for k in range(pix.size):
+        key[k] = np.int64(np.rint(t_s[k] * 1e6)) * (2 * n_pixels) + pix[k] * 2 + np.int64(on[k])
+    return key
+
+
+@njit(cache=True, nogil=True)
+def _decode_keys(key, width, n_pixels, out_x, out_y, out_t, out_p):
+    for k in range(key.size):
+        t = key[k] // (2 * n_pixels)
+        rest = key[k] - t * (2 * n_pixels)
+        i = rest // 2
+        out_t[k] = t
+        out_p[k] = rest - 2 * i
+        out_y[k] = i // width
+        out_x[k] = i - (i // width) * width
+
+
+def _assemble(pix: np.ndarray, t_s: np.ndarray, on: np.ndarray, width: int, n_pixels: int) -> np.ndarray:
+    """Events (structured) in (t, y, x, p) order: one key per event, one sort (equal keys
+    are identical events, so the sort need not be stable)."""
+    key = _order_keys(pix, t_s, on, n_pixels)
+    key.sort()
+    out = np.empty(key.size, EVENT_DTYPE)
+    x, y, t, p = (np.empty(key.size, out.dtype[f]) for f in ("x", "y", "t", "p"))
+    _decode_keys(key, width, n_pixels, x, y, t, p)
+    out["x"], out["y"], out["t"], out["p"] = x, y, t, p
+    return out
+
+
 _LOG_LUT_8BIT = log_intensity_8bit(np.arange(256.0))
 _NO_TABLE = np.empty(0)
+_NO_EVENTS = (np.empty(0, np.int64), np.empty(0), np.empty(0, np.bool_))  # (pixel, t s, ON)
 
 
 class EventEmulator:
@@ -283,6 +317,7 @@ class EventEmulator:
         self._intensity: np.ndarray | None = None  # input (DN) at the last frame
         self._base: np.ndarray | None = None
         self._last_event = np.full(n, -np.inf)  # s
+        self._leak_step = self.theta_on * self.leak_rate  # base's drift per second (one array to read)
         # Work arrays of the compiled kernels, reused every frame.
         self._count = np.zeros(n, np.int64)
         self._x0 = np.zeros(n)
@@ -334,7 +369,7 @@ class EventEmulator:
         else:
             log_lut = gain_lut = _NO_TABLE
         n_active = _advance(self._intensity, intensity, self._filtered, self._base, self.theta_on, self.theta_off,
-                            self.leak_rate, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active,
+                            self._leak_step, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active,
                             log_lut, gain_lut)
         n_events = int(np.abs(self._count[:n_active]).sum())
         pix = np.empty(n_events, np.int64)
@@ -342,16 +377,12 @@ class EventEmulator:
         on = np.empty(n_events, np.bool_)
         k = _emit(self._active, n_active, self._count, self._x0, self._x1, self.theta_on, self.theta_off, self._base,
                   self._last_event, t0, dt, float(p.refractory_s), p.refractory_mode == "defer", pix, t, on)
-        events = [_events(pix[:k] % self.width, pix[:k] // self.width, t[:k], on[:k])]
+        parts = [(pix[:k], t[:k], on[:k])]
         self._intensity, self._t = intensity, t1
         self._interval += 1
-        noise = self._shot_noise(intensity, t0, dt)
-        events += [noise, self._hot_pixel_events(t0, dt)]
-        out = np.concatenate(events)
-        # Sorted by (t, y, x, p) through one int64 key (one argsort instead of a 4-key lexsort).
-        n_pix = self.width * self.height
-        key = (out["t"] * (2 * n_pix) + (out["y"].astype(np.int64) * self.width + out["x"]) * 2 + out["p"])
-        return out[np.argsort(key)]  # equal keys are identical events: order among them is moot
+        parts += [self._shot_noise(intensity, t0, dt), self._hot_pixel_events(t0, dt)]
+        return _assemble(*(np.concatenate([q[j] for q in parts]) for j in range(3)), self.width,
+                         self.width * self.height)
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
@@ -366,10 +397,10 @@ class EventEmulator:
                     keep[k] = False
         return keep
 
-    def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> np.ndarray:
+    def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         p = self.params
         if p.shot_noise_hz <= 0:
-            return np.empty(0, EVENT_DTYPE)
+            return _NO_EVENTS
         rng = _rng(self.seed, 1, self._interval)
         n = int(rng.poisson(self._noise_rate_total * dt))
         state = np.uint64(rng.integers(0, 2**63, dtype=np.int64))
@@ -386,14 +417,14 @@ class EventEmulator:
         # A noise event resets the pixel like a real one: its reference jumps to the current
         # signal (for a real crossing that is base +- theta). Applied at the interval's end.
         self._base[pix] = self._filtered[pix]
-        return _events(pix % self.width, pix // self.width, t, on)
+        return pix, t, on
 
-    def _hot_pixel_events(self, t0: float, dt: float) -> np.ndarray:
+    def _hot_pixel_events(self, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         p = self.params
         if not len(self.hot_pixels) or p.hot_pixel_hz <= 0:
-            return np.empty(0, EVENT_DTYPE)
+            return _NO_EVENTS
         rng = _rng(self.seed, 2, self._interval)
         counts = rng.poisson(p.hot_pixel_hz * dt, len(self.hot_pixels))
         pix = np.repeat(self.hot_pixels, counts)
         t = t0 + dt * rng.uniform(size=len(pix))
-        return _events(pix % self.width, pix // self.width, t, np.ones(len(pix), bool))
+        return pix.astype(np.int64), t, np.ones(len(pix), np.bool_)
