@@ -98,12 +98,6 @@ def _rng(seed: int, *key: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([seed, *key]))
 
 
-def _events(x, y, t_s, p) -> np.ndarray:
-    out = np.empty(len(t_s), EVENT_DTYPE)
-    out["x"], out["y"], out["t"], out["p"] = x, y, np.rint(np.asarray(t_s) * 1e6).astype(np.int64), p
-    return out
-
-
 # --- compiled per-pixel kernels (numba): one pass over the frame, then one over the events --
 
 @njit(cache=True, nogil=True)
