@@ -24,7 +24,12 @@ Events are a numpy structured array (x, y, t, p) in tonic's convention: x column
 (uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t. Streaming:
 `EventEmulator.process` takes any number of frames at a time and keeps only per-pixel
 state, and every random draw is keyed by (seed, frame interval), so the output is the
-same bytes however the video is chunked.
+same bytes however the video is chunked. Input: 8-bit DN, or float DN-equivalents of
+linear radiance (`radiance_to_dn`, the HDR path).
+
+Speed: the per-pixel work runs in numba kernels (`_advance`: one pass over the frame;
+`_emit`: one over the pixels that crossed; `_noise_candidates`: one per noise candidate),
+compiled on first use and cached beside this file.
 """
 from __future__ import annotations
 
