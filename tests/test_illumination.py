@@ -25,8 +25,8 @@ def test_crater_shadow_has_the_analytic_length(azimuth, elevation):
     field = shadow_field(x, x, h, sun_direction(azimuth, elevation), FLAT)
     c, s = np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))
     t = np.arange(-radius, radius, 0.02)  # along the line through the centre, toward the Sun
-    from traj2events.illumination import _bilinear
-    lit = _bilinear(x, x, field.lit, t * c, t * s, fill=1.0)
+    from traj2events.terrain import bilinear
+    lit = bilinear(field.lit, (x[0], x[0]), x[1] - x[0], t * c, t * s, fill=1.0)
     measured = radius - t[lit < 0.5].min()
     expected = min(2 * radius - radius**2 * np.tan(np.radians(elevation)) / depth, 2 * radius)
     assert measured == pytest.approx(expected, abs=0.5)  # two grid spacings

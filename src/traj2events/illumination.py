@@ -27,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .terrain import bilinear
+
 SOLAR_CONSTANT_W_M2 = 1361.0  # at 1 AU
 AU_M = 1.495978707e11
 DARK_M = 1.0e12  # shadow height where the Sun is below the horizon (finite, to interpolate)
@@ -84,7 +86,8 @@ class ShadowField:
 
     def obstruction_at(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
         """Bilinear O at points inside the grid; -inf outside (callers pass a parent)."""
-        return _bilinear(self.x_m, self.y_m, self.obstruction_m, x_m, y_m, fill=-np.inf)
+        return bilinear(self.obstruction_m, (self.x_m[0], self.y_m[0]), self.x_m[1] - self.x_m[0], x_m, y_m,
+                        fill=-np.inf)
 
 
 def shadow_field(x_m: np.ndarray, y_m: np.ndarray, heights_m: np.ndarray, sun_dir: np.ndarray, radius_m: float,
@@ -121,8 +124,7 @@ def shadow_field(x_m: np.ndarray, y_m: np.ndarray, heights_m: np.ndarray, sun_di
 
     def beyond_sweep(row_coord, lateral):
         # Convert sweep coordinates back to (x, y) for the boundary function.
-        px = np.full(lateral.shape, row_coord)
-        py = ya[0] + sign_l * lateral * spacing
+        px, py = np.broadcast_arrays(row_coord, ya[0] + sign_l * lateral * spacing)
         return beyond(py, px) if swap else beyond(px, py)
 
     s_out = np.empty_like(ha)
@@ -131,13 +133,7 @@ def shadow_field(x_m: np.ndarray, y_m: np.ndarray, heights_m: np.ndarray, sun_di
     outside = lateral > n1 - 1  # lateral_cells <= 1: at most the last column leaves the grid
     # Boundary values, fetched once: the row beyond the first, and the out-of-grid samples of every row.
     o_next = beyond_sweep(xa[-1] + sign_a * spacing, lateral)
-    edge = None
-    if outside.any():
-        rows = np.repeat(xa[:, None], outside.sum(), axis=1)
-        lat = np.broadcast_to(lateral[outside], rows.shape)
-        px = rows
-        py = ya[0] + sign_l * lat * spacing
-        edge = beyond(py, px) if swap else beyond(px, py)
+    edge = beyond_sweep(xa[:, None], lateral[outside][None, :]) if outside.any() else None
     for i in range(n0 - 1, -1, -1):
         with np.errstate(invalid="ignore"):  # -inf - (-inf) where the Sun is set; overwritten next
             s_row = o_next - step_m * ta[i]
@@ -161,19 +157,3 @@ def shadow_field(x_m: np.ndarray, y_m: np.ndarray, heights_m: np.ndarray, sun_di
         return np.ascontiguousarray(a.T if swap else a)
 
     return ShadowField(x_m, y_m, back(s_out), back(o_out), back(lit))
-
-
-def _bilinear(x: np.ndarray, y: np.ndarray, values: np.ndarray, xq: np.ndarray, yq: np.ndarray,
-              fill: float) -> np.ndarray:
-    xq, yq = np.broadcast_arrays(np.asarray(xq, float), np.asarray(yq, float))
-    dx, dy = x[1] - x[0], y[1] - y[0]
-    u, v = (xq - x[0]) / dx, (yq - y[0]) / dy
-    n0, n1 = values.shape
-    inside = (u >= 0) & (u <= n0 - 1) & (v >= 0) & (v <= n1 - 1)
-    i = np.clip(np.floor(u).astype(np.int64), 0, n0 - 2)
-    k = np.clip(np.floor(v).astype(np.int64), 0, n1 - 2)
-    fu, fv = np.clip(u - i, 0, 1), np.clip(v - k, 0, 1)
-    with np.errstate(invalid="ignore"):
-        val = ((values[i, k] * (1 - fu) + values[i + 1, k] * fu) * (1 - fv)
-               + (values[i, k + 1] * (1 - fu) + values[i + 1, k + 1] * fu) * fv)
-    return np.where(inside, val, fill)

@@ -277,17 +277,25 @@ class GridTerrain:
     origin_m: tuple[float, float]
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
-        u = (np.asarray(x_m, float) - self.origin_m[0]) / self.spacing_m
-        v = (np.asarray(y_m, float) - self.origin_m[1]) / self.spacing_m
-        n0, n1 = self.heights_m.shape
-        inside = (u >= 0) & (u <= n0 - 1) & (v >= 0) & (v <= n1 - 1)
-        i = np.clip(np.floor(u).astype(np.int64), 0, max(n0 - 2, 0))
-        j = np.clip(np.floor(v).astype(np.int64), 0, max(n1 - 2, 0))
-        fu, fv = np.clip(u - i, 0, 1), np.clip(v - j, 0, 1)
-        h = self.heights_m
-        i1, j1 = np.minimum(i + 1, n0 - 1), np.minimum(j + 1, n1 - 1)
-        val = (h[i, j] * (1 - fu) + h[i1, j] * fu) * (1 - fv) + (h[i, j1] * (1 - fu) + h[i1, j1] * fu) * fv
-        return np.where(inside, val, 0.0)
+        return bilinear(self.heights_m, self.origin_m, self.spacing_m, x_m, y_m, fill=0.0)
+
+
+def bilinear(values: np.ndarray, origin: tuple[float, float], spacing: float, x: np.ndarray, y: np.ndarray,
+             fill: float) -> np.ndarray:
+    """Bilinear interpolation of a regular grid (axis 0 along x, axis 1 along y, equal
+    spacing, values[0, 0] at `origin`) at points (x, y); `fill` outside the grid."""
+    x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
+    u, v = (x - origin[0]) / spacing, (y - origin[1]) / spacing
+    n0, n1 = values.shape
+    inside = (u >= 0) & (u <= n0 - 1) & (v >= 0) & (v <= n1 - 1)
+    i = np.clip(np.floor(u).astype(np.int64), 0, max(n0 - 2, 0))
+    j = np.clip(np.floor(v).astype(np.int64), 0, max(n1 - 2, 0))
+    fu, fv = np.clip(u - i, 0, 1), np.clip(v - j, 0, 1)
+    i1, j1 = np.minimum(i + 1, n0 - 1), np.minimum(j + 1, n1 - 1)
+    with np.errstate(invalid="ignore"):
+        val = ((values[i, j] * (1 - fu) + values[i1, j] * fu) * (1 - fv)
+               + (values[i, j1] * (1 - fu) + values[i1, j1] * fu) * fv)
+    return np.where(inside, val, fill)
 
 
 def load_elevation_grid(path: str | os.PathLike, spacing_m: float | None = None,
