@@ -15,11 +15,12 @@ import numpy as np
 from . import __version__
 
 
-def _settings(args):
+def _settings(args, kind=None):
+    """The --settings JSON (inline, or @file) as ScenarioSettings, or as `kind`."""
     from .config import ScenarioSettings
 
     text = Path(args.settings[1:]).read_text() if args.settings.startswith("@") else args.settings
-    return ScenarioSettings.from_json(text)
+    return (kind or ScenarioSettings).from_json(text)
 
 
 def _log(msg: str) -> None:
@@ -265,8 +266,7 @@ def cmd_render(args) -> int:
     from .render import TerrainRenderer
     from .video import VideoWriter, display_frame
 
-    text = Path(args.settings[1:]).read_text() if args.settings.startswith("@") else args.settings
-    s = RenderSettings.from_json(text)
+    s = _settings(args, RenderSettings)
     tr = read_trajectory(args.trajectory)
     if tr.t is None or len(tr.t) < 1:
         print(f"error: {args.trajectory}: expected poses/t with at least one pose", file=sys.stderr)

@@ -23,7 +23,7 @@ import numpy as np
 from .camera import Camera, CameraPose, opengl_camera_to_world
 from .illumination import Sun
 from .reflectance import ReflectanceParams, max_radiance_factor
-from .tiles import TileKey, TileSet
+from .tiles import TileKey, TileSet, depth_range
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 if not hasattr(np, "infty"):
@@ -203,13 +203,10 @@ class TerrainRenderer:
         self._evict()
         # Front to back: the depth test then rejects hidden fragments early, and the order
         # (hence which of two coincident surfaces wins) does not depend on Python's hashing.
-        cam = np.asarray(pose.position, float)
-        order = sorted(keys, key=lambda k: (float(np.linalg.norm(self.tiles.tile(k).centre - cam)), k))
-        self._renderer.draw_order = [self._nodes[k] for k in order]
-        if keys:
-            near, far = self.tiles.depth_range(keys, pose, self.camera)
-        else:
-            near, far = 1.0, 10.0
+        dists, radii = self.tiles.distances(keys, pose.position)
+        order = sorted(range(len(keys)), key=lambda a: (dists[a], keys[a]))
+        self._renderer.draw_order = [self._nodes[keys[a]] for a in order]
+        near, far = depth_range(dists, radii, self.camera) if keys else (1.0, 10.0)
         self._gl_camera.znear, self._gl_camera.zfar = near, far
         self._scene.set_pose(self._camera_node, opengl_camera_to_world(pose))
         self._renderer.uniforms = {

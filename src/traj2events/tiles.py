@@ -166,16 +166,21 @@ class TileSet:
         root = self.tile((0, 0, 0))
         return float(max(np.max(np.abs(root.heights_m)) * 2.0, 100.0))
 
-    def depth_range(self, keys: list[TileKey], pose: CameraPose, camera: Camera) -> tuple[float, float]:
-        """(znear, zfar) that bracket every drawn tile: near from the closest bounding
-        sphere (a point at distance d inside the frustum has depth >= d cos(half diagonal))."""
-        cam = np.asarray(pose.position, float)
-        half_diag = np.arctan(np.hypot(camera.width, camera.height) / 2 / camera.focal_px)
-        dists = np.array([np.linalg.norm(self.tile(k).centre - cam) for k in keys])
+    def distances(self, keys: list[TileKey], position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(distance from `position` to each tile's centre, each tile's bounding radius), m."""
+        centres = np.array([self.tile(k).centre for k in keys]).reshape(-1, 3)
         radii = np.array([self.tile(k).radius_m for k in keys])
-        near = max(float(np.min(dists - radii)) * np.cos(half_diag) * 0.99, 1e-3)
-        far = float(np.max(dists + radii)) * 1.01 + 1.0
-        return near, far
+        return np.linalg.norm(centres - np.asarray(position, float), axis=1), radii
+
+
+def depth_range(dists: np.ndarray, radii: np.ndarray, camera: Camera) -> tuple[float, float]:
+    """(znear, zfar) that bracket every drawn tile (centre distances and bounding radii):
+    near from the closest bounding sphere (a point at distance d inside the frustum has
+    depth >= d cos(half diagonal))."""
+    half_diag = np.arctan(np.hypot(camera.width, camera.height) / 2 / camera.focal_px)
+    near = max(float(np.min(dists - radii)) * np.cos(half_diag) * 0.99, 1e-3)
+    far = float(np.max(dists + radii)) * 1.01 + 1.0
+    return near, far
 
 
 def _grid_faces(n: int) -> np.ndarray:

@@ -67,9 +67,7 @@ def read_video(path: str | os.PathLike, frames: list[int] | None = None) -> np.n
     """Decode a video to (n, H, W) uint8 grey; only the listed frame indices if given."""
     import ffmpeg
 
-    probe = ffmpeg.probe(str(path))
-    stream = next(s for s in probe["streams"] if s["codec_type"] == "video")
-    width, height = int(stream["width"]), int(stream["height"])
+    width, height, _, _ = video_info(path)
     source = ffmpeg.input(str(path))
     if frames is not None:
         source = source.filter("select", "+".join(f"eq(n,{k})" for k in frames))  # ffmpeg-python escapes the commas
