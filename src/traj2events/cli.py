@@ -321,7 +321,7 @@ def cmd_render(args) -> int:
 
 
 def _frame_source(args):
-    """(width, height, kind, times (s) or None, iterator of (frames in DN, times in s)) for the
+    """(width, height, kind, iterator of (frames in DN, times in s)) for the
     events command's INPUT: frames.h5 (linear radiance: the HDR path), a video, or a folder
     of images. Memory stays bounded by one chunk of frames."""
     import h5py
@@ -351,7 +351,7 @@ def _frame_source(args):
                     raise ValueError(f"events INPUT: images in {path} differ in size (expected {width} x {height})")
                 yield np.stack(batch), times[start:start + chunk]
 
-        return width, height, "images (8-bit)", times, images()
+        return width, height, "images (8-bit)", images()
     if path.suffix.lower() in (".h5", ".hdf5"):
         f = h5py.File(path, "r")
         if "radiance" not in f or "t" not in f:
@@ -367,7 +367,7 @@ def _frame_source(args):
                 for start in range(0, n, chunk):
                     yield radiance_to_dn(f["radiance"][start:start + chunk], white), times[start:start + chunk]
 
-        return width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", times, radiance()
+        return width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", radiance()
     width, height, fps, _ = video_info(path)
     fps = args.fps or fps
     if not fps > 0:
@@ -379,7 +379,7 @@ def _frame_source(args):
             yield frames, (k + np.arange(len(frames))) / fps
             k += len(frames)
 
-    return width, height, f"video (8-bit, {fps:g} fps)", None, video()
+    return width, height, f"video (8-bit, {fps:g} fps)", video()
 
 
 def cmd_events(args) -> int:
@@ -394,7 +394,7 @@ def cmd_events(args) -> int:
                                    ("hot_pixel_fraction", args.hot_pixel_fraction), ("hot_pixel_hz", args.hot_pixel_hz))
                  if v is not None}
     params = replace(params, **overrides)
-    width, height, kind, _, source = _frame_source(args)
+    width, height, kind, source = _frame_source(args)
     emulator = EventEmulator(width, height, params, seed=args.seed)
     attrs = {"preset": args.preset, "seed": args.seed, "input": str(args.input), "input_kind": kind,
              **{f"emulator_{k}": v for k, v in asdict(params).items()}, "traj2events_version": __version__}
