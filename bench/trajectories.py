@@ -69,9 +69,11 @@ def dop853_errors(vehicle, results) -> tuple[float, float]:
     return max(e[0] for e in errs), max(e[1] for e in errs)
 
 
-def batch(config: dict, jobs: int, nodes: int | None, verify: bool) -> None:
+def batch(config: dict, jobs: int, nodes: int | None, clustering: float | None, verify: bool) -> None:
     if nodes:
         config["ocp"]["n_nodes"] = nodes
+    if clustering is not None:
+        config["ocp"]["mesh_clustering"] = clustering
     start = time.perf_counter()
     verified = []
     totals = {"n": 0, "first": 0, "first_converged": 0, "solved": 0}
@@ -88,7 +90,7 @@ def batch(config: dict, jobs: int, nodes: int | None, verify: bool) -> None:
         n_over = sum(r.error_position_m > 0.1 or r.error_velocity_m_s > 0.01 for r in ok)
         print(f"{name}: {len(results)} samples, {sum(r.method == 'warm' for r in results)} on the first attempt, "
               f"{len(ok)} solved, max error {er:.3g} m / {ev:.3g} m/s, {n_over} over 0.1 m or 0.01 m/s, "
-              f"{time.perf_counter() - t0:.1f} s", flush=True)
+              f"{time.perf_counter() - t0:.1f} s (solves {sum(r.total_time_s for r in results):.1f} s of CPU)", flush=True)
         if verify:
             verified.append((name, s.vehicle, results))
         totals["n"] += len(results)
@@ -97,7 +99,8 @@ def batch(config: dict, jobs: int, nodes: int | None, verify: bool) -> None:
         totals["solved"] += len(ok)
         worst_r, worst_v, over = max(worst_r, er), max(worst_v, ev), over + n_over
     wall = time.perf_counter() - start
-    print(f"TOTAL: {totals['n']} trajectories, N = {config['ocp']['n_nodes']}, {jobs} processes: {wall:.1f} s wall; "
+    print(f"TOTAL: {totals['n']} trajectories, N = {config['ocp']['n_nodes']}, "
+          f"clustering {config['ocp'].get('mesh_clustering', 0.0)}, {jobs} processes: {wall:.1f} s wall; "
           f"{100 * totals['first'] / totals['n']:.1f} % accepted before retries "
           f"({100 * totals['first_converged'] / totals['n']:.1f} % converged on the first attempt), "
           f"{100 * totals['solved'] / totals['n']:.1f} % after; max error {worst_r:.3g} m / {worst_v:.3g} m/s; "
@@ -113,13 +116,14 @@ def main() -> None:
     parser.add_argument("--config", default=None, help="config YAML (mesh: config/config.yaml, batch: config/paper.yaml)")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--nodes", type=int, default=None, help="override ocp.n_nodes (batch)")
+    parser.add_argument("--clustering", type=float, default=None, help="override ocp.mesh_clustering (batch)")
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--verify", action="store_true", help="batch: re-check every sample with DOP853 afterwards")
     args = parser.parse_args()
     default = "config/config.yaml" if args.what == "mesh" else "config/paper.yaml"
     config = load_config(ROOT / (args.config or default), SCHEMA)
     print(f"# {args.what} on {machine()}, {time.strftime('%Y-%m-%d')}")
-    mesh(config, args.repeat) if args.what == "mesh" else batch(config, args.jobs, args.nodes, args.verify)
+    mesh(config, args.repeat) if args.what == "mesh" else batch(config, args.jobs, args.nodes, args.clustering, args.verify)
 
 
 if __name__ == "__main__":

@@ -68,6 +68,7 @@ class ScriptedProblem:
         self.outcomes = list(outcomes)
         self.calls = []
         self.settings = type("S", (), {"n_nodes": n_nodes})()
+        self.fractions = np.linspace(0.0, 1.0, n_nodes)
 
     def solve(self, bc, guess=None):
         self.calls.append("cold" if guess is None else "warm")
@@ -119,7 +120,7 @@ def test_spurious_optimum_without_refinement_moves_on_to_the_next_strategy():
 
 
 def test_refine_guess_interpolates_onto_finer_nodes(solved30):
-    t, state, control = refine_guess(solved30, 59)
+    t, state, control = refine_guess(solved30, np.linspace(0.0, 1.0, 59))
     assert len(t) == 59 and t[-1] == pytest.approx(solved30.tf_s)
     np.testing.assert_allclose(state[::2], solved30.state, atol=1e-9)  # every other node is an old node
     np.testing.assert_allclose(control[::2], solved30.control, atol=1e-12)

@@ -57,7 +57,8 @@ def cmd_base(args) -> int:
               f"{sol.status}. Check the ranges and vehicle in the config.", file=sys.stderr)
         return 1
     attrs = {**vehicle_attrs(s.vehicle), **solution_attrs(sol, bc), "scenario": s.scenario.name,
-             "epsilon": s.ocp.epsilon, "traj2events_version": __version__}
+             "epsilon": s.ocp.epsilon, "mesh_clustering": s.ocp.mesh_clustering,
+             "traj2events_version": __version__}
     write_trajectory(args.output, (sol.t, sol.state, sol.control), None, attrs)
     return 0
 
@@ -124,7 +125,7 @@ def cmd_upsample(args) -> int:
                                      "error_velocity_m_s")}
     attrs = {**vehicle_attrs(s.vehicle), **solve, "fps": args.fps, "upsampling": args.method,
              "scenario": s.scenario.name, "id": args.id, "seed": s.seed, "epsilon": s.ocp.epsilon,
-             "continuation": sample["method"], "traj2events_version": __version__}
+             "mesh_clustering": s.ocp.mesh_clustering, "continuation": sample["method"], "traj2events_version": __version__}
     write_trajectory(args.output, (t, state, control), poses, attrs)
     return 0
 

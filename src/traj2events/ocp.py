@@ -5,12 +5,16 @@
                cos(phi) cos(theta) >= cos(tilt_max),  z <= 0,  m >= dry mass,
                x(0) = x0,  x(tf) = xf (yaw and mass free),  tf free.
 
-Transcriptions: Hermite-Simpson (compressed form) with piecewise-linear controls (the
-midpoint control is the mean of its nodes: quadratic interpolants overshoot their bounds
-where controls saturate, trajectories.md), or trapezoidal. The problem is solved in
+Transcriptions: Hermite-Simpson with piecewise-linear controls (the midpoint control is
+the mean of its nodes: quadratic interpolants overshoot their bounds where controls
+saturate, trajectories.md), or trapezoidal; Hermite-Simpson in the compressed form
+(midpoint states substituted). Nodes may cluster toward both ends (`mesh_clustering`),
+where landings turn fastest. The problem is solved in
 nondimensional variables (1000 m, 100 m/s, 10 s, 1e4 kg), which IPOPT needs far fewer
-iterations for, and with MUMPS' own scaling off (bounded iteration counts for every
-t_f guess). It is built once and solved many times with new boundary conditions.
+iterations for, with MUMPS' own scaling off (bounded iteration counts for every t_f
+guess) and constant bounds given to IPOPT as variable bounds (they then hold at every
+iterate, and the KKT system is smaller). It is built once and solved many times with
+new boundary conditions.
 """
 from __future__ import annotations
 
@@ -39,6 +43,7 @@ FINAL_FIXED = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 11])
 class OcpSettings:
     n_nodes: int = 40
     transcription: str = "hermite-simpson"
+    mesh_clustering: float = 0.0
     epsilon: float = 0.5
     max_iter: int = 100
     tol: float = 1e-8
@@ -53,6 +58,8 @@ class OcpSettings:
     def __post_init__(self) -> None:
         if self.transcription not in TRANSCRIPTIONS:
             raise ValueError(f"ocp.transcription: expected one of {TRANSCRIPTIONS}, got {self.transcription!r}")
+        if not 0.0 <= self.mesh_clustering < 1.0:
+            raise ValueError(f"ocp.mesh_clustering: expected 0 <= value < 1, got {self.mesh_clustering}")
         if self.n_nodes < 3:
             raise ValueError(f"ocp.n_nodes: expected >= 3, got {self.n_nodes}")
         if self.refine_n_nodes and self.refine_n_nodes <= self.n_nodes:
@@ -79,6 +86,18 @@ class BoundaryConditions:
             (1 - s) * self.final + s * other.final,
             (1 - s) * self.tf_guess_s + s * other.tf_guess_s,
         )
+
+
+def node_fractions(n_nodes: int, clustering: float) -> np.ndarray:
+    """Node times as fractions of t_f (n_nodes,): s = xi - a sin(2 pi xi) / (2 pi).
+
+    Step sizes go as 1 - a cos(2 pi xi): (1 - a) times the uniform step at both ends,
+    where landings turn quickly (the initial re-orientation and the final pitch-up to
+    upright), (1 + a) times it in the middle. a = 0 is the uniform mesh."""
+    xi = np.linspace(0.0, 1.0, n_nodes)
+    s = xi - clustering * np.sin(2 * np.pi * xi) / (2 * np.pi)
+    s[0], s[-1] = 0.0, 1.0
+    return s
 
 
 def replace_tf_guess(bc: BoundaryConditions, tf_guess_s: float) -> BoundaryConditions:
@@ -127,7 +146,9 @@ class LandingProblem:
         tau = opti.variable()  # final time / TIME_S
         x0 = opti.parameter(N_STATE)  # scaled boundary values
         xf = opti.parameter(len(FINAL_FIXED))
-        h = tau / (n - 1)
+        self.fractions = node_fractions(n, settings.mesh_clustering)
+        h = tau * ca.DM(np.diff(self.fractions)).T  # (1, n-1) interval lengths
+        hx = ca.repmat(h, N_STATE, 1)  # the same, per state row
 
         def control_effort(w):  # |u|^2 with u the physical control
             return w[0, :] ** 2 + ca.sum1((w[1:4, :] - w[4:7, :]) ** 2)
@@ -136,13 +157,13 @@ class LandingProblem:
         Lk = control_effort(W)
         if settings.transcription == "hermite-simpson":
             Wm = 0.5 * (W[:, :-1] + W[:, 1:])  # piecewise-linear controls
-            Xm = 0.5 * (X[:, :-1] + X[:, 1:]) + h / 8 * (Fk[:, :-1] - Fk[:, 1:])
+            Xm = 0.5 * (X[:, :-1] + X[:, 1:]) + hx / 8 * (Fk[:, :-1] - Fk[:, 1:])
             Fm = f_scaled.map(n - 1)(Xm, Wm)
-            opti.subject_to(X[:, 1:] - X[:, :-1] == h / 6 * (Fk[:, :-1] + 4 * Fm + Fk[:, 1:]))
-            effort = h / 6 * ca.sum2(Lk[:-1] + 4 * control_effort(Wm) + Lk[1:])
+            opti.subject_to(X[:, 1:] - X[:, :-1] == hx / 6 * (Fk[:, :-1] + 4 * Fm + Fk[:, 1:]))
+            effort = ca.sum2(h * (Lk[:-1] + 4 * control_effort(Wm) + Lk[1:])) / 6
         else:
-            opti.subject_to(X[:, 1:] - X[:, :-1] == h / 2 * (Fk[:, :-1] + Fk[:, 1:]))
-            effort = h / 2 * ca.sum2(Lk[:-1] + Lk[1:])
+            opti.subject_to(X[:, 1:] - X[:, :-1] == hx / 2 * (Fk[:, :-1] + Fk[:, 1:]))
+            effort = ca.sum2(h * (Lk[:-1] + Lk[1:])) / 2
 
         eps = settings.epsilon
         fuel_kg = MASS_KG * (x0[12] - X[12, -1])
@@ -151,6 +172,12 @@ class LandingProblem:
         opti.subject_to(opti.bounded(0, ca.vec(W), 1))
         cos_tilt = np.cos(np.radians(vehicle.tilt_max_deg))
         opti.subject_to(ca.cos(X[6, :]) * ca.cos(X[7, :]) >= cos_tilt)
+        # Roll and pitch bounds halfway between the tilt limit and 90 deg: never active
+        # at a solution (the tilt limit is tighter), but as variable bounds they hold
+        # at every iterate, so the Euler-rate singularity at theta = +-90 deg stays out
+        # of reach (without them ~2-5 % of solves diverged there).
+        angle_max = np.radians(0.5 * (vehicle.tilt_max_deg + 90.0))
+        opti.subject_to(opti.bounded(-angle_max, ca.vec(X[6:8, :]), angle_max))
         opti.subject_to(X[2, :] <= 0)  # above the ground (z down)
         opti.subject_to(X[12, :] >= vehicle.dry_mass_kg / MASS_KG)
         opti.subject_to(X[:, 0] == x0)
@@ -159,7 +186,7 @@ class LandingProblem:
 
         opti.solver(
             "ipopt",
-            {"print_time": False, "expand": True},
+            {"print_time": False, "expand": True, "detect_simple_bounds": True},
             {
                 "print_level": 0,
                 "sb": "yes",
@@ -178,12 +205,12 @@ class LandingProblem:
         """Straight-line states from x0 to xf, hover throttle, rest attitude thrusters."""
         n = self.settings.n_nodes
         final = np.where(np.isnan(bc.final), bc.initial, bc.final)
-        s = np.linspace(0.0, 1.0, n)[:, None]
+        s = self.fractions[:, None]
         state = (1 - s) * bc.initial + s * final
         hover = np.clip(bc.initial[12] * self.vehicle.g_m_s2 / self.vehicle.thrust_main_N, 0, 1)
         control = np.zeros((n, 4))
         control[:, 0] = hover
-        return np.linspace(0.0, bc.tf_guess_s, n), state, control
+        return bc.tf_guess_s * self.fractions, state, control
 
     # -- solve -------------------------------------------------------------------------
     def solve(
@@ -213,7 +240,7 @@ class LandingProblem:
         eps = self.settings.epsilon
         cost = (1 - eps) * (bc.initial[12] - X[-1, 12]) + eps * TIME_S * float(value(self._effort))
         return Solution(
-            t=np.linspace(0.0, tf, self.settings.n_nodes),
+            t=tf * self.fractions,
             state=X,
             control=control,
             cost=float(cost),

@@ -121,9 +121,9 @@ class SampleResult:
         return self.method != "failed"
 
 
-def refine_guess(sol: Solution, n_nodes: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A solution interpolated onto n_nodes uniform nodes (warm start on a finer mesh)."""
-    t = np.linspace(0.0, sol.tf_s, n_nodes)
+def refine_guess(sol: Solution, fractions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A solution interpolated onto nodes at `fractions` of its t_f (warm start on a finer mesh)."""
+    t = sol.tf_s * fractions
     state = np.column_stack([np.interp(t, sol.t, c) for c in sol.state.T])
     control = np.column_stack([np.interp(t, sol.t, c) for c in sol.control.T])
     return t, state, control
@@ -175,7 +175,7 @@ def solve_by_continuation(
         if accepted(sol):
             return True
         if sol.success and fine_problem is not None:
-            log.append(fine_problem.solve(bc, refine_guess(sol, fine_problem.settings.n_nodes)))
+            log.append(fine_problem.solve(bc, refine_guess(sol, fine_problem.fractions)))
             return accepted(log[-1])
         return False
 
