@@ -1,7 +1,8 @@
 """Benchmark: trajectory solves, run time against re-integration error.
 
   python bench/trajectories.py mesh  [--config config/config.yaml]
-      N from 20 to 160, Hermite-Simpson vs trapezoidal, on each scenario's base problem:
+      N from 20 to 160, Hermite-Simpson (uniform and clustered nodes) vs trapezoidal, on
+      each scenario's base problem:
       solve time (median of --repeat) and final-state error after re-integrating the
       optimal controls with DOP853 (rtol 1e-10).
   python bench/trajectories.py batch [--config config/paper.yaml] [--jobs 2] [--nodes N]
@@ -42,23 +43,25 @@ def machine() -> str:
 
 
 def mesh(config: dict, repeat: int) -> None:
-    print("| scenario | transcription | N | iterations | solve (s, median) | final position error (m) | final velocity error (m/s) |")
-    print("|---|---|---|---|---|---|---|")
+    print("| scenario | transcription | mesh a | N | iterations | solve (s, median) | final position error (m) | final velocity error (m/s) |")
+    print("|---|---|---|---|---|---|---|---|")
     for name in config["scenarios"]:
         s = ScenarioSettings.from_config(config, name)
         dyn = Dynamics(s.vehicle)
         bc = base_conditions(s.scenario, s.vehicle)
-        for transcription, nodes in (("hermite-simpson", (20, 40, 60, 80, 120, 160)),
-                                     ("trapezoidal", (39, 79, 159, 319))):
+        for transcription, a, nodes in (("hermite-simpson", 0.0, (20, 40, 60, 80, 120, 160)),
+                                        ("hermite-simpson", 0.6, (20, 30, 40, 50, 60, 80)),
+                                        ("trapezoidal", 0.0, (39, 79, 159, 319))):
             for n in nodes:
-                problem = LandingProblem(s.vehicle, replace(s.ocp, n_nodes=n, transcription=transcription, refine_n_nodes=0))
+                problem = LandingProblem(s.vehicle, replace(s.ocp, n_nodes=n, transcription=transcription,
+                                                            mesh_clustering=a, refine_n_nodes=0))
                 problem.solve(bc)  # first solve pays for building the expanded functions
                 times, sol = [], None
                 for _ in range(repeat):
                     sol = problem.solve(bc)
                     times.append(sol.solve_time_s)
                 err = final_state_error(dyn, sol.t, sol.state, sol.control) if sol.success else (np.nan, np.nan)
-                print(f"| {name} | {transcription} | {n} | {sol.iterations} | {statistics.median(times):.3f} | "
+                print(f"| {name} | {transcription} | {a} | {n} | {sol.iterations} | {statistics.median(times):.3f} | "
                       f"{err[0]:.2e} | {err[1]:.2e} |", flush=True)
 
 

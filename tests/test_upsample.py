@@ -58,4 +58,4 @@ def test_shooting_check_agrees_with_dop853(solved30, dynamics):
     fast = ShootingCheck(dynamics)(solved30.t, solved30.state, solved30.control)
     reference = final_state_error(dynamics, solved30.t, solved30.state, solved30.control)
     assert fast[0] == pytest.approx(reference[0], abs=1e-5)
-    assert fast[1] == pytest.approx(reference[1], abs=1e-6)
+    assert fast[1] == pytest.approx(reference[1], abs=5e-6)  # 0.05 % of the 0.01 m/s it is compared with
