@@ -10,10 +10,17 @@
       re-integration check): wall time, share solved before / after retries, worst errors.
       Goal (issue 2): 500 trajectories on 2 cores <= 60 s, every error <= 0.1 m, 0.01 m/s.
       --verify re-checks every accepted sample with SciPy's DOP853 afterwards (not timed).
+  python bench/trajectories.py compare --a JSON --b JSON [--samples 30]
+      Two variants of the NLP solve the same samples alternately in one process (warm
+      start from each one's base solution): time ratio B/A, mean iterations, samples
+      accepted at 0.1 m / 0.01 m/s, worst error. JSON keys: ocp settings (n_nodes,
+      mesh_clustering, tol, ...) or IPOPT options (mu_init, ...), e.g.
+      --a '{}' --b '{"mu_init": 0.1}'.
 """
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
 import statistics
@@ -113,9 +120,39 @@ def batch(config: dict, jobs: int, nodes: int | None, clustering: float | None, 
         print(f"  {name}: DOP853 (rtol 1e-10) re-integration, worst final error {er:.3g} m / {ev:.3g} m/s")
 
 
+def compare(config: dict, a: dict, b: dict, n_samples: int) -> None:
+    from traj2events.scenarios import sample_conditions
+    from traj2events.upsample import ShootingCheck
+
+    print(f"A = {a}, B = {b}, {n_samples} samples per scenario")
+    for name in config["scenarios"]:
+        s = ScenarioSettings.from_config(config, name)
+        check = ShootingCheck(Dynamics(s.vehicle))
+        variants = []
+        for options in (a, b):
+            ocp = {k: v for k, v in options.items() if k in s.ocp.to_dict()}
+            ipopt = {k: v for k, v in options.items() if k not in ocp}
+            problem = LandingProblem(s.vehicle, replace(s.ocp, **ocp), ipopt)
+            variants.append((problem, problem.solve(base_conditions(s.scenario, s.vehicle))))
+        rows = [[], []]
+        for i in range(n_samples):
+            bc = sample_conditions(s.scenario, s.vehicle, s.seed, i)
+            for row, (problem, base) in zip(rows, variants):
+                sol = problem.solve(bc, (base.t, base.state, base.control))
+                err = check(sol.t, sol.state, sol.control) if sol.success else (np.inf, np.inf)
+                row.append((sol.solve_time_s, sol.iterations, err[0] <= 0.1 and err[1] <= 0.01, err[0]))
+        ra, rb = np.array(rows[0]), np.array(rows[1])
+        print(f"{name}: time B/A {rb[:, 0].sum() / ra[:, 0].sum():.3f}; iterations {ra[:, 1].mean():.1f} / "
+              f"{rb[:, 1].mean():.1f}; accepted {int(ra[:, 2].sum())} / {int(rb[:, 2].sum())}; "
+              f"worst error {ra[:, 3].max():.3g} / {rb[:, 3].max():.3g} m", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("mesh", "batch"))
+    parser.add_argument("what", choices=("mesh", "batch", "compare"))
+    parser.add_argument("--a", default="{}", help="compare: variant A as JSON")
+    parser.add_argument("--b", default="{}", help="compare: variant B as JSON")
+    parser.add_argument("--samples", type=int, default=30, help="compare: samples per scenario")
     parser.add_argument("--config", default=None, help="config YAML (mesh: config/config.yaml, batch: config/paper.yaml)")
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--nodes", type=int, default=None, help="override ocp.n_nodes (batch)")
@@ -126,7 +163,12 @@ def main() -> None:
     default = "config/config.yaml" if args.what == "mesh" else "config/paper.yaml"
     config = load_config(ROOT / (args.config or default), SCHEMA)
     print(f"# {args.what} on {machine()}, {time.strftime('%Y-%m-%d')}")
-    mesh(config, args.repeat) if args.what == "mesh" else batch(config, args.jobs, args.nodes, args.clustering, args.verify)
+    if args.what == "mesh":
+        mesh(config, args.repeat)
+    elif args.what == "batch":
+        batch(config, args.jobs, args.nodes, args.clustering, args.verify)
+    else:
+        compare(config, json.loads(args.a), json.loads(args.b), args.samples)
 
 
 if __name__ == "__main__":
