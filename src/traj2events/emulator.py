@@ -184,20 +184,21 @@ def _emit(active, n_active, count, x0, x1, theta_on, theta_off, base, last_event
 
 
 @njit(cache=True, nogil=True)
-def _splitmix(state):
-    """splitmix64: (next state, 53-bit uniform in [0, 1)). Counter-based, so a frame
-    interval's noise depends only on (seed, interval)."""
+def _splitmix_bits(state):
+    """splitmix64: (next state, 64 random bits). Counter-based (the state only adds a
+    constant), so a frame interval's noise depends only on (seed, interval)."""
     state = (state + np.uint64(0x9E3779B97F4A7C15)) & np.uint64(0xFFFFFFFFFFFFFFFF)
     z = state
     z = ((z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)) & np.uint64(0xFFFFFFFFFFFFFFFF)
     z = ((z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)) & np.uint64(0xFFFFFFFFFFFFFFFF)
-    z = z ^ (z >> np.uint64(31))
-    return state, np.float64(z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+    return state, z ^ (z >> np.uint64(31))
 
 
 @njit(cache=True)
 def _alias_table(weights):
-    """Walker/Vose alias table: sample index i with probability weights[i] / sum in O(1)."""
+    """Walker/Vose alias table: sample index i with probability weights[i] / sum in O(1).
+    Packed one uint64 per column, (acceptance probability * 2^32) << 31 | alias index, so
+    that a draw reads one 8-byte word at a random place instead of two arrays."""
     n = weights.size
     scaled = weights * (n / weights.sum())
     prob = np.ones(n)
@@ -226,31 +227,45 @@ def _alias_table(weights):
         else:
             large[nl] = l_i
             nl += 1
-    return prob, alias
+    packed = np.empty(n, np.uint64)
+    for i in range(n):
+        p32 = np.uint64(min(max(np.rint(prob[i] * 4294967296.0), 0.0), 4294967296.0))  # 33 bits
+        packed[i] = (p32 << np.uint64(31)) | np.uint64(alias[i])
+    return packed
 
 
 @njit(cache=True, nogil=True)
-def _noise_candidates(n, state, prob, alias, intensity, g_max, t0, dt, out_pix, out_t, out_p):
+def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t, out_p):
     """Shot noise by thinning: n candidates at the majorant rate R g_max theta_nom/theta(x),
     their pixel drawn in proportion to theta_nom/theta(x) (alias table), each kept with
-    probability g(I) / g_max; ON or OFF with equal odds."""
-    n_pixels = prob.size
+    probability g(I) / g_max; ON or OFF with equal odds. Three splitmix draws per candidate
+    (pixel and alias coin; keep; time and polarity). Written without data-dependent
+    branches (every candidate is stored, the count advances only if kept): a mispredicted
+    branch would cancel the next candidates' table reads, which are random and slow."""
+    n_pixels = np.uint64(table.size)
+    low32 = np.uint64(0xFFFFFFFF)
+    low31 = np.uint64(0x7FFFFFFF)
     k = 0
     for _ in range(n):
-        state, u = _splitmix(state)
-        column = min(np.int64(u * n_pixels), n_pixels - 1)
-        state, u = _splitmix(state)
-        i = column if u < prob[column] else alias[column]
-        state, u_t = _splitmix(state)
-        state, u_keep = _splitmix(state)
-        state, u_on = _splitmix(state)
+        state, bits = _splitmix_bits(state)
+        column = ((bits >> np.uint64(32)) * n_pixels) >> np.uint64(32)
+        entry = table[column]
+        i = np.int64(column if (bits & low32) < (entry >> np.uint64(31)) else entry & low31)
+        state, keep_bits = _splitmix_bits(state)
+        state, bits = _splitmix_bits(state)
         g = max(1.0 - 0.75 * (np.float64(intensity[i]) + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
-        if u_keep * g_max < g:
-            out_pix[k] = i
-            out_t[k] = t0 + dt * u_t
-            out_p[k] = u_on < 0.5
-            k += 1
+        out_pix[k] = i
+        out_t[k] = t0 + dt * (np.float64(bits >> np.uint64(11)) * (1.0 / 9007199254740992.0))
+        out_p[k] = (bits & np.uint64(1)) == np.uint64(1)
+        k += np.int64(np.float64(keep_bits >> np.uint64(11)) * (g_max / 9007199254740992.0) < g)
     return k
+
+
+@njit(cache=True, nogil=True)
+def _reset_reference(pix, base, filtered):
+    """A noise event sets its pixel's reference to the current signal."""
+    for j in range(pix.size):
+        base[pix[j]] = filtered[pix[j]]
 
 
 @njit(cache=True, nogil=True)
@@ -280,9 +295,7 @@ def _assemble(pix: np.ndarray, t_s: np.ndarray, on: np.ndarray, width: int, n_pi
     key = _order_keys(pix, t_s, on, n_pixels)
     key.sort()
     out = np.empty(key.size, EVENT_DTYPE)
-    x, y, t, p = (np.empty(key.size, out.dtype[f]) for f in ("x", "y", "t", "p"))
-    _decode_keys(key, width, n_pixels, x, y, t, p)
-    out["x"], out["y"], out["t"], out["p"] = x, y, t, p
+    _decode_keys(key, width, n_pixels, out["x"], out["y"], out["t"], out["p"])  # field views: no copies
     return out
 
 
@@ -316,7 +329,10 @@ class EventEmulator:
         self._intensity: np.ndarray | None = None  # input (DN) at the last frame
         self._base: np.ndarray | None = None
         self._last_event = np.full(n, -np.inf)  # s
-        self._leak_step = self.theta_on * self.leak_rate  # base's drift per second (one array to read)
+        # Base's drift per second, and the thresholds, in float32 for the per-frame pass: it
+        # is memory-bound, and these are random draws whose last bits carry nothing.
+        self._leak_step = (self.theta_on * self.leak_rate).astype(np.float32)
+        self.theta_on, self.theta_off = self.theta_on.astype(np.float32), self.theta_off.astype(np.float32)
         # Work arrays of the compiled kernels, reused every frame.
         self._count = np.zeros(n, np.int64)
         self._x0 = np.zeros(n)
@@ -406,7 +422,7 @@ class EventEmulator:
         pix = np.empty(n, np.int64)
         t = np.empty(n, np.float64)
         on = np.empty(n, np.bool_)
-        k = _noise_candidates(n, state, self._alias[0], self._alias[1], intensity, self._g_max, t0, dt, pix, t, on)
+        k = _noise_candidates(n, state, self._alias, intensity, self._g_max, t0, dt, pix, t, on)
         pix, t, on = pix[:k], t[:k], on[:k]
         if p.refractory_s > 0:
             order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
@@ -415,7 +431,7 @@ class EventEmulator:
             pix, t, on = pix[keep], t[keep], on[keep]
         # A noise event resets the pixel like a real one: its reference jumps to the current
         # signal (for a real crossing that is base +- theta). Applied at the interval's end.
-        self._base[pix] = self._filtered[pix]
+        _reset_reference(pix, self._base, self._filtered)
         return pix, t, on
 
     def _hot_pixel_events(self, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
