@@ -238,8 +238,9 @@ def _alias_table(weights):
 def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t, out_p):
     """Shot noise by thinning: n candidates at the majorant rate R g_max theta_nom/theta(x),
     their pixel drawn in proportion to theta_nom/theta(x) (alias table), each kept with
-    probability g(I) / g_max; ON or OFF with equal odds. Three splitmix draws per candidate
-    (pixel and alias coin; keep; time and polarity). Written without data-dependent
+    probability g(I) / g_max; ON or OFF with equal odds. Two splitmix draws per candidate:
+    pixel (high 32 bits) and alias coin (low 32); keep (high 32), time within the interval
+    (31 bits: 5 ps steps at 10 ms, 5 ns at 10 s) and polarity (1). Written without data-dependent
     branches (every candidate is stored, the count advances only if kept): a mispredicted
     branch would cancel the next candidates' table reads, which are random and slow."""
     n_pixels = np.uint64(table.size)
@@ -251,13 +252,12 @@ def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t,
         column = ((bits >> np.uint64(32)) * n_pixels) >> np.uint64(32)
         entry = table[column]
         i = np.int64(column if (bits & low32) < (entry >> np.uint64(31)) else entry & low31)
-        state, keep_bits = _splitmix_bits(state)
         state, bits = _splitmix_bits(state)
         g = max(1.0 - 0.75 * (np.float64(intensity[i]) + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
         out_pix[k] = i
-        out_t[k] = t0 + dt * (np.float64(bits >> np.uint64(11)) * (1.0 / 9007199254740992.0))
+        out_t[k] = t0 + dt * (np.float64((bits & low32) >> np.uint64(1)) * (1.0 / 2147483648.0))
         out_p[k] = (bits & np.uint64(1)) == np.uint64(1)
-        k += np.int64(np.float64(keep_bits >> np.uint64(11)) * (g_max / 9007199254740992.0) < g)
+        k += np.int64(np.float64(bits >> np.uint64(32)) * (g_max / 4294967296.0) < g)
     return k
 
 
