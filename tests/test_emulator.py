@@ -127,6 +127,32 @@ def test_shot_noise_rate_balance_and_exponential_intervals():
     assert stats.kstest(gaps, "expon", args=(0, gaps.mean())).pvalue > 0.001
 
 
+@pytest.mark.parametrize("weights", [[1.0, 2.0, 3.0, 4.0], [1.0] * 7 + [25.0]])
+def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
+    # The packed alias table and the branch-free thinning kernel, directly: with I = 0 every
+    # candidate is kept (g = g_max), so the counts follow the weights alone.
+    from traj2events.emulator import _alias_table, _noise_candidates
+
+    weights = np.array(weights)
+    n = 400_000
+    pix, t, on = np.empty(n, np.int64), np.empty(n), np.empty(n, np.bool_)
+    g_max = 1.0 - 0.75 * 20.0 / 275.0
+    k = _noise_candidates(n, np.uint64(12345), _alias_table(weights), np.zeros(len(weights), np.uint8), g_max,
+                          2.0, 0.01, pix, t, on)
+    assert k == n
+    expected = n * weights / weights.sum()
+    counts = np.bincount(pix, minlength=len(weights))
+    assert np.all(np.abs(counts - expected) < 5 * np.sqrt(expected))
+    assert 2.0 <= t.min() and t.max() < 2.01
+    assert stats.kstest((t - 2.0) / 0.01, "uniform").pvalue > 0.001
+    assert on.mean() == pytest.approx(0.5, abs=5 * 0.5 / np.sqrt(n))
+    # Bright pixels keep only g(I) / g_max of their candidates.
+    bright = np.full(len(weights), 255, np.uint8)
+    kept = _noise_candidates(n, np.uint64(7), _alias_table(weights), bright, g_max, 0.0, 0.01, pix, t, on)
+    g = 1 - 0.75 * (255 + 20) / 275
+    assert kept == pytest.approx(n * g / g_max, abs=5 * np.sqrt(n * 0.25))
+
+
 def test_leak_is_on_only_at_the_expected_mean_rate():
     params = replace(CLEAN, leak_hz=0.5)
     h, w, seconds = 60, 60, 20.0
