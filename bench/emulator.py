@@ -7,9 +7,9 @@ edges everywhere produce events (~0.04 events per pixel per frame, about half of
 shot noise); and at 1024 x 1024 the same texture under a light flickering at 10 Hz
 (brightness x1 / x0.15, ~0.08 events per pixel per frame). The paper preset's 3 Hz
 photoreceptor low-pass caps how many events a pixel can give, however fast the texture
-moves: sliding it 8 px per frame instead of 2 gave no more events. Prints frames/s and events/s at 346 x 260 (DAVIS346) and
-1024 x 1024, the bytes per event of events.h5 (DSEC layout, Blosc/zstd) and the peak
-resident memory. Goal (issue 5): >= 120 frames/s at
+moves: sliding it 8 px per frame instead of 2 gave no more events. Prints frames/s and
+events/s at 346 x 260 (DAVIS346) and 1024 x 1024, the bytes per event of events.h5 (DSEC
+layout, Blosc/zstd) and the peak resident memory. Goal (issue 5): >= 120 frames/s at
 1024 x 1024 and >= 1e7 events/s (v2e's own loop: ~6 frames/s at 1024 x 1024).
 """
 from __future__ import annotations

@@ -13,7 +13,7 @@
   python bench/trajectories.py compare --a JSON --b JSON [--samples 30]
       Two variants of the NLP solve the same samples alternately in one process (warm
       start from each one's base solution): time ratio B/A, mean iterations, samples
-      accepted at 0.1 m / 0.01 m/s, worst error. JSON keys: ocp settings (n_nodes,
+      accepted (ocp.accept_error_m / _m_s, as the workflow), worst error. JSON keys: ocp settings (n_nodes,
       mesh_clustering, tol, ...) or IPOPT options (mu_init, ...), e.g.
       --a '{}' --b '{"mu_init": 0.1}'.
 """
@@ -39,8 +39,8 @@ from traj2events.batch import solve_samples  # noqa: E402
 from traj2events.config import ScenarioSettings, load_config  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.ocp import LandingProblem  # noqa: E402
-from traj2events.scenarios import base_conditions  # noqa: E402
-from traj2events.upsample import final_state_error  # noqa: E402
+from traj2events.scenarios import base_conditions, sample_conditions  # noqa: E402
+from traj2events.upsample import ShootingCheck, final_state_error  # noqa: E402
 
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
@@ -121,9 +121,6 @@ def batch(config: dict, jobs: int, nodes: int | None, clustering: float | None, 
 
 
 def compare(config: dict, a: dict, b: dict, n_samples: int) -> None:
-    from traj2events.scenarios import sample_conditions
-    from traj2events.upsample import ShootingCheck
-
     print(f"A = {a}, B = {b}, {n_samples} samples per scenario")
     for name in config["scenarios"]:
         s = ScenarioSettings.from_config(config, name)
@@ -140,7 +137,8 @@ def compare(config: dict, a: dict, b: dict, n_samples: int) -> None:
             for row, (problem, base) in zip(rows, variants):
                 sol = problem.solve(bc, (base.t, base.state, base.control))
                 err = check(sol.t, sol.state, sol.control) if sol.success else (np.inf, np.inf)
-                row.append((sol.solve_time_s, sol.iterations, err[0] <= 0.1 and err[1] <= 0.01, err[0]))
+                accepted = err[0] <= problem.settings.accept_error_m and err[1] <= problem.settings.accept_error_m_s
+                row.append((sol.solve_time_s, sol.iterations, accepted, err[0]))
         ra, rb = np.array(rows[0]), np.array(rows[1])
         print(f"{name}: time B/A {rb[:, 0].sum() / ra[:, 0].sum():.3f}; iterations {ra[:, 1].mean():.1f} / "
               f"{rb[:, 1].mean():.1f}; accepted {int(ra[:, 2].sum())} / {int(rb[:, 2].sum())}; "

@@ -125,7 +125,8 @@ def cmd_upsample(args) -> int:
                                      "error_velocity_m_s")}
     attrs = {**vehicle_attrs(s.vehicle), **solve, "fps": args.fps, "upsampling": args.method,
              "scenario": s.scenario.name, "id": args.id, "seed": s.seed, "epsilon": s.ocp.epsilon,
-             "mesh_clustering": s.ocp.mesh_clustering, "continuation": sample["method"], "traj2events_version": __version__}
+             "mesh_clustering": s.ocp.mesh_clustering, "continuation": sample["method"],
+             "traj2events_version": __version__}
     write_trajectory(args.output, (t, state, control), poses, attrs)
     return 0
 

@@ -329,8 +329,8 @@ class EventEmulator:
         self._intensity: np.ndarray | None = None  # input (DN) at the last frame
         self._base: np.ndarray | None = None
         self._last_event = np.full(n, -np.inf)  # s
-        # Base's drift per second, and the thresholds, in float32 for the per-frame pass: it
-        # is memory-bound, and these are random draws whose last bits carry nothing.
+        # Base's drift per second, and the thresholds, in float32: less for the per-frame
+        # pass to read, and these are random draws whose last bits carry nothing.
         self._leak_step = (self.theta_on * self.leak_rate).astype(np.float32)
         self.theta_on, self.theta_off = self.theta_on.astype(np.float32), self.theta_off.astype(np.float32)
         # Work arrays of the compiled kernels, reused every frame.

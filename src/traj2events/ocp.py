@@ -9,9 +9,8 @@ Transcriptions: Hermite-Simpson with piecewise-linear controls (the midpoint con
 the mean of its nodes: quadratic interpolants overshoot their bounds where controls
 saturate, trajectories.md), or trapezoidal; Hermite-Simpson in the compressed form
 (midpoint states substituted). Nodes may cluster toward both ends (`mesh_clustering`),
-where landings turn fastest. The problem is solved in
-nondimensional variables (1000 m, 100 m/s, 10 s, 1e4 kg), which IPOPT needs far fewer
-iterations for, with MUMPS' own scaling off (bounded iteration counts for every t_f
+where landings turn fastest. The problem is solved in nondimensional variables (1000 m,
+100 m/s, 10 s, 1e4 kg), which IPOPT needs far fewer iterations for, with MUMPS' own scaling off (bounded iteration counts for every t_f
 guess) and constant bounds given to IPOPT as variable bounds (they then hold at every
 iterate, and the KKT system is smaller). It is built once and solved many times with
 new boundary conditions.
