@@ -11,6 +11,11 @@ moves: sliding it 8 px per frame instead of 2 gave no more events. Prints frames
 events/s at 346 x 260 (DAVIS346) and 1024 x 1024, the bytes per event of events.h5 (DSEC
 layout, Blosc/zstd) and the peak resident memory. Goal (issue 5): >= 120 frames/s at
 1024 x 1024 and >= 1e7 events/s (v2e's own loop: ~6 frames/s at 1024 x 1024).
+
+  python bench/emulator.py --profile
+
+prints instead where a 1024 x 1024 interval's time goes (ms per frame in each compiled
+kernel and in the whole interval), for the texture and the flicker input.
 """
 from __future__ import annotations
 
@@ -28,6 +33,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import numpy as np  # noqa: E402
 from scipy.ndimage import gaussian_filter  # noqa: E402
 
+import traj2events.emulator as emulator  # noqa: E402
 from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.io import EventsWriter  # noqa: E402
 
@@ -46,10 +52,46 @@ def flickering(frames: np.ndarray, period_frames: int, dim: float) -> np.ndarray
     return np.clip(frames * gain[:, None, None], 0, 255).round().astype(np.uint8)
 
 
+def profile(n_frames: int) -> None:
+    """Time spent per 1024 x 1024 interval in each kernel (wrapped in timers: ~1 us each)."""
+    spent: dict[str, float] = {}
+
+    def timed(name, function):
+        def wrapper(*args, **kwargs):
+            start = time.perf_counter()
+            result = function(*args, **kwargs)
+            spent[name] = spent.get(name, 0.0) + time.perf_counter() - start
+            return result
+        return wrapper
+
+    for name in ("_advance", "_emit", "_noise_candidates", "_reset_reference", "_assemble"):
+        setattr(emulator, name, timed(name, getattr(emulator, name)))
+    EventEmulator._interval_events = timed("whole interval", EventEmulator._interval_events)
+    print("| input | frames/s | " + " | ".join(("frame pass", "event times", "noise", "reference resets",
+                                                  "ordering", "whole interval")) + " |")
+    print("|---|---|---|---|---|---|---|---|")
+    texture = moving_texture(1024, 1024, n_frames)
+    for label, frames in (("texture", texture), ("10 Hz flicker", flickering(texture, 10, 0.15))):
+        times = np.arange(n_frames) / 100.0
+        EventEmulator(1024, 1024, PRESETS["paper"], seed=0).process(frames[:2], times[:2])
+        spent.clear()
+        emu = EventEmulator(1024, 1024, PRESETS["paper"], seed=1)
+        start = time.perf_counter()
+        for k in range(0, n_frames, 10):
+            emu.process(frames[k:k + 10], times[k:k + 10])
+        elapsed = time.perf_counter() - start
+        ms = [spent[name] / (n_frames - 1) * 1e3 for name in ("_advance", "_emit", "_noise_candidates",
+                                                               "_reset_reference", "_assemble", "whole interval")]
+        print(f"| {label} | {(n_frames - 1) / elapsed:.0f} | " + " | ".join(f"{m:.2f} ms" for m in ms) + " |")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=100)
+    parser.add_argument("--profile", action="store_true", help="time per kernel instead (1024 x 1024)")
     args = parser.parse_args()
+    if args.profile:
+        return profile(args.frames)
     print(f"# emulator, paper preset, 1 thread, on {platform.node()} ({os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}")
     print("| size | input | frames | frames/s | events | events/s | events per pixel per frame | bytes/event on disk |")
     print("|---|---|---|---|---|---|---|---|")
