@@ -259,6 +259,24 @@ PREFETCH_AHEAD = 32  # candidates whose table entry is requested before it is re
 
 
 @njit(cache=True, nogil=True)
+def _alias_column(bits, n_pixels):
+    """The alias-table column a candidate's pixel draw (high 32 bits) lands on."""
+    return ((bits >> np.uint64(32)) * n_pixels) >> np.uint64(32)
+
+
+@njit(cache=True, nogil=True)
+def _draw_ahead(state, slot, pixel_bits, keep_bits, n_pixels, table, intensity):
+    """A candidate's two draws into the ring's slot, its table and intensity reads
+    requested now; returns the generator's next state."""
+    state, pixel_bits[slot] = _splitmix_bits(state)
+    state, keep_bits[slot] = _splitmix_bits(state)
+    column = _alias_column(pixel_bits[slot], n_pixels)
+    _prefetch(table, column)
+    _prefetch(intensity, column)
+    return state
+
+
+@njit(cache=True, nogil=True)
 def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t, out_p):
     """Shot noise by thinning: n candidates at the majorant rate R g_max theta_nom/theta(x),
     their pixel drawn in proportion to theta_nom/theta(x) (alias table), each kept with
@@ -276,16 +294,12 @@ def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t,
     pixel_bits = np.empty(PREFETCH_AHEAD, np.uint64)  # ring of the draws made ahead
     keep_bits = np.empty(PREFETCH_AHEAD, np.uint64)
     for c in range(min(PREFETCH_AHEAD, n)):
-        state, pixel_bits[c] = _splitmix_bits(state)
-        state, keep_bits[c] = _splitmix_bits(state)
-        column = np.int64(((pixel_bits[c] >> np.uint64(32)) * n_pixels) >> np.uint64(32))
-        _prefetch(table, column)
-        _prefetch(intensity, column)
+        state = _draw_ahead(state, c, pixel_bits, keep_bits, n_pixels, table, intensity)
     k = 0
     for c in range(n):
         slot = c % PREFETCH_AHEAD
         bits, bits2 = pixel_bits[slot], keep_bits[slot]
-        column = ((bits >> np.uint64(32)) * n_pixels) >> np.uint64(32)
+        column = _alias_column(bits, n_pixels)
         entry = table[column]
         i = np.int64(column if (bits & low32) < (entry >> np.uint64(31)) else entry & low31)
         g = max(1.0 - 0.75 * (np.float64(intensity[i]) + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
@@ -294,11 +308,7 @@ def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t,
         out_p[k] = (bits2 & np.uint64(1)) == np.uint64(1)
         k += np.int64(np.float64(bits2 >> np.uint64(32)) * (g_max / 4294967296.0) < g)
         if c + PREFETCH_AHEAD < n:  # the candidate PREFETCH_AHEAD ahead takes this slot
-            state, pixel_bits[slot] = _splitmix_bits(state)
-            state, keep_bits[slot] = _splitmix_bits(state)
-            ahead = np.int64(((pixel_bits[slot] >> np.uint64(32)) * n_pixels) >> np.uint64(32))
-            _prefetch(table, ahead)
-            _prefetch(intensity, ahead)
+            state = _draw_ahead(state, slot, pixel_bits, keep_bits, n_pixels, table, intensity)
     return k
 
 
