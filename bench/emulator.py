@@ -52,6 +52,21 @@ def flickering(frames: np.ndarray, period_frames: int, dim: float) -> np.ndarray
     return np.clip(frames * gain[:, None, None], 0, 255).round().astype(np.uint8)
 
 
+def load_kernels(frames: np.ndarray) -> None:
+    """Load (or compile) the kernels for this input type, so that no timing includes it."""
+    EventEmulator(frames.shape[2], frames.shape[1], PRESETS["paper"], seed=0).process(frames[:2], [0.0, 0.01])
+
+
+def emulate_timed(frames: np.ndarray) -> tuple[list[np.ndarray], float]:
+    """Paper preset at 100 fps, streamed in chunks of 10 frames: (event chunks, seconds)."""
+    n_frames, height, width = frames.shape
+    times = np.arange(n_frames) / 100.0
+    emu = EventEmulator(width, height, PRESETS["paper"], seed=1)
+    start = time.perf_counter()
+    chunks = [emu.process(frames[k:k + 10], times[k:k + 10]) for k in range(0, n_frames, 10)]
+    return chunks, time.perf_counter() - start
+
+
 def profile(n_frames: int) -> None:
     """Time spent per 1024 x 1024 interval in each kernel (wrapped in timers: ~1 us each)."""
     spent: dict[str, float] = {}
@@ -64,24 +79,20 @@ def profile(n_frames: int) -> None:
             return result
         return wrapper
 
-    for name in ("_advance", "_emit", "_noise_candidates", "_reset_reference", "_assemble"):
+    columns = {"_advance": "frame pass", "_emit": "event times", "_noise_candidates": "noise",
+               "_reset_reference": "reference resets", "_assemble": "ordering"}
+    for name in columns:
         setattr(emulator, name, timed(name, getattr(emulator, name)))
     EventEmulator._interval_events = timed("whole interval", EventEmulator._interval_events)
-    print("| input | frames/s | " + " | ".join(("frame pass", "event times", "noise", "reference resets",
-                                                  "ordering", "whole interval")) + " |")
-    print("|---|---|---|---|---|---|---|---|")
+    columns["whole interval"] = "whole interval"
+    print("| input | frames/s | " + " | ".join(columns.values()) + " |")
+    print("|---" * (len(columns) + 2) + "|")
     texture = moving_texture(1024, 1024, n_frames)
     for label, frames in (("texture", texture), ("10 Hz flicker", flickering(texture, 10, 0.15))):
-        times = np.arange(n_frames) / 100.0
-        EventEmulator(1024, 1024, PRESETS["paper"], seed=0).process(frames[:2], times[:2])
+        load_kernels(frames)
         spent.clear()
-        emu = EventEmulator(1024, 1024, PRESETS["paper"], seed=1)
-        start = time.perf_counter()
-        for k in range(0, n_frames, 10):
-            emu.process(frames[k:k + 10], times[k:k + 10])
-        elapsed = time.perf_counter() - start
-        ms = [spent[name] / (n_frames - 1) * 1e3 for name in ("_advance", "_emit", "_noise_candidates",
-                                                               "_reset_reference", "_assemble", "whole interval")]
+        _, elapsed = emulate_timed(frames)
+        ms = [spent[name] / (n_frames - 1) * 1e3 for name in columns]
         print(f"| {label} | {(n_frames - 1) / elapsed:.0f} | " + " | ".join(f"{m:.2f} ms" for m in ms) + " |")
 
 
@@ -103,21 +114,13 @@ def main() -> None:
         frames = moving_texture(height, width, args.frames)
         if flicker:
             frames = flickering(frames, period_frames=10, dim=0.15)
-        times = np.arange(args.frames) / 100.0
-        # Load (or compile) the kernels outside the timing, for both input types.
-        EventEmulator(width, height, PRESETS["paper"], seed=0).process(frames[:2], times[:2])
-        emu = EventEmulator(width, height, PRESETS["paper"], seed=1)
-        start = time.perf_counter()
-        n_events = 0
-        chunks = []
-        for k in range(0, args.frames, 10):  # streamed in chunks of 10 frames
-            chunks.append(emu.process(frames[k:k + 10], times[k:k + 10]))
-            n_events += len(chunks[-1])
-        elapsed = time.perf_counter() - start
+        load_kernels(frames)
+        chunks, elapsed = emulate_timed(frames)
+        n_events = sum(len(c) for c in chunks)
         writer = EventsWriter(out / "events.h5", width, height, {})
         for c in chunks:
             writer.append(c)
-        writer.close(int(times[-1] * 1e6))
+        writer.close(int((args.frames - 1) / 100.0 * 1e6))
         per_event = (out / "events.h5").stat().st_size / max(n_events, 1)
         fps = (args.frames - 1) / elapsed
         print(f"| {width} x {height} | {label} | {args.frames} | {fps:.1f} | {n_events} | {n_events / elapsed:.3g} | "
