@@ -35,7 +35,7 @@ from scipy.ndimage import gaussian_filter  # noqa: E402
 
 import traj2events.emulator as emulator  # noqa: E402
 from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
-from traj2events.io import EventsWriter  # noqa: E402
+from traj2events.formats.events import EventsWriter  # noqa: E402
 
 
 def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.ndarray:

@@ -32,7 +32,7 @@ import numpy as np  # noqa: E402
 
 from traj2events.camera import Camera, camera_pose  # noqa: E402
 from traj2events.illumination import Sun  # noqa: E402
-from traj2events.io import round_mantissa  # noqa: E402
+from traj2events.formats.frames import round_mantissa  # noqa: E402
 from traj2events.reflectance import ReflectanceParams  # noqa: E402
 from traj2events.render import TerrainRenderer  # noqa: E402
 from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402

@@ -36,13 +36,13 @@ sys.path.insert(0, str(ROOT / "src"))
 import numpy as np  # noqa: E402
 
 from traj2events.batch import solve_samples  # noqa: E402
-from traj2events.config import ScenarioSettings, load_config  # noqa: E402
+from traj2events.config import load_config  # noqa: E402
+from traj2events.scenarios import ScenarioSettings  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.ocp import LandingProblem  # noqa: E402
 from traj2events.scenarios import base_conditions, sample_conditions  # noqa: E402
 from traj2events.upsample import ShootingCheck, final_state_error  # noqa: E402
 
-SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
 def machine() -> str:
@@ -159,7 +159,7 @@ def main() -> None:
     parser.add_argument("--verify", action="store_true", help="batch: re-check every sample with DOP853 afterwards")
     args = parser.parse_args()
     default = "config/config.yaml" if args.what == "mesh" else "config/paper.yaml"
-    config = load_config(ROOT / (args.config or default), SCHEMA)
+    config = load_config(ROOT / (args.config or default))
     print(f"# {args.what} on {machine()}, {time.strftime('%Y-%m-%d')}")
     if args.what == "mesh":
         mesh(config, args.repeat)

@@ -8,7 +8,6 @@ from traj2events.dynamics import Dynamics, Vehicle
 from traj2events.ocp import BoundaryConditions, LandingProblem, OcpSettings
 
 ROOT = Path(__file__).resolve().parents[1]
-SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
 def landing_bc(downrange=1500.0, altitude=600.0, speed=15.0, pitch_deg=5.0, mass=10_000.0, tf_guess=50.0):

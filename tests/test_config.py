@@ -1,4 +1,5 @@
-"""Config validation: every class of mistake stops with a message naming the key."""
+"""Config: overlays on the one set of defaults, and validation that names the key of every
+class of mistake."""
 import copy
 import subprocess
 import sys
@@ -6,28 +7,30 @@ import sys
 import pytest
 import yaml
 
-from traj2events.config import ConfigError, ScenarioSettings, load_config, load_yaml, validate_config
+from traj2events.config import SCHEMA_PATH, ConfigError, load_config, load_yaml, resolve_config, validate_config
+from traj2events.defaults import default_config, merge_config
+from traj2events.scenarios import ScenarioSettings
 
-from conftest import ROOT, SCHEMA
+from conftest import ROOT
 
 
 @pytest.fixture(scope="module")
 def schema():
-    return load_yaml(SCHEMA)
+    return load_yaml(SCHEMA_PATH)
 
 
 @pytest.fixture()
 def config():
-    return load_yaml(ROOT / "config" / "config.yaml")
+    return default_config()
 
 
 @pytest.mark.parametrize("name", ["config.yaml", "smoke.yaml", "paper.yaml"])
 def test_shipped_configs_are_valid(name):
-    load_config(ROOT / "config" / name, SCHEMA)
+    load_config(ROOT / "config" / name)
 
 
 def test_paper_config_has_500_trajectories():
-    config = load_config(ROOT / "config" / "paper.yaml", SCHEMA)
+    config = load_config(ROOT / "config" / "paper.yaml")
     assert sum(s["n_trajectories"] for s in config["scenarios"].values()) == 500
 
 
@@ -105,7 +108,7 @@ def test_cli_check_config_reports_the_key(tmp_path, config):
     config["camera"]["fps"] = -5
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(config))
-    run = subprocess.run([sys.executable, "-m", "traj2events.cli", "check-config", str(path), "--schema", str(SCHEMA)],
+    run = subprocess.run([sys.executable, "-m", "traj2events.cli", "check-config", str(path)],
                          capture_output=True, text=True)
     assert run.returncode == 2
     assert "camera.fps" in run.stderr
@@ -123,7 +126,78 @@ def test_missing_or_broken_file_is_named(tmp_path):
 def test_motion_field_cli_names_a_missing_trajectory(tmp_path):
     run = subprocess.run([sys.executable, "-m", "traj2events.cli", "motion-field", str(tmp_path / "nope.h5"),
                           "--width", "8", "--height", "8", "--fov-deg", "45", "--output", str(tmp_path / "m.h5"),
-                          "--flo-dir", str(tmp_path / "flow"), "--figure", str(tmp_path / "m.png")],
+                          "--flo-dir", str(tmp_path / "flow")],
                          capture_output=True, text=True)
     assert run.returncode == 2 and "nope.h5" in run.stderr
     assert not (tmp_path / "m.h5").exists() and not (tmp_path / "flow").exists()
+
+
+def test_overlays_hold_only_what_differs_from_the_defaults():
+    smoke = load_yaml(ROOT / "config" / "smoke.yaml")
+    config = load_config(ROOT / "config" / "smoke.yaml")
+    assert list(config["scenarios"]) == ["descent"]  # the others are set to null
+    assert config["camera"]["width"] == 32 and config["camera"]["fov_deg"] == default_config()["camera"]["fov_deg"]
+    assert config["ocp"]["n_nodes"] == 30 and config["ocp"]["tol"] == default_config()["ocp"]["tol"]
+    assert len(yaml.safe_dump(smoke)) < len(yaml.safe_dump(config)) / 5
+    assert load_config(ROOT / "config" / "config.yaml") == default_config()
+
+
+def test_merge_replaces_values_and_merges_mappings():
+    base = {"a": {"b": 1, "c": [1, 2]}, "scenarios": {"x": {"n": 1, "sun": {"az": 1, "el": 2}}, "y": {"n": 2}}}
+    merged = merge_config(base, {"a": {"c": [3]}, "scenarios": {"x": {"sun": {"el": 5}}, "y": None, "z": {"n": 3}}})
+    assert merged == {"a": {"b": 1, "c": [3]}, "scenarios": {"x": {"n": 1, "sun": {"az": 1, "el": 5}}, "z": {"n": 3}}}
+    assert base["scenarios"]["x"]["sun"]["el"] == 2  # the base is not modified
+
+
+def test_a_new_scenario_must_be_complete():
+    with pytest.raises(ConfigError, match=r"scenarios.hover.tf_guess_s"):
+        resolve_config({"scenarios": {"hover": {"n_trajectories": 1}}})
+
+
+@pytest.mark.parametrize("name", ["logs", "figures"])
+def test_reserved_scenario_names_are_refused(name):
+    config = default_config()
+    config["scenarios"][name] = config["scenarios"]["descent"]
+    with pytest.raises(ConfigError, match=rf"scenarios.{name}.*reserved"):
+        validate_config(config)
+
+
+def test_dataclass_defaults_come_from_the_defaults_file():
+    from dataclasses import fields
+
+    from traj2events.ocp import OcpSettings
+    from traj2events.reflectance import ReflectanceParams
+    from traj2events.state import Vehicle
+    from traj2events.terrain import TerrainParams
+    from traj2events.tiles import LodSettings
+
+    d = default_config()
+    for cls, values in ((OcpSettings, d["ocp"]), (Vehicle, d["vehicle"]), (LodSettings, d["render"]["lod"]),
+                        (ReflectanceParams, d["render"]["reflectance"]),
+                        (TerrainParams, {k: v for k, v in d["terrain"].items() if k not in ("elevation_grid", "grid_spacing_m")})):
+        defaults = {f.name: f.default for f in fields(cls) if f.name in values}
+        assert set(defaults) == set(values), cls  # every config key is a field
+        assert {k: (list(v) if isinstance(v, tuple) else v) for k, v in defaults.items()} == values, cls
+
+
+def test_cli_defaults_come_from_the_defaults_file():
+    from traj2events.cli import build_parser
+
+    d = default_config()
+    args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f"])
+    assert (args.width, args.fov_deg, args.every) == (d["camera"]["width"], d["camera"]["fov_deg"],
+                                                      d["motion_field"]["every_n_frames"])
+    args = build_parser().parse_args(["events", "in.mkv", "-o", "e.h5"])
+    assert (args.preset, args.refractory_mode, args.window_ms) == (d["events"]["preset"], d["events"]["refractory_mode"],
+                                                                  d["events"]["window_ms"])
+
+
+def test_non_utf8_and_non_mapping_configs_are_named(tmp_path):
+    latin = tmp_path / "latin.yaml"
+    latin.write_bytes("seed: 1 # caf\xe9\n".encode("latin-1"))
+    with pytest.raises(ConfigError, match="latin.yaml.*UTF-8"):
+        load_config(latin)
+    listing = tmp_path / "list.yaml"
+    listing.write_text("- 1\n- 2\n")
+    with pytest.raises(ConfigError, match="list.yaml.*mapping"):
+        load_config(listing)

@@ -8,7 +8,8 @@ from PIL import Image
 
 from traj2events.cli import main
 from traj2events.emulator import EVENT_DTYPE
-from traj2events.io import EventsWriter, read_events, read_events_window, write_elope_npz, write_faery
+from traj2events.formats.events import EventsWriter, read_events, read_events_window
+from traj2events.formats.exports import write_elope_npz, write_faery
 from traj2events.video import VideoWriter
 
 

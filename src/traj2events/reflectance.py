@@ -24,21 +24,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .defaults import section
+
 MODELS = ("hapke", "lunar-lambert")
+
+
+_REFLECTANCE = section("render")["reflectance"]
 
 
 @dataclass(frozen=True)
 class ReflectanceParams:
-    model: str = "hapke"
+    model: str = _REFLECTANCE["model"]
     # Hapke: representative lunar values (w, b, c, B0, h after Helfenstein & Veverka 1987
     # and Sato et al. 2014, LROC WAC; see docs/rendering.md).
-    single_scattering_albedo: float = 0.21
-    phase_b: float = 0.26
-    phase_c: float = 0.4
-    opposition_b0: float = 1.0
-    opposition_h: float = 0.07
+    single_scattering_albedo: float = _REFLECTANCE["single_scattering_albedo"]
+    phase_b: float = _REFLECTANCE["phase_b"]
+    phase_c: float = _REFLECTANCE["phase_c"]
+    opposition_b0: float = _REFLECTANCE["opposition_b0"]
+    opposition_h: float = _REFLECTANCE["opposition_h"]
     # Lunar-Lambert: normal albedo of the maria-highland average.
-    albedo: float = 0.12
+    albedo: float = _REFLECTANCE["albedo"]
 
     def __post_init__(self) -> None:
         if self.model not in MODELS:

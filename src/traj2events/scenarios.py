@@ -10,13 +10,14 @@ positive pitch tilts the thrust backwards (braking) and the camera forwards.
 from __future__ import annotations
 
 import zlib
+import json
 from dataclasses import asdict, dataclass, field, replace
 from typing import Callable
 
 import numpy as np
 
 from .dynamics import N_STATE, Vehicle
-from .ocp import BoundaryConditions, LandingProblem, Solution
+from .ocp import BoundaryConditions, LandingProblem, OcpSettings, Solution
 
 # Range keys in the order they are drawn (changing it changes every sample).
 RANGE_KEYS = (
@@ -204,3 +205,33 @@ def solve_by_continuation(
                                 sum(s.solve_time_s for s in log), *errors)
     return SampleResult(index, bc, log[-1], "failed", len(log), sum(s.iterations for s in log),
                         sum(s.solve_time_s for s in log), *errors, reason=reason)
+
+
+@dataclass(frozen=True)
+class ScenarioSettings:
+    """Everything one scenario's solves depend on (a rule's `params`)."""
+
+    vehicle: Vehicle
+    ocp: OcpSettings
+    scenario: Scenario
+    seed: int
+
+    @classmethod
+    def from_config(cls, config: dict, name: str) -> "ScenarioSettings":
+        vehicle = dict(config["vehicle"])
+        vehicle["inertia_kgm2"] = tuple(vehicle["inertia_kgm2"])
+        return cls(Vehicle(**vehicle), OcpSettings(**config["ocp"]),
+                   Scenario.from_config(name, config["scenarios"][name]), int(config["seed"]))
+
+    def to_json(self) -> str:
+        return json.dumps({"vehicle": self.vehicle.to_dict(), "ocp": self.ocp.to_dict(),
+                           "scenario": self.scenario.to_dict(), "seed": self.seed}, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> "ScenarioSettings":
+        d = json.loads(text)
+        sc = d["scenario"]
+        scenario = Scenario(sc["name"], sc["n_trajectories"], sc["tf_guess_s"],
+                            {k: tuple(v) for k, v in sc["ranges"].items()})
+        vehicle = dict(d["vehicle"], inertia_kgm2=tuple(d["vehicle"]["inertia_kgm2"]))
+        return cls(Vehicle(**vehicle), OcpSettings(**d["ocp"]), scenario, int(d["seed"]))

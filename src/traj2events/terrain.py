@@ -28,23 +28,28 @@ from typing import Protocol
 
 import numpy as np
 
+from .defaults import section
+
+_TERRAIN = section("terrain")
+
 
 @dataclass(frozen=True)
 class TerrainParams:
-    """Procedural terrain settings (config key `terrain`; sources in docs/rendering.md)."""
+    """Procedural terrain settings: config key `terrain`, defaults in defaults.yaml (which
+    gives the meaning and source of each value; see also docs/rendering.md)."""
 
-    seed: int = 0
-    crater_density_k: float = 0.08  # K in N(>D) = K D^-slope per m^2 (D in m): Gault (1970) equilibrium ~10^-1.1
-    crater_slope: float = 2.0  # cumulative slope; 2 = equilibrium for small lunar craters
-    crater_diameter_min_m: float = 1.0
-    crater_diameter_max_m: float = 2000.0
-    depth_to_diameter: float = 0.2  # rim crest to floor, fresh simple craters (Pike 1977)
-    rim_height_to_diameter: float = 0.036  # Pike (1977): rim height ~ 0.036 D
-    fresh_fraction: float = 0.2  # the rest are degraded
-    roughness_m_at_1m: float = 0.02  # RMS height of the 1 m wavelength octave
-    roughness_hurst: float = 0.8  # amplitude ~ wavelength^hurst
-    roughness_wavelength_max_m: float = 64.0
-    site_radius_m: float = 30.0  # flat pad radius; blends to the terrain over the next radius
+    seed: int = _TERRAIN["seed"]
+    crater_density_k: float = _TERRAIN["crater_density_k"]
+    crater_slope: float = _TERRAIN["crater_slope"]
+    crater_diameter_min_m: float = _TERRAIN["crater_diameter_min_m"]
+    crater_diameter_max_m: float = _TERRAIN["crater_diameter_max_m"]
+    depth_to_diameter: float = _TERRAIN["depth_to_diameter"]
+    rim_height_to_diameter: float = _TERRAIN["rim_height_to_diameter"]
+    fresh_fraction: float = _TERRAIN["fresh_fraction"]
+    roughness_m_at_1m: float = _TERRAIN["roughness_m_at_1m"]
+    roughness_hurst: float = _TERRAIN["roughness_hurst"]
+    roughness_wavelength_max_m: float = _TERRAIN["roughness_wavelength_max_m"]
+    site_radius_m: float = _TERRAIN["site_radius_m"]
 
     def __post_init__(self) -> None:
         if not 0 < self.crater_diameter_min_m <= self.crater_diameter_max_m:

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .camera import Camera, CameraPose
+from .defaults import section
 from .illumination import ShadowField, no_obstruction, shadow_field
 from .terrain import Terrain, surface_points
 
@@ -45,17 +46,25 @@ class Tile:
     heights_m: np.ndarray = field(repr=False)  # (cells + 1, cells + 1), the tile's own grid
 
 
+_LOD = section("render")["lod"]
+
+
 @dataclass(frozen=True)
 class LodSettings:
-    cells: int = 32
-    margin: int = 32  # cells of extra grid toward the Sun for the shadow march
-    pixels_per_cell: float = 2.0
-    min_spacing_m: float = 0.05
+    cells: int = _LOD["cells"]
+    margin: int = _LOD["margin"]  # cells of extra grid toward the Sun for the shadow march
+    pixels_per_cell: float = _LOD["pixels_per_cell"]
+    min_spacing_m: float = _LOD["min_spacing_m"]
     skirt_cells: float = 2.0  # skirt depth in cells of the tile
     foreshortening: bool = True  # measure a cell by its projected area, not its width
 
 
 class TileSet:
+    @property
+    def n_cached(self) -> int:
+        """Tiles built and held in the cache."""
+        return len(self._cache)
+
     def __init__(self, terrain: Terrain, sun_dir: np.ndarray, radius_m: float, half_extent_m: float,
                  lod: LodSettings = LodSettings()):
         self.terrain = terrain

@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .formats.atomic import atomic_output
+
 
 def display_frame(radiance: np.ndarray, white_w_m2_sr: float, gamma: float) -> np.ndarray:
     """Linear radiance -> 8-bit display values: 255 (L / white)^(1/gamma), clipped."""
@@ -25,7 +27,8 @@ class VideoWriter:
         import ffmpeg
 
         self.path = Path(path)
-        self.tmp = self.path.with_name(f".{self.path.name}.part")
+        self._context = atomic_output(self.path)
+        self.tmp = self._context.__enter__()
         self.width, self.height = width, height
         source = ffmpeg.input("pipe:", format="rawvideo", pix_fmt="gray", s=f"{width}x{height}", framerate=fps)
         common = {"fflags": "+bitexact", "flags:v": "+bitexact", "map_metadata": -1}
@@ -50,11 +53,12 @@ class VideoWriter:
         self._process.stdin.close()
         code = self._process.wait()
         if code != 0 or not keep:
-            self.tmp.unlink(missing_ok=True)
+            error = RuntimeError(f"ffmpeg failed writing {self.path} (exit {code})" if code else "not kept")
+            self._context.__exit__(type(error), error, None)  # removes the temporary file
             if code != 0:
-                raise RuntimeError(f"ffmpeg failed writing {self.path} (exit {code})")
+                raise error
             return
-        os.replace(self.tmp, self.path)
+        self._context.__exit__(None, None, None)
 
     def __enter__(self):
         return self

@@ -1,6 +1,7 @@
-# Shared helpers: config validation (before any job runs), per-scenario params, the
-# package's source hash (so a change in the science reruns the rules it affects), and
-# the list of everything the config asks for.
+# Shared helpers: the config (overlays merged on the package's defaults and validated
+# before any job runs), per-scenario params, each rule's code fingerprint (computed from
+# its stage module's imports, so a change in the science reruns the rules it affects and
+# nothing else), and the list of everything the config asks for.
 import hashlib
 import shlex
 import sys
@@ -8,18 +9,23 @@ from pathlib import Path
 
 import pandas as pd
 
-import traj2events
-from traj2events.config import ConfigError, RenderSettings, ScenarioSettings, load_yaml, validate_config
+from traj2events.config import ConfigError, resolve_config
+from traj2events.fingerprint import code_fingerprint
+from traj2events.scenarios import ScenarioSettings
+from traj2events.stages.render import RenderSettings
 
 try:
-    validate_config(config, load_yaml(Path(workflow.basedir) / "workflow/schemas/config.schema.yaml"))
+    _resolved = resolve_config(config)
 except ConfigError as error:
     raise WorkflowError(f"invalid configuration: {error}")
+config.clear()
+config.update(_resolved)
 
 # Rules call the `traj2events` command that sits beside the Python running Snakemake
 # (e.g. .venv/bin), so that `.venv/bin/snakemake` works without activating the venv.
-shell.prefix(f"set -euo pipefail; export PATH={shlex.quote(str(Path(sys.executable).parent))}:\"$PATH\"; ")
-PACKAGE_DIR = Path(traj2events.__file__).parent
+shell.prefix(
+    f"set -euo pipefail; export PATH={shlex.quote(str(Path(sys.executable).parent))}:\"$PATH\"; "
+)
 SCENARIOS = list(config["scenarios"])
 ENV = "../../envs/trajectories.yaml"
 
@@ -29,15 +35,9 @@ wildcard_constraints:
     id=r"\d{4}",
 
 
-def source_hash(*modules):
-    """Hash of the package modules a rule runs (plus the CLI that calls them)."""
-    digest = hashlib.sha256()
-    for module in sorted({*modules, "__init__", "cli", "config", "io"}):
-        digest.update((PACKAGE_DIR / f"{module}.py").read_bytes())
-    if "render" in modules:  # the GLSL the renderer compiles
-        for shader in sorted((PACKAGE_DIR / "shaders").glob("*.*")):
-            digest.update(shader.read_bytes())
-    return digest.hexdigest()[:16]
+def code(stage):
+    """Fingerprint of the code a rule runs: the stage module and what it imports."""
+    return code_fingerprint(f"traj2events.stages.{stage}")
 
 
 def scenario_settings(wildcards):
@@ -61,6 +61,15 @@ def frames_output(path):
     return path if config["render"]["keep_frames"] else temp(path)
 
 
+def camera_options(wildcards):
+    """The camera and sphere of the config as command-line options."""
+    c = config["camera"]
+    return (
+        f"--width {c['width']} --height {c['height']} --fov-deg {c['fov_deg']} "
+        f"--moon-radius-m {config['motion_field']['moon_radius_m']}"
+    )
+
+
 EXPORT_FILES = {"npz": "events.npz", "evt3": "events.raw", "aedat4": "events.aedat4"}
 
 
@@ -76,9 +85,10 @@ def export_flags(wildcards, output):
 def event_options(wildcards):
     """The emulator settings of the config as command-line options."""
     e = config["events"]
-    return (f"--preset {e['preset']} --refractory-s {e['refractory_s']} --refractory-mode {e['refractory_mode']} "
-            f"--hot-pixel-fraction {e['hot_pixel_fraction']} --hot-pixel-hz {e['hot_pixel_hz']} "
-            f"--window-ms {e['window_ms']}")
+    return (
+        f"--preset {e['preset']} --refractory-s {e['refractory_s']} --refractory-mode {e['refractory_mode']} "
+        f"--hot-pixel-fraction {e['hot_pixel_fraction']} --hot-pixel-hz {e['hot_pixel_hz']}"
+    )
 
 
 def event_seed(wildcards):
@@ -94,8 +104,17 @@ def solved_ids(scenario):
     return [f"{i:04d}" for i in samples.loc[samples["success"], "id"]]
 
 
-PER_TRAJECTORY = ["trajectory.h5", "video.mkv", "preview.mp4", "frames.png", "motion_field.h5", "motion_field.png",
-                  "events.h5", "events.png", *(EXPORT_FILES[name] for name in config["events"]["exports"])]
+PER_TRAJECTORY = [
+    "trajectory.h5",
+    "video.mkv",
+    "preview.mp4",
+    "frames.png",
+    "motion_field.h5",
+    "motion_field.png",
+    "events.h5",
+    "events.png",
+    *(EXPORT_FILES[name] for name in config["events"]["exports"]),
+]
 
 
 def scenario_outputs(wildcards):

@@ -1,5 +1,5 @@
 # Stages 4-5: render the lunar surface from every pose (linear radiance + depth), and the
-# videos (lossless FFV1, H.264 preview) and frame mosaic made from the same frames.
+# videos (lossless FFV1, H.264 preview) made from the same frames.
 
 
 rule render:
@@ -10,15 +10,9 @@ rule render:
         frames=frames_output("results/{scenario}/{id}/frames.h5"),
         video="results/{scenario}/{id}/video.mkv",
         preview="results/{scenario}/{id}/preview.mp4",
-        mosaic=report(
-            "results/{scenario}/{id}/frames.png",
-            caption="../report/frames.rst",
-            category="Frames",
-            subcategory="{scenario}",
-        ),
     params:
         settings=render_settings,
-        code=source_hash("render", "tiles", "terrain", "illumination", "reflectance", "camera", "video", "figures"),
+        code=code("render"),
     threads: 1
     log:
         "results/logs/{scenario}/{id}/render.log",
@@ -26,5 +20,5 @@ rule render:
         "../../envs/render.yaml"
     shell:
         # llvmpipe would start a thread per core in every job; one job = one core.
-        "LP_NUM_THREADS={threads} traj2events render {input.trajectory} --settings '{params.settings}' --frames {output.frames} "
-        "--video {output.video} --preview {output.preview} --mosaic {output.mosaic} 2> {log}"
+        "LP_NUM_THREADS={threads} traj2events render {input.trajectory} --settings '{params.settings}' "
+        "--frames {output.frames} --video {output.video} --preview {output.preview} 2> {log}"

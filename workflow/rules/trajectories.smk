@@ -1,5 +1,6 @@
 # Stages 1-3: base solve per scenario, continuation sampling (a checkpoint: failed samples
-# produce no trajectory file), and camera poses at the frame rate per trajectory.
+# produce no trajectory file), and camera poses at the frame rate per trajectory; the
+# per-scenario index and the dataset summary.
 
 
 rule base_solution:
@@ -7,7 +8,7 @@ rule base_solution:
         "results/{scenario}/base.h5",
     params:
         settings=scenario_settings,
-        code=source_hash("dynamics", "ocp", "scenarios"),
+        code=code("base_solution"),
     log:
         "results/logs/{scenario}/base_solution.log",
     conda:
@@ -24,7 +25,7 @@ checkpoint sample_trajectories:
         table="results/{scenario}/samples.csv",
     params:
         settings=scenario_settings,
-        code=source_hash("dynamics", "ocp", "scenarios", "batch", "upsample"),
+        code=code("sample_trajectories"),
     threads: workflow.cores
     log:
         "results/logs/{scenario}/sample_trajectories.log",
@@ -43,7 +44,7 @@ rule camera_poses:
     params:
         fps=config["camera"]["fps"],
         method=config["upsampling"]["method"],
-        code=source_hash("dynamics", "ocp", "upsample"),
+        code=code("camera_poses"),
     log:
         "results/logs/{scenario}/{id}/camera_poses.log",
     conda:
@@ -59,7 +60,7 @@ rule dataset_index:
     output:
         "results/{scenario}/index.csv",
     params:
-        code=source_hash(),
+        code=code("index"),
     log:
         "results/logs/{scenario}/dataset_index.log",
     conda:
@@ -73,22 +74,16 @@ rule trajectory_summary:
         solutions=expand("results/{scenario}/solutions.h5", scenario=SCENARIOS),
         tables=expand("results/{scenario}/samples.csv", scenario=SCENARIOS),
     output:
-        table=report(
+        report(
             "results/summary.csv",
             caption="../report/summary.rst",
             category="Trajectories",
         ),
-        figure=report(
-            "results/figures/trajectories.png",
-            caption="../report/trajectories.rst",
-            category="Trajectories",
-        ),
     params:
-        code=source_hash("figures"),
+        code=code("summary"),
     log:
         "results/logs/trajectory_summary.log",
     conda:
         ENV
     shell:
-        "traj2events summary --solutions {input.solutions} --tables {input.tables} "
-        "--table {output.table} --figure {output.figure} 2> {log}"
+        "traj2events summary --solutions {input.solutions} --tables {input.tables} --output {output} 2> {log}"

@@ -1,4 +1,4 @@
-"""Files: atomic writes, self-describing trajectories, byte-reproducible HDF5."""
+"""File formats: atomic writes, self-describing trajectories, byte-reproducible HDF5, .flo."""
 
 import h5py
 import numpy as np
@@ -6,7 +6,9 @@ import pytest
 from conftest import landing_bc
 
 from traj2events.dynamics import Dynamics
-from traj2events.io import atomic_output, read_trajectory, solution_attrs, vehicle_attrs, write_trajectory
+from traj2events.formats.atomic import atomic_directory, atomic_output
+from traj2events.formats.flow import read_flo, write_flo
+from traj2events.formats.trajectory import read_trajectory, solution_attrs, vehicle_attrs, write_trajectory
 from traj2events.upsample import reintegrate, upsample
 
 
@@ -67,8 +69,6 @@ def test_flo_round_trip_through_opencv_is_exact(tmp_path):
     flow = rng.normal(scale=30, size=(7, 11, 2)).astype(np.float32)
     flow[0, 0] = [np.float32(1e-38), -np.float32(3.4e38)]  # extremes survive too
     path = tmp_path / "000001.flo"
-    from traj2events.io import read_flo, write_flo
-
     write_flo(path, flow)
     assert path.stat().st_size == 12 + flow.nbytes
     read = cv2.readOpticalFlow(str(path))
@@ -80,10 +80,34 @@ def test_flo_round_trip_through_opencv_is_exact(tmp_path):
 
 
 def test_flo_rejects_wrong_shape_and_magic(tmp_path):
-    from traj2events.io import read_flo, write_flo
-
     with pytest.raises(ValueError, match="(H, W, 2)"):
         write_flo(tmp_path / "x.flo", np.zeros((4, 4)))
     (tmp_path / "bad.flo").write_bytes(b"\x00" * 20)
     with pytest.raises(ValueError, match="magic"):
         read_flo(tmp_path / "bad.flo")
+
+
+def test_atomic_directory_replaces_the_folder_only_when_complete(tmp_path):
+    target = tmp_path / "flow"
+    target.mkdir()
+    (target / "old.flo").write_bytes(b"old")
+    with pytest.raises(RuntimeError):
+        with atomic_directory(target) as tmp:
+            (tmp / "new.flo").write_bytes(b"half")
+            raise RuntimeError("job died")
+    assert [p.name for p in tmp_path.iterdir()] == ["flow"] and (target / "old.flo").exists()
+    with atomic_directory(target) as tmp:
+        (tmp / "new.flo").write_bytes(b"new")
+    assert [p.name for p in target.iterdir()] == ["new.flo"]
+    assert target.stat().st_mode & 0o055  # readable by others, unlike mkdtemp's 0700
+
+
+def test_reading_outputs_needs_neither_solver_nor_renderer():
+    import subprocess
+    import sys
+
+    code = ("import sys, traj2events.formats.trajectory, traj2events.formats.events, traj2events.formats.flow, "
+            "traj2events.formats.frames, traj2events.formats.exports; "
+            "print(sorted(m for m in ('casadi', 'numba', 'pyrender', 'OpenGL', 'scipy', 'matplotlib') if m in sys.modules))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.strip() == "[]"

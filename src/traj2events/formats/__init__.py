@@ -1,0 +1,11 @@
+"""File formats, with numpy and h5py (+ hdf5plugin for events) only: reading any output
+of the pipeline never loads the solver or the renderer.
+
+    atomic      one helper for every write: a temporary name, renamed when complete
+    hdf5        byte-reproducible HDF5 files, datasets and attributes
+    trajectory  base.h5, solutions.h5, trajectory.h5 (nodes, poses, vehicle constants)
+    frames      frames.h5 (linear radiance and depth per frame)
+    flow        motion_field.h5 and Middlebury .flo
+    events      the event dtype and events.h5 (DSEC layout)
+    exports     the ELOPE-style .npz, EVT 3.0 and AEDAT4
+"""

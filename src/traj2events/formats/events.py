@@ -1,0 +1,111 @@
+"""Events: the structured dtype (x, y, t, p) used everywhere in the package (tonic's
+convention) and events.h5 in the DSEC layout."""
+from __future__ import annotations
+
+import os
+
+import h5py
+import numpy as np
+
+from .atomic import atomic_output
+from .hdf5 import create, set_attrs
+
+EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
+
+
+def _blosc_zstd():
+    import hdf5plugin  # registers the Blosc filter with HDF5
+
+    return hdf5plugin.Blosc(cname="zstd", clevel=5, shuffle=hdf5plugin.Blosc.SHUFFLE)
+
+
+class EventsWriter:
+    """events.h5 in the DSEC layout, appended chunk by chunk (events sorted by t):
+    `events/x`, `events/y` (uint16), `events/t` (int64, us, relative to `t_offset`),
+    `events/p` (uint8, 1 = ON), `ms_to_idx` (uint64: index of the first event at or after
+    each millisecond), `t_offset` (int64, us). Event arrays are compressed with Blosc/zstd
+    through hdf5plugin (what DSEC uses); attributes hold the emulator's parameters."""
+
+    def __init__(self, path: str | os.PathLike, width: int, height: int, attrs: dict, t_offset_us: int = 0,
+                 chunk: int = 1 << 18):
+        compression = _blosc_zstd()
+        self._context = atomic_output(path)
+        tmp = self._context.__enter__()
+        self._file = create(tmp)
+        group = self._file.create_group("events")
+        self._sets = {name: group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,),
+                                                 track_times=False, **compression)
+                      for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1"))}
+        self._file.create_dataset("t_offset", data=np.int64(t_offset_us), track_times=False)
+        set_attrs(self._file, {"width": width, "height": height, **attrs})
+        self.t_offset_us = t_offset_us
+        self.n = 0
+        self._ms_to_idx: list[np.ndarray] = []
+        self._next_ms = 0
+        self._last_t = np.iinfo(np.int64).min
+
+    def append(self, events: np.ndarray) -> None:
+        if not len(events):
+            return
+        t = events["t"].astype(np.int64) - self.t_offset_us
+        if t[0] < self._last_t or np.any(np.diff(t) < 0):
+            raise ValueError("events.h5: events must arrive sorted by t")
+        # ms_to_idx[m] = first index with t >= 1000 m, for every m up to this chunk's last event.
+        last_ms = int(t[-1] // 1000)
+        if last_ms >= self._next_ms:
+            ms = np.arange(self._next_ms, last_ms + 1, dtype=np.int64)
+            self._ms_to_idx.append(self.n + np.searchsorted(t, ms * 1000, side="left"))
+            self._next_ms = last_ms + 1
+        for name, values in (("x", events["x"]), ("y", events["y"]), ("t", t), ("p", events["p"])):
+            ds = self._sets[name]
+            ds.resize((self.n + len(t),))
+            ds[self.n:] = values
+        self.n += len(t)
+        self._last_t = int(t[-1])
+
+    def close(self, duration_us: int, exc=(None, None, None)) -> None:
+        if exc[0] is None:
+            # Milliseconds after the last event, up to the end of the recording, index past the end.
+            end_ms = int(max(duration_us - self.t_offset_us, 0) // 1000)
+            if end_ms >= self._next_ms:
+                self._ms_to_idx.append(np.full(end_ms - self._next_ms + 1, self.n, dtype=np.int64))
+            ms_to_idx = np.concatenate(self._ms_to_idx) if self._ms_to_idx else np.zeros(1, np.int64)
+            self._file.create_dataset("ms_to_idx", data=ms_to_idx.astype(np.uint64), track_times=False)
+        self._file.close()
+        self._context.__exit__(*exc)
+
+
+def read_events(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
+    """events.h5 -> (structured array x, y, t (absolute us), p; attributes)."""
+    _blosc_zstd()
+    with h5py.File(path, "r") as f:
+        g = f["events"]
+        out = np.empty(len(g["t"]), EVENT_DTYPE)
+        out["x"], out["y"], out["p"] = g["x"][()], g["y"][()], g["p"][()]
+        out["t"] = g["t"][()] + int(f["t_offset"][()])
+        return out, dict(f.attrs)
+
+
+def read_events_attrs(path: str | os.PathLike) -> dict:
+    """events.h5's attributes (width, height, the emulator's parameters), no events."""
+    with h5py.File(path, "r") as f:
+        return dict(f.attrs)
+
+
+def read_events_window(path: str | os.PathLike, t_start_us: int, t_end_us: int) -> np.ndarray:
+    """Events with t in [t_start, t_end) (absolute us), read through ms_to_idx: only that slice."""
+    _blosc_zstd()
+    with h5py.File(path, "r") as f:
+        offset = int(f["t_offset"][()])
+        ms_to_idx = f["ms_to_idx"]
+        n_ms = len(ms_to_idx)
+        lo_ms = min(max((t_start_us - offset) // 1000, 0), n_ms - 1)
+        hi_ms = (t_end_us - offset) // 1000 + 1
+        lo = int(ms_to_idx[lo_ms])
+        hi = int(ms_to_idx[hi_ms]) if hi_ms < n_ms else len(f["events/t"])
+        g = f["events"]
+        out = np.empty(hi - lo, EVENT_DTYPE)
+        out["x"], out["y"], out["p"] = g["x"][lo:hi], g["y"][lo:hi], g["p"][lo:hi]
+        out["t"] = g["t"][lo:hi] + offset
+    return out[(out["t"] >= t_start_us) & (out["t"] < t_end_us)]
+

@@ -1,0 +1,46 @@
+"""Motion-field files: motion_field.h5 (every field of a trajectory) and Middlebury .flo
+(one displacement field per file, which optical-flow tools read)."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from .atomic import atomic_output
+from .hdf5 import create, set_attrs, write_dataset
+
+FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
+
+
+def write_flo(path: str | os.PathLike, flow: np.ndarray) -> None:
+    """Middlebury .flo: magic, int32 width, int32 height, then (u, v) float32 per pixel,
+    row by row. cv2.readOpticalFlow reads it back bit for bit."""
+    flow = np.ascontiguousarray(flow, dtype="<f4")
+    if flow.ndim != 3 or flow.shape[2] != 2:
+        raise ValueError(f"{path}: expected a flow of shape (H, W, 2), got {flow.shape}")
+    header = np.array([FLO_MAGIC], dtype="<f4").tobytes() + np.array(flow.shape[1::-1], dtype="<i4").tobytes()
+    with atomic_output(path) as tmp:
+        tmp.write_bytes(header + flow.tobytes())
+
+
+def read_flo(path: str | os.PathLike) -> np.ndarray:
+    data = Path(path).read_bytes()
+    if np.frombuffer(data[:4], dtype="<f4")[0] != np.float32(FLO_MAGIC):
+        raise ValueError(f"{path}: not a Middlebury .flo file (bad magic number)")
+    width, height = np.frombuffer(data[4:12], dtype="<i4")
+    return np.frombuffer(data[12:], dtype="<f4").reshape(height, width, 2).copy()
+
+
+def write_motion_field(path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, np.ndarray],
+                       attrs: dict) -> None:
+    """motion_field.h5: t (K,), frame_index (K,), and each (K, H, W, ...) field, chunked
+    one frame per chunk and compressed."""
+    with atomic_output(path) as tmp, create(tmp) as f:
+        write_dataset(f, "t", t)
+        write_dataset(f, "frame_index", frame_index)
+        for name, data in fields.items():
+            chunks = (1, *data.shape[1:]) if len(data) else None
+            f.create_dataset(name, data=data, chunks=chunks, compression="gzip", compression_opts=4, shuffle=True,
+                             track_times=False)
+        set_attrs(f, attrs)

@@ -1,0 +1,120 @@
+"""Trajectory files: base.h5 (a scenario's base solution), solutions.h5 (every sample of
+a scenario: the checkpoint between solving and camera poses) and trajectory.h5 (one
+trajectory's collocation nodes and its camera poses at the frame rate).
+
+Groups `nodes` and `poses` hold `t` (s), `state` (n x 13, order and units in
+`state_names`: m, m/s, rad, rad/s, kg) and `control` (n x 4, dimensionless); the root
+attributes hold the vehicle constants, so anyone can re-integrate the dynamics."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import h5py
+import numpy as np
+
+from ..state import CONTROL_NAMES, STATE_NAMES, Vehicle
+from .atomic import atomic_output
+from .hdf5 import create, plain, set_attrs, write_dataset
+
+
+def vehicle_attrs(vehicle: Vehicle) -> dict:
+    """The root attributes that let anyone re-integrate the dynamics from the file."""
+    return {
+        "mass_kg": vehicle.mass_kg,
+        "dry_mass_kg": vehicle.dry_mass_kg,
+        "thrust_main_N": vehicle.thrust_main_N,
+        "thrust_rcs_N": vehicle.thrust_rcs_N,
+        "lever_arm_m": vehicle.lever_arm_m,
+        "inertia_kgm2": np.array(vehicle.inertia_kgm2),
+        "isp_s": vehicle.isp_s,
+        "g_m_s2": vehicle.g_m_s2,
+        "g0_m_s2": vehicle.g0_m_s2,
+        "tilt_max_deg": vehicle.tilt_max_deg,
+    }
+
+
+def vehicle_from_attrs(attrs: h5py.AttributeManager) -> Vehicle:
+    return Vehicle(**{k: (tuple(attrs[k]) if k == "inertia_kgm2" else float(attrs[k]))
+                      for k in Vehicle.__dataclass_fields__})
+
+
+def solution_attrs(solution, bc) -> dict:
+    """A solve's outcome (an ocp.Solution and its ocp.BoundaryConditions) as attributes."""
+    return {
+        "initial_state": bc.initial,
+        "final_state": bc.final,
+        "transcription": solution.transcription,
+        "N": len(solution.t),
+        "solver_status": solution.status,
+        "solver_success": solution.success,
+        "iterations": solution.iterations,
+        "solve_time_s": solution.solve_time_s,
+        "cost": solution.cost,
+        "tf_s": solution.tf_s,
+    }
+
+
+def _write_nodes(group: h5py.Group, t: np.ndarray, state: np.ndarray, control: np.ndarray) -> None:
+    write_dataset(group, "t", t)
+    write_dataset(group, "state", state)
+    write_dataset(group, "control", control)
+    group.attrs["state_names"] = list(STATE_NAMES)
+    group.attrs["control_names"] = list(CONTROL_NAMES)
+
+
+def write_trajectory(
+    path: str | os.PathLike,
+    nodes: tuple[np.ndarray, np.ndarray, np.ndarray],
+    poses: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
+    attrs: dict,
+) -> None:
+    """One trajectory: nodes/{t,state,control}, optional poses/{t,state,control}, attrs."""
+    with atomic_output(path) as tmp, create(tmp) as f:
+        _write_nodes(f.create_group("nodes"), *nodes)
+        if poses is not None:
+            _write_nodes(f.create_group("poses"), *poses)
+        set_attrs(f, attrs)
+
+
+@dataclass
+class Trajectory:
+    t_nodes: np.ndarray
+    state_nodes: np.ndarray
+    control_nodes: np.ndarray
+    t: np.ndarray | None
+    state: np.ndarray | None
+    control: np.ndarray | None
+    attrs: dict
+    vehicle: Vehicle
+
+
+def read_trajectory(path: str | os.PathLike) -> Trajectory:
+    with h5py.File(path, "r") as f:
+        poses = [f[f"poses/{k}"][()] for k in ("t", "state", "control")] if "poses" in f else [None] * 3
+        return Trajectory(
+            f["nodes/t"][()], f["nodes/state"][()], f["nodes/control"][()], *poses,
+            attrs=dict(f.attrs), vehicle=vehicle_from_attrs(f.attrs),
+        )
+
+
+def write_solution_set(path: str | os.PathLike, samples: dict[int, tuple[tuple, dict]], attrs: dict) -> None:
+    """All samples of one scenario: samples/{id:04d}/{t,state,control} with each sample's
+    status in its attributes. `samples`: {id: ((t, state, control), attributes)}."""
+    with atomic_output(path) as tmp, create(tmp) as f:
+        group = f.create_group("samples")
+        for index, (nodes, sample_attrs) in samples.items():
+            g = group.create_group(f"{index:04d}")
+            _write_nodes(g, *nodes)
+            set_attrs(g, sample_attrs)
+        set_attrs(f, attrs)
+
+
+def read_solution_set(path: str | os.PathLike) -> dict:
+    """{"attrs": root attributes, "samples": {id: {"t", "state", "control", **attrs}}}."""
+    with h5py.File(path, "r") as f:
+        samples = {}
+        for name, g in f["samples"].items():
+            samples[int(name)] = {"t": g["t"][()], "state": g["state"][()], "control": g["control"][()],
+                                  **{k: plain(v) for k, v in g.attrs.items()}}
+        return {"attrs": dict(f.attrs), "samples": samples}

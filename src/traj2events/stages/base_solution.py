@@ -1,0 +1,45 @@
+"""Stage 1: a scenario's base solution (every sampled range at its midpoint), which the
+continuation sampling starts from."""
+from __future__ import annotations
+
+import os
+
+from .. import __version__
+from ..formats.trajectory import solution_attrs, vehicle_attrs, write_trajectory
+from ..ocp import LandingProblem, Solution, replace_tf_guess
+from ..progress import log
+from ..scenarios import ScenarioSettings, base_conditions
+
+# A cold start is robust (docs/trajectories.md); other t_f guesses are the retries.
+TF_GUESS_FACTORS = (1.0, 0.5, 2.0)
+
+
+class BaseSolveError(ValueError):
+    """The base problem did not solve with any t_f guess."""
+
+
+def solve_base(settings: ScenarioSettings) -> tuple[Solution, object]:
+    """(solution, boundary conditions) of the scenario's base problem; BaseSolveError if
+    no t_f guess converges."""
+    s = settings
+    problem = LandingProblem(s.vehicle, s.ocp)
+    bc = base_conditions(s.scenario, s.vehicle)
+    for factor in TF_GUESS_FACTORS:
+        trial = replace_tf_guess(bc, bc.tf_guess_s * factor)
+        log(f"{s.scenario.name}: base solve, N = {s.ocp.n_nodes}, t_f guess {trial.tf_guess_s:.1f} s")
+        sol = problem.solve(trial)
+        log(f"{s.scenario.name}: {sol.status} after {sol.iterations} iterations, {sol.solve_time_s:.2f} s")
+        if sol.success:
+            return sol, bc
+    raise BaseSolveError(f"scenario '{s.scenario.name}': the base problem (midpoint of every range) did not "
+                         f"solve: {sol.status}. Check the ranges and vehicle in the config.")
+
+
+def base_solution(settings: ScenarioSettings, output: str | os.PathLike) -> Solution:
+    """Solve the base problem and write base.h5 (nodes only)."""
+    sol, bc = solve_base(settings)
+    attrs = {**vehicle_attrs(settings.vehicle), **solution_attrs(sol, bc), "scenario": settings.scenario.name,
+             "epsilon": settings.ocp.epsilon, "mesh_clustering": settings.ocp.mesh_clustering,
+             "traj2events_version": __version__}
+    write_trajectory(output, (sol.t, sol.state, sol.control), None, attrs)
+    return sol

@@ -1,0 +1,173 @@
+"""Stage 7: emulate an event camera on a trajectory's frames (or any video or folder of
+images) and write events.h5, plus the exports the config asks for.
+
+Inputs, each read in chunks so memory stays bounded:
+    frames.h5        linear radiance scaled to 8-bit-equivalent DN (the HDR path)
+    a video          8-bit grey, as v2e reads it
+    a folder         8-bit grey images, sorted by name (needs the frame rate)
+"""
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+from .. import __version__
+from ..emulator import PRESETS, EmulatorParams, EventEmulator, radiance_to_dn
+from ..formats.events import EventsWriter, read_events
+from ..formats.exports import write_elope_npz, write_faery
+from ..formats.frames import FramesFile
+from ..formats.trajectory import read_trajectory
+from ..progress import log
+from ..state import BODY_RATES
+from ..video import iter_video, video_info
+
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
+
+
+@dataclass
+class FrameSource:
+    """Frames to emulate on: size, a description, and (frames in DN, times in s) chunks."""
+
+    width: int
+    height: int
+    kind: str
+    chunks: Iterator[tuple[np.ndarray, np.ndarray]]
+
+
+def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
+    from PIL import Image
+
+    files = sorted(p for p in path.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+    if not files:
+        raise ValueError(f"events INPUT: {path} holds no .png/.jpg/.tif/.bmp images")
+    if not fps:
+        raise ValueError("events: --fps is required for a folder of images")
+    width, height = Image.open(files[0]).size
+    times = np.arange(len(files)) / fps
+
+    def images():
+        for start in range(0, len(files), chunk):
+            batch = [np.asarray(Image.open(f).convert("L")) for f in files[start:start + chunk]]
+            if any(b.shape != (height, width) for b in batch):
+                raise ValueError(f"events INPUT: images in {path} differ in size (expected {width} x {height})")
+            yield np.stack(batch), times[start:start + chunk]
+
+    return FrameSource(width, height, "images (8-bit)", images())
+
+
+def frames_source(path: Path, white: float | None, chunk: int) -> FrameSource:
+    frames = FramesFile(path)
+    white = white or float(frames.attrs.get("display_white_w_m2_sr", 0) or 0)
+    if not white > 0:
+        frames.close()
+        raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
+    _, height, width = frames.shape
+
+    def radiance():
+        with frames:
+            for chunk_radiance, times in frames.radiance_chunks(chunk):
+                yield radiance_to_dn(chunk_radiance, white), times
+
+    return FrameSource(width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", radiance())
+
+
+def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
+    width, height, video_fps, _ = video_info(path)
+    fps = fps or video_fps
+    if not fps > 0:
+        raise ValueError(f"events: {path} gives no frame rate; give --fps")
+
+    def video():
+        k = 0
+        for frames in iter_video(path, chunk):
+            yield frames, (k + np.arange(len(frames))) / fps
+            k += len(frames)
+
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video())
+
+
+def frame_source(path: str | os.PathLike, chunk: int = 64, fps: float | None = None,
+                 white: float | None = None) -> FrameSource:
+    """The frames of frames.h5, a video or a folder of images (by what `path` is)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"events INPUT: {path} does not exist")
+    if chunk < 1:
+        raise ValueError(f"events: chunk: expected >= 1 frames, got {chunk}")
+    if path.is_dir():
+        return image_folder_source(path, fps, chunk)
+    if path.suffix.lower() in (".h5", ".hdf5"):
+        return frames_source(path, white, chunk)
+    return video_source(path, fps, chunk)
+
+
+def emulator_params(preset: str, **overrides) -> EmulatorParams:
+    """A preset's parameters with the given (non-None) values replaced."""
+    from dataclasses import replace
+
+    if preset not in PRESETS:
+        raise ValueError(f"events: preset: expected one of {sorted(PRESETS)}, got {preset!r}")
+    return replace(PRESETS[preset], **{k: v for k, v in overrides.items() if v is not None})
+
+
+def emulate(source: FrameSource, params: EmulatorParams, seed: int, output: str | os.PathLike, preset: str,
+            input_name: str, progress_every: int = 640) -> tuple[int, int, float]:
+    """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
+    `input_name` are recorded in its attributes). Returns (frames, events, time of the
+    last frame in s)."""
+    emulator = EventEmulator(source.width, source.height, params, seed=seed)
+    attrs = {"preset": preset, "seed": seed, "input": input_name, "input_kind": source.kind,
+             **{f"emulator_{k}": v for k, v in asdict(params).items()}, "traj2events_version": __version__}
+    start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
+    writer = EventsWriter(output, source.width, source.height, attrs)
+    try:
+        for frames, times in source.chunks:
+            events = emulator.process(frames, times)
+            writer.append(events)
+            n_frames += len(frames)
+            n_events += len(events)
+            t_last = float(times[-1])
+            if n_frames % progress_every < len(frames):
+                log(f"  {n_frames} frames, {n_events} events, {n_frames / (time.perf_counter() - start):.0f} frames/s")
+    except BaseException as exc:
+        writer.close(0, (type(exc), exc, exc.__traceback__))
+        raise
+    writer.close(int(round(t_last * 1e6)))
+    elapsed = time.perf_counter() - start
+    log(f"{n_frames} frames, {n_events} events in {elapsed:.1f} s ({n_frames / elapsed:.0f} frames/s, "
+        f"{n_events / elapsed:.3g} events/s)")
+    return n_frames, n_events, t_last
+
+
+def central_range(frames: str | os.PathLike) -> np.ndarray:
+    """(n, 2): t (s) and the distance along the central pixel's ray (m, 0 = sky), from
+    frames.h5's depth (which is along the boresight)."""
+    with FramesFile(frames) as f:
+        _, h, w = f.shape
+        i, j = h // 2, w // 2
+        focal = float(f.attrs["focal_px"])
+        ray = np.sqrt(1.0 + ((j + 0.5 - w / 2) / focal) ** 2 + ((i + 0.5 - h / 2) / focal) ** 2)
+        return np.stack([f.t, f.depth_at(i, j) * ray], axis=1)
+
+
+def export_events(events: str | os.PathLike, npz: str | None = None, evt3: str | None = None,
+                  aedat4: str | None = None, trajectory: str | None = None, frames: str | None = None) -> None:
+    """Write the asked-for exports of events.h5: ELOPE-style .npz (with trajectory.h5: its
+    timestamps and states; with frames.h5: the range meter), EVT 3.0, AEDAT4."""
+    if not (npz or evt3 or aedat4):
+        return
+    stream, attrs = read_events(events)  # the exports take the whole stream: ~13 bytes/event in memory
+    if npz:
+        timestamps = traj = None
+        if trajectory is not None:
+            tr = read_trajectory(trajectory)
+            timestamps, traj = tr.t, tr.state[:, :BODY_RATES.stop]
+        write_elope_npz(npz, stream, timestamps, traj, central_range(frames) if frames else None)
+    for path in (evt3, aedat4):
+        if path:
+            write_faery(path, stream, int(attrs["width"]), int(attrs["height"]))

@@ -1,0 +1,31 @@
+"""The dataset index: one row per trajectory of a scenario."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from ..formats.atomic import atomic_output
+from ..formats.trajectory import read_trajectory
+from ..progress import log
+from ..state import MASS
+
+
+def index_row(path: str | os.PathLike) -> dict:
+    tr = read_trajectory(path)
+    a = tr.attrs
+    return {"scenario": a["scenario"], "id": int(a["id"]), "path": str(path), "tf_s": float(a["tf_s"]),
+            "n_poses": len(tr.t), "fps": float(a["fps"]), "N": int(a["N"]),
+            "final_mass_kg": float(tr.state_nodes[-1, MASS]), "continuation": a["continuation"],
+            "error_position_m": float(a["error_position_m"])}
+
+
+def dataset_index(paths: list[str | os.PathLike], output: str | os.PathLike) -> pd.DataFrame:
+    """index.csv from the trajectory.h5 files among `paths` (other files are ignored)."""
+    rows = [index_row(p) for p in paths if Path(p).name == "trajectory.h5"]
+    table = pd.DataFrame(rows)
+    with atomic_output(output) as tmp:
+        table.to_csv(tmp, index=False, float_format="%.9g")
+    log(f"{output}: {len(rows)} trajectories")
+    return table

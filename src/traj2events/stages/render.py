@@ -1,0 +1,129 @@
+"""Stages 4-5: render the lunar surface from every pose of a trajectory (linear radiance
+and depth, frames.h5) and the videos made from the same frames (lossless FFV1 of the 8-bit
+display frames, and an H.264 preview)."""
+from __future__ import annotations
+
+import json
+import os
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import __version__
+from ..camera import Camera, camera_pose
+from ..formats.frames import FramesWriter
+from ..formats.trajectory import read_trajectory
+from ..illumination import Sun
+from ..progress import log
+from ..reflectance import ReflectanceParams
+from ..render import TerrainRenderer
+from ..state import POSE
+from ..terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
+from ..tiles import LodSettings, TileSet
+from ..video import VideoWriter, display_frame
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """Everything one scenario's rendering depends on (the render rule's `params`):
+    camera, terrain, Sun, reflectance, level of detail, display mapping."""
+
+    scenario: str
+    width: int
+    height: int
+    fov_deg: float
+    moon_radius_m: float
+    terrain: dict
+    sun: dict
+    reflectance: dict
+    lod: dict
+    half_extent_m: float
+    display_white_w_m2_sr: float
+    display_gamma: float
+
+    @classmethod
+    def from_config(cls, config: dict, name: str) -> "RenderSettings":
+        sc = config["scenarios"][name]
+        radius = float(config["motion_field"]["moon_radius_m"])
+        # Out to the horizon of the scenario's highest camera (with a margin for climbs
+        # and relief), from the farthest start point.
+        reach = max(abs(v) for v in sc["downrange_m"]) + max(abs(v) for v in sc["crossrange_m"])
+        horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
+        r = config["render"]
+        return cls(name, int(config["camera"]["width"]), int(config["camera"]["height"]),
+                   float(config["camera"]["fov_deg"]), radius, dict(config["terrain"]), dict(sc["sun"]),
+                   dict(r["reflectance"]), dict(r["lod"]), float(reach + horizon),
+                   float(r["display_white_w_m2_sr"]), float(r["display_gamma"]))
+
+    def to_json(self) -> str:
+        return json.dumps(self.__dict__, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> "RenderSettings":
+        return cls(**json.loads(text))
+
+    def build(self):
+        """(camera, tiles, sun, reflectance) ready for render.TerrainRenderer."""
+        t = dict(self.terrain)
+        grid, spacing = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None)
+        terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
+        sun = Sun(**self.sun)
+        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, LodSettings(**self.lod))
+        return Camera(self.width, self.height, self.fov_deg), tiles, sun, ReflectanceParams(**self.reflectance)
+
+    def frame_attrs(self, camera: Camera, sun: Sun) -> dict:
+        """The scene's description, stored with the frames."""
+        return {"width": self.width, "height": self.height, "fov_deg": self.fov_deg, "focal_px": camera.focal_px,
+                "moon_radius_m": self.moon_radius_m, "sun_range_m": sun.range_m, "sun_azimuth_deg": sun.azimuth_deg,
+                "sun_elevation_deg": sun.elevation_deg, "sun_irradiance_w_m2": sun.irradiance_w_m2,
+                "reflectance": self.reflectance, "terrain": self.terrain, "lod": self.lod,
+                "terrain_half_extent_m": self.half_extent_m, "display_white_w_m2_sr": self.display_white_w_m2_sr,
+                "display_gamma": self.display_gamma}
+
+
+def render_trajectory(trajectory: str | os.PathLike, settings: RenderSettings, frames: str | os.PathLike,
+                      video: str | os.PathLike, preview: str | os.PathLike) -> None:
+    """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv, preview.mp4."""
+    s = settings
+    tr = read_trajectory(trajectory)
+    if tr.t is None or len(tr.t) < 1:
+        raise ValueError(f"{trajectory}: expected poses/t with at least one pose")
+    camera, tiles, sun, reflectance = s.build()
+    fps = float(tr.attrs["fps"])
+    n = len(tr.t)
+    attrs = {**s.frame_attrs(camera, sun), "fps": fps, "scenario": tr.attrs["scenario"], "id": int(tr.attrs["id"]),
+             "traj2events_version": __version__}
+    attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
+    log(f"{trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {sun.azimuth_deg} deg, "
+        f"el {sun.elevation_deg} deg, {s.reflectance['model']})")
+    start = time.perf_counter()
+    triangles = reused = 0
+    with TerrainRenderer(tiles, camera, sun, reflectance) as renderer, \
+            FramesWriter(frames, tr.t, np.arange(n), s.height, s.width, attrs) as out, \
+            VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless, \
+            VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview:
+        frame = None
+        for k in range(n):
+            # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
+            if frame is None or not np.array_equal(tr.state[k, POSE], tr.state[k - 1, POSE]):
+                frame = renderer.render(camera_pose(tr.state[k]))
+                triangles += frame.n_triangles
+            else:
+                reused += 1
+            out.write(k, frame.radiance, frame.depth_m)
+            shown = display_frame(frame.radiance, s.display_white_w_m2_sr, s.display_gamma)
+            lossless.write(shown)
+            shown_preview.write(shown)
+            if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
+                elapsed = time.perf_counter() - start
+                log(f"  {k + 1}/{n} frames, {elapsed / (k + 1) * 1e3:.1f} ms/frame, "
+                    f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 - reused, 1):.0f} triangles/frame")
+    log(f"{n} frames in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
+
+
+# frames.h5's attribute order (kept, so the same scene gives the same bytes).
+FRAME_ATTR_ORDER = ("width", "height", "fov_deg", "focal_px", "fps", "moon_radius_m", "sun_range_m", "sun_azimuth_deg",
+                    "sun_elevation_deg", "sun_irradiance_w_m2", "reflectance", "terrain", "lod",
+                    "terrain_half_extent_m", "display_white_w_m2_sr", "display_gamma", "scenario", "id",
+                    "traj2events_version")

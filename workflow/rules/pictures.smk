@@ -1,0 +1,89 @@
+# Pictures: the frame, motion-field and event-frame mosaics at the paper's five times, and
+# the dataset figure. Their own rules, so a picture setting or a figure's style reruns
+# pictures only.
+
+
+rule frames_picture:
+    input:
+        trajectory="results/{scenario}/{id}/trajectory.h5",
+        video="results/{scenario}/{id}/video.mkv",
+    output:
+        report(
+            "results/{scenario}/{id}/frames.png",
+            caption="../report/frames.rst",
+            category="Frames",
+            subcategory="{scenario}",
+        ),
+    params:
+        code=code("pictures"),
+    log:
+        "results/logs/{scenario}/{id}/frames_picture.log",
+    conda:
+        ENV
+    shell:
+        "traj2events picture frames {input.trajectory} --video {input.video} --output {output} 2> {log}"
+
+
+rule motion_field_picture:
+    input:
+        trajectory="results/{scenario}/{id}/trajectory.h5",
+        video="results/{scenario}/{id}/video.mkv",
+    output:
+        report(
+            "results/{scenario}/{id}/motion_field.png",
+            caption="../report/motion_field.rst",
+            category="Motion field",
+            subcategory="{scenario}",
+        ),
+    params:
+        camera=camera_options,
+        code=code("pictures"),
+    log:
+        "results/logs/{scenario}/{id}/motion_field_picture.log",
+    conda:
+        ENV
+    shell:
+        "traj2events picture motion-field {input.trajectory} {params.camera} --video {input.video} "
+        "--output {output} 2> {log}"
+
+
+rule events_picture:
+    input:
+        events="results/{scenario}/{id}/events.h5",
+        trajectory="results/{scenario}/{id}/trajectory.h5",
+    output:
+        report(
+            "results/{scenario}/{id}/events.png",
+            caption="../report/events.rst",
+            category="Events",
+            subcategory="{scenario}",
+        ),
+    params:
+        window_ms=config["events"]["window_ms"],
+        code=code("pictures"),
+    log:
+        "results/logs/{scenario}/{id}/events_picture.log",
+    conda:
+        ENV
+    shell:
+        "traj2events picture events {input.events} --trajectory {input.trajectory} "
+        "--window-ms {params.window_ms} --output {output} 2> {log}"
+
+
+rule dataset_picture:
+    input:
+        expand("results/{scenario}/solutions.h5", scenario=SCENARIOS),
+    output:
+        report(
+            "results/figures/trajectories.png",
+            caption="../report/trajectories.rst",
+            category="Trajectories",
+        ),
+    params:
+        code=code("pictures"),
+    log:
+        "results/logs/dataset_picture.log",
+    conda:
+        ENV
+    shell:
+        "traj2events picture dataset {input} --output {output} 2> {log}"
