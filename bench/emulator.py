@@ -17,6 +17,7 @@ layout, Blosc/zstd) and the peak resident memory. Goal (issue 5): >= 120 frames/
 prints instead where a 1024 x 1024 interval's time goes (ms per frame in each compiled
 kernel and in the whole interval), for the texture and the flicker input.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -43,7 +44,7 @@ def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.
     rng = np.random.default_rng(seed)
     big = gaussian_filter(rng.uniform(0, 1, (height, width + 2 * n_frames + 2)), 3.0)
     big = (big - big.min()) / (big.max() - big.min()) * 230 + 10
-    return np.stack([big[:, 2 * k:2 * k + width] for k in range(n_frames)]).round().astype(np.uint8)
+    return np.stack([big[:, 2 * k : 2 * k + width] for k in range(n_frames)]).round().astype(np.uint8)
 
 
 def flickering(frames: np.ndarray, period_frames: int, dim: float) -> np.ndarray:
@@ -63,7 +64,7 @@ def emulate_timed(frames: np.ndarray) -> tuple[list[np.ndarray], float]:
     times = np.arange(n_frames) / 100.0
     emu = EventEmulator(width, height, PRESETS["paper"], seed=1)
     start = time.perf_counter()
-    chunks = [emu.process(frames[k:k + 10], times[k:k + 10]) for k in range(0, n_frames, 10)]
+    chunks = [emu.process(frames[k : k + 10], times[k : k + 10]) for k in range(0, n_frames, 10)]
     return chunks, time.perf_counter() - start
 
 
@@ -77,10 +78,16 @@ def profile(n_frames: int) -> None:
             result = function(*args, **kwargs)
             spent[name] = spent.get(name, 0.0) + time.perf_counter() - start
             return result
+
         return wrapper
 
-    columns = {"_advance": "frame pass", "_emit": "event times", "_noise_candidates": "noise",
-               "_reset_reference": "reference resets", "_assemble": "ordering"}
+    columns = {
+        "_advance": "frame pass",
+        "_emit": "event times",
+        "_noise_candidates": "noise",
+        "_reset_reference": "reference resets",
+        "_assemble": "ordering",
+    }
     for name in columns:
         setattr(emulator, name, timed(name, getattr(emulator, name)))
     EventEmulator._interval_events = timed("whole interval", EventEmulator._interval_events)
@@ -103,14 +110,19 @@ def main() -> None:
     args = parser.parse_args()
     if args.profile:
         return profile(args.frames)
-    print(f"# emulator, paper preset, 1 thread, on {platform.node()} ({os.cpu_count()} cores), {time.strftime('%Y-%m-%d')}")
+    print(
+        f"# emulator, paper preset, 1 thread, on {platform.node()} ({os.cpu_count()} cores), "
+        f"{time.strftime('%Y-%m-%d')}"
+    )
     print("| size | input | frames | frames/s | events | events/s | events per pixel per frame | bytes/event on disk |")
     print("|---|---|---|---|---|---|---|---|")
     out = Path(__file__).resolve().parent / "out"
     out.mkdir(exist_ok=True)
-    for (height, width), label, flicker in (((260, 346), "texture, 2 px/frame", False),
-                                            ((1024, 1024), "texture, 2 px/frame", False),
-                                            ((1024, 1024), "the same, 10 Hz flicker", True)):
+    for (height, width), label, flicker in (
+        ((260, 346), "texture, 2 px/frame", False),
+        ((1024, 1024), "texture, 2 px/frame", False),
+        ((1024, 1024), "the same, 10 Hz flicker", True),
+    ):
         frames = moving_texture(height, width, args.frames)
         if flicker:
             frames = flickering(frames, period_frames=10, dim=0.15)
@@ -123,10 +135,15 @@ def main() -> None:
         writer.close(int((args.frames - 1) / 100.0 * 1e6))
         per_event = (out / "events.h5").stat().st_size / max(n_events, 1)
         fps = (args.frames - 1) / elapsed
-        print(f"| {width} x {height} | {label} | {args.frames} | {fps:.1f} | {n_events} | {n_events / elapsed:.3g} | "
-              f"{n_events / (args.frames - 1) / (width * height):.3f} | {per_event:.2f} |", flush=True)
-    print(f"peak resident memory: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB "
-          "(including the input video held in memory)")
+        print(
+            f"| {width} x {height} | {label} | {args.frames} | {fps:.1f} | {n_events} | {n_events / elapsed:.3g} | "
+            f"{n_events / (args.frames - 1) / (width * height):.3f} | {per_event:.2f} |",
+            flush=True,
+        )
+    print(
+        f"peak resident memory: {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB "
+        "(including the input video held in memory)"
+    )
 
 
 if __name__ == "__main__":

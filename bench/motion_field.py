@@ -9,6 +9,7 @@ the textbook inverse-depth formula's float32 error for comparison, the exact dis
 displacement (float64), and the bytes per field on disk (gzip-4 + shuffle, as written).
 Goal (issue 3): < 20 ms per 1024 x 1024 sphere field on one core.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -36,8 +37,12 @@ from traj2events.motion_field import (  # noqa: E402
 )
 
 POSES = {
-    "braking, 2 km, pitch 55 deg": np.array([-4000, 30, -2000, 90, 1, 12, 0.02, np.radians(55), 0.03, 0.01, -0.02, 0.005, 9500]),
-    "descent, 100 m, pitch 3 deg": np.array([-150, 2, -100, 8, 0.2, 3, 0.01, np.radians(3), 0.01, 0.002, 0.01, 0.001, 9600]),
+    "braking, 2 km, pitch 55 deg": np.array(
+        [-4000, 30, -2000, 90, 1, 12, 0.02, np.radians(55), 0.03, 0.01, -0.02, 0.005, 9500]
+    ),
+    "descent, 100 m, pitch 3 deg": np.array(
+        [-150, 2, -100, 8, 0.2, 3, 0.01, np.radians(3), 0.01, 0.002, 0.01, 0.001, 9600]
+    ),
 }
 
 
@@ -54,8 +59,9 @@ def median_ms(fn, repeat: int) -> float:
 def stored_bytes(field: np.ndarray) -> int:
     buffer = io.BytesIO()
     with h5py.File(buffer, "w") as f:
-        f.create_dataset("x", data=field[None], chunks=(1, *field.shape), compression="gzip", compression_opts=4,
-                         shuffle=True)
+        f.create_dataset(
+            "x", data=field[None], chunks=(1, *field.shape), compression="gzip", compression_opts=4, shuffle=True
+        )
     return buffer.getbuffer().nbytes
 
 
@@ -65,11 +71,15 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=20)
     args = parser.parse_args()
     camera = Camera(args.size, args.size, 45.0)
-    print(f"# motion field, {args.size} x {args.size}, on {platform.node()} ({os.cpu_count()} cores, 1 used), "
-          f"{time.strftime('%Y-%m-%d')}")
-    print("| pose | float32 field (ms) | float64 field (ms) | float32 vs float64 (max rel. to max flow) | "
-          "textbook h, float32 (max rel. h error) | stable h, float32 | displacement k->k+1, float64 (ms) | "
-          "stored (bytes/px, flow + disp) |")
+    print(
+        f"# motion field, {args.size} x {args.size}, on {platform.node()} ({os.cpu_count()} cores, 1 used), "
+        f"{time.strftime('%Y-%m-%d')}"
+    )
+    print(
+        "| pose | float32 field (ms) | float64 field (ms) | float32 vs float64 (max rel. to max flow) | "
+        "textbook h, float32 (max rel. h error) | stable h, float32 | displacement k->k+1, float64 (ms) | "
+        "stored (bytes/px, flow + disp) |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for name, state in POSES.items():
         t32 = median_ms(lambda: sphere_flow(camera, state, dtype=np.float32), args.repeat)
@@ -93,8 +103,11 @@ def main() -> None:
         td = median_ms(lambda: sphere_displacement(camera, state, nxt), max(3, args.repeat // 4))
         disp, _ = sphere_displacement(camera, state, nxt)
         size = (stored_bytes(f32) + stored_bytes(disp.astype(np.float32))) / args.size**2
-        print(f"| {name} | {t32:.1f} | {t64:.1f} | {err:.1e} | {rel['textbook']:.1e} | {rel['stable']:.1e} | "
-              f"{td:.0f} | {size:.2f} |", flush=True)
+        print(
+            f"| {name} | {t32:.1f} | {t64:.1f} | {err:.1e} | {rel['textbook']:.1e} | {rel['stable']:.1e} | "
+            f"{td:.0f} | {size:.2f} |",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ render at budget `--reference` (RMS of the radiance difference / mean radiance; 
 depth difference). Also bytes per frame on disk (frames.h5 radiance + depth, FFV1 video),
 and the paper config's cost (500 trajectories x ~7500 frames).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -31,8 +32,8 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 from traj2events.camera import Camera, camera_pose  # noqa: E402
-from traj2events.illumination import Sun  # noqa: E402
 from traj2events.formats.frames import round_mantissa  # noqa: E402
+from traj2events.illumination import Sun  # noqa: E402
 from traj2events.reflectance import ReflectanceParams  # noqa: E402
 from traj2events.render import TerrainRenderer  # noqa: E402
 from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
@@ -41,10 +42,16 @@ from traj2events.video import VideoWriter, display_frame  # noqa: E402
 
 R_MOON = 1737400.0
 CASES = {
-    "braking, 2 km, pitch 55 deg": (np.array([-4000, 30, -2000, 90, 1, 12, 0.02, np.radians(55), 0.03, 0, 0, 0, 9500.0]),
-                                    Sun(1.496e11, 105, 7), 180e3),
-    "descent, 150 m, pitch 3 deg": (np.array([-150, 2, -150, 8, 0.2, 3, 0.01, np.radians(3), 0.01, 0, 0, 0, 9600.0]),
-                                    Sun(1.496e11, 155, 2), 110e3),
+    "braking, 2 km, pitch 55 deg": (
+        np.array([-4000, 30, -2000, 90, 1, 12, 0.02, np.radians(55), 0.03, 0, 0, 0, 9500.0]),
+        Sun(1.496e11, 105, 7),
+        180e3,
+    ),
+    "descent, 150 m, pitch 3 deg": (
+        np.array([-150, 2, -150, 8, 0.2, 3, 0.01, np.radians(3), 0.01, 0, 0, 0, 9600.0]),
+        Sun(1.496e11, 155, 2),
+        110e3,
+    ),
 }
 
 
@@ -78,20 +85,32 @@ def run_case(name, state, sun, extent, size, n_frames, budgets, reference):
             keys = tiles.select(path[-1], camera)
         finest = max(k[0] for k in keys)
         uniform = sum(2 * tiles.lod.cells**2 * 4 ** (finest - k[0]) for k in keys)
-        results[budget] = dict(seconds=statistics.median(times), triangles=frame.n_triangles, tiles=frame.n_tiles,
-                               uniform=uniform, build_s=build_s, n_built=len(tiles._cache), frame=frame)
+        results[budget] = dict(
+            seconds=statistics.median(times),
+            triangles=frame.n_triangles,
+            tiles=frame.n_tiles,
+            uniform=uniform,
+            build_s=build_s,
+            n_built=len(tiles._cache),
+            frame=frame,
+        )
     ref = results[reference]["frame"]
-    ground = (ref.depth_m > 0)
+    ground = ref.depth_m > 0
     print(f"\n{name}, {size} x {size}, Hapke + shadows, one core ({n_frames} frames)")
-    print(f"{'px/cell':>8} {'s/frame':>8} {'triangles':>10} {'tiles':>6} {'LOD saves':>10} {'build s':>8} "
-          f"{'radiance err':>13} {'depth err':>10}")
+    print(
+        f"{'px/cell':>8} {'s/frame':>8} {'triangles':>10} {'tiles':>6} {'LOD saves':>10} {'build s':>8} "
+        f"{'radiance err':>13} {'depth err':>10}"
+    )
     for budget, r in results.items():
         f = r["frame"]
         both = ground & (f.depth_m > 0)
         rad_err = np.sqrt(np.mean((f.radiance - ref.radiance)[ground] ** 2)) / max(ref.radiance[ground].mean(), 1e-9)
         depth_err = np.median(np.abs(f.depth_m[both] / ref.depth_m[both] - 1)) if both.any() else np.nan
-        print(f"{budget:8.1f} {r['seconds']:8.3f} {r['triangles']:10d} {r['tiles']:6d} {r['uniform'] / r['triangles']:9.1f}x "
-              f"{r['build_s']:8.1f} {rad_err:13.4f} {depth_err:10.2e}")
+        print(
+            f"{budget:8.1f} {r['seconds']:8.3f} {r['triangles']:10d} {r['tiles']:6d} "
+            f"{r['uniform'] / r['triangles']:9.1f}x "
+            f"{r['build_s']:8.1f} {rad_err:13.4f} {depth_err:10.2e}"
+        )
     return results
 
 
@@ -99,8 +118,14 @@ def disk_bytes(frame, size):
     buf = io.BytesIO()
     with h5py.File(buf, "w") as f:
         for name, data in (("radiance", frame.radiance), ("depth_m", frame.depth_m)):
-            f.create_dataset(name, data=round_mantissa(data)[None], chunks=(1, size, size), compression="gzip",
-                             compression_opts=1, shuffle=True)
+            f.create_dataset(
+                name,
+                data=round_mantissa(data)[None],
+                chunks=(1, size, size),
+                compression="gzip",
+                compression_opts=1,
+                shuffle=True,
+            )
     h5_bytes = len(buf.getvalue())
     tmp = Path("bench/out")
     tmp.mkdir(parents=True, exist_ok=True)
@@ -118,8 +143,10 @@ def main() -> None:
     parser.add_argument("--budgets", type=float, nargs="+", default=[2.0, 4.0, 8.0])
     parser.add_argument("--reference", type=float, default=1.0, help="budget of the high-detail reference")
     args = parser.parse_args()
-    print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python "
-          f"{platform.python_version()}, LP_NUM_THREADS={os.environ['LP_NUM_THREADS']}")
+    print(
+        f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python "
+        f"{platform.python_version()}, LP_NUM_THREADS={os.environ['LP_NUM_THREADS']}"
+    )
     per_frame = []
     for name, (state, sun, extent) in CASES.items():
         results = run_case(name, state, sun, extent, args.size, args.frames, args.budgets, args.reference)
@@ -129,9 +156,11 @@ def main() -> None:
     h5_b, video_b = disk_bytes(per_frame[0][default]["frame"], args.size)
     frames = 500 * 7500
     print(f"\nper frame on disk: frames.h5 {h5_b / 1e6:.2f} MB (radiance + depth), video.mkv {video_b / 1e6:.3f} MB")
-    print(f"paper config ({frames:.2e} frames at {args.size}^2, budget {default} px/cell, {s:.3f} s/frame): "
-          f"{frames * s / 3600:.0f} core-hours to render; frames.h5 {frames * h5_b / 1e12:.1f} TB (temporary), "
-          f"video.mkv {frames * video_b / 1e12:.2f} TB")
+    print(
+        f"paper config ({frames:.2e} frames at {args.size}^2, budget {default} px/cell, {s:.3f} s/frame): "
+        f"{frames * s / 3600:.0f} core-hours to render; frames.h5 {frames * h5_b / 1e12:.1f} TB (temporary), "
+        f"video.mkv {frames * video_b / 1e12:.2f} TB"
+    )
 
 
 if __name__ == "__main__":

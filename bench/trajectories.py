@@ -1,22 +1,23 @@
 """Benchmark: trajectory solves, run time against re-integration error.
 
-  python bench/trajectories.py mesh  [--config config/config.yaml]
-      N from 20 to 160, Hermite-Simpson (uniform and clustered nodes) vs trapezoidal, on
-      each scenario's base problem:
-      solve time (median of --repeat) and final-state error after re-integrating the
-      optimal controls with DOP853 (rtol 1e-10).
-  python bench/trajectories.py batch [--config config/paper.yaml] [--jobs 2] [--nodes N]
-      The whole config's samples as the workflow solves them (continuation, retries,
-      re-integration check): wall time, share solved before / after retries, worst errors.
-      Goal (issue 2): 500 trajectories on 2 cores <= 60 s, every error <= 0.1 m, 0.01 m/s.
-      --verify re-checks every accepted sample with SciPy's DOP853 afterwards (not timed).
-  python bench/trajectories.py compare --a JSON --b JSON [--samples 30]
-      Two variants of the NLP solve the same samples alternately in one process (warm
-      start from each one's base solution): time ratio B/A, mean iterations, samples
-      accepted (ocp.accept_error_m / _m_s, as the workflow), worst error. JSON keys: ocp settings (n_nodes,
-      mesh_clustering, tol, ...) or IPOPT options (mu_init, ...), e.g.
-      --a '{}' --b '{"mu_init": 0.1}'.
+python bench/trajectories.py mesh  [--config config/config.yaml]
+    N from 20 to 160, Hermite-Simpson (uniform and clustered nodes) vs trapezoidal, on
+    each scenario's base problem:
+    solve time (median of --repeat) and final-state error after re-integrating the
+    optimal controls with DOP853 (rtol 1e-10).
+python bench/trajectories.py batch [--config config/paper.yaml] [--jobs 2] [--nodes N]
+    The whole config's samples as the workflow solves them (continuation, retries,
+    re-integration check): wall time, share solved before / after retries, worst errors.
+    Goal (issue 2): 500 trajectories on 2 cores <= 60 s, every error <= 0.1 m, 0.01 m/s.
+    --verify re-checks every accepted sample with SciPy's DOP853 afterwards (not timed).
+python bench/trajectories.py compare --a JSON --b JSON [--samples 30]
+    Two variants of the NLP solve the same samples alternately in one process (warm
+    start from each one's base solution): time ratio B/A, mean iterations, samples
+    accepted (ocp.accept_error_m / _m_s, as the workflow), worst error. JSON keys: ocp settings (n_nodes,
+    mesh_clustering, tol, ...) or IPOPT options (mu_init, ...), e.g.
+    --a '{}' --b '{"mu_init": 0.1}'.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -37,39 +38,52 @@ import numpy as np  # noqa: E402
 
 from traj2events.batch import solve_samples  # noqa: E402
 from traj2events.config import load_config  # noqa: E402
-from traj2events.scenarios import ScenarioSettings  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.ocp import LandingProblem  # noqa: E402
-from traj2events.scenarios import base_conditions, sample_conditions  # noqa: E402
+from traj2events.scenarios import (  # noqa: E402
+    ScenarioSettings,  # noqa: E402
+    base_conditions,
+    sample_conditions,
+)
 from traj2events.upsample import ShootingCheck, final_state_error  # noqa: E402
 
 
-
 def machine() -> str:
-    return f"{platform.node()}, {os.cpu_count()} cores, {platform.processor() or platform.machine()}, Python {platform.python_version()}"
+    cpu = platform.processor() or platform.machine()
+    return f"{platform.node()}, {os.cpu_count()} cores, {cpu}, Python {platform.python_version()}"
 
 
 def mesh(config: dict, repeat: int) -> None:
-    print("| scenario | transcription | mesh a | N | iterations | solve (s, median) | final position error (m) | final velocity error (m/s) |")
+    print(
+        "| scenario | transcription | mesh a | N | iterations | solve (s, median) | final position error (m) "
+        "| final velocity error (m/s) |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for name in config["scenarios"]:
         s = ScenarioSettings.from_config(config, name)
         dyn = Dynamics(s.vehicle)
         bc = base_conditions(s.scenario, s.vehicle)
-        for transcription, a, nodes in (("hermite-simpson", 0.0, (20, 40, 60, 80, 120, 160)),
-                                        ("hermite-simpson", 0.6, (20, 30, 40, 50, 60, 80)),
-                                        ("trapezoidal", 0.0, (39, 79, 159, 319))):
+        for transcription, a, nodes in (
+            ("hermite-simpson", 0.0, (20, 40, 60, 80, 120, 160)),
+            ("hermite-simpson", 0.6, (20, 30, 40, 50, 60, 80)),
+            ("trapezoidal", 0.0, (39, 79, 159, 319)),
+        ):
             for n in nodes:
-                problem = LandingProblem(s.vehicle, replace(s.ocp, n_nodes=n, transcription=transcription,
-                                                            mesh_clustering=a, refine_n_nodes=0))
+                problem = LandingProblem(
+                    s.vehicle,
+                    replace(s.ocp, n_nodes=n, transcription=transcription, mesh_clustering=a, refine_n_nodes=0),
+                )
                 problem.solve(bc)  # first solve pays for building the expanded functions
                 times, sol = [], None
                 for _ in range(repeat):
                     sol = problem.solve(bc)
                     times.append(sol.solve_time_s)
                 err = final_state_error(dyn, sol.t, sol.state, sol.control) if sol.success else (np.nan, np.nan)
-                print(f"| {name} | {transcription} | {a} | {n} | {sol.iterations} | {statistics.median(times):.3f} | "
-                      f"{err[0]:.2e} | {err[1]:.2e} |", flush=True)
+                print(
+                    f"| {name} | {transcription} | {a} | {n} | {sol.iterations} | {statistics.median(times):.3f} | "
+                    f"{err[0]:.2e} | {err[1]:.2e} |",
+                    flush=True,
+                )
 
 
 def dop853_errors(vehicle, results) -> tuple[float, float]:
@@ -92,15 +106,19 @@ def batch(config: dict, jobs: int, nodes: int | None, clustering: float | None, 
         s = ScenarioSettings.from_config(config, name)
         t0 = time.perf_counter()
         base = LandingProblem(s.vehicle, s.ocp).solve(base_conditions(s.scenario, s.vehicle))
-        results = solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base,
-                                jobs=jobs)
+        results = solve_samples(
+            s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base, jobs=jobs
+        )
         ok = [r for r in results if r.success]
         er = max((r.error_position_m for r in ok), default=np.nan)
         ev = max((r.error_velocity_m_s for r in ok), default=np.nan)
         n_over = sum(r.error_position_m > 0.1 or r.error_velocity_m_s > 0.01 for r in ok)
-        print(f"{name}: {len(results)} samples, {sum(r.method == 'warm' for r in results)} on the first attempt, "
-              f"{len(ok)} solved, max error {er:.3g} m / {ev:.3g} m/s, {n_over} over 0.1 m or 0.01 m/s, "
-              f"{time.perf_counter() - t0:.1f} s (solves {sum(r.total_time_s for r in results):.1f} s of CPU)", flush=True)
+        print(
+            f"{name}: {len(results)} samples, {sum(r.method == 'warm' for r in results)} on the first attempt, "
+            f"{len(ok)} solved, max error {er:.3g} m / {ev:.3g} m/s, {n_over} over 0.1 m or 0.01 m/s, "
+            f"{time.perf_counter() - t0:.1f} s (solves {sum(r.total_time_s for r in results):.1f} s of CPU)",
+            flush=True,
+        )
         if verify:
             verified.append((name, s.vehicle, results))
         totals["n"] += len(results)
@@ -109,12 +127,14 @@ def batch(config: dict, jobs: int, nodes: int | None, clustering: float | None, 
         totals["solved"] += len(ok)
         worst_r, worst_v, over = max(worst_r, er), max(worst_v, ev), over + n_over
     wall = time.perf_counter() - start
-    print(f"TOTAL: {totals['n']} trajectories, N = {config['ocp']['n_nodes']}, "
-          f"clustering {config['ocp'].get('mesh_clustering', 0.0)}, {jobs} processes: {wall:.1f} s wall; "
-          f"{100 * totals['first'] / totals['n']:.1f} % accepted before retries "
-          f"({100 * totals['first_converged'] / totals['n']:.1f} % converged on the first attempt), "
-          f"{100 * totals['solved'] / totals['n']:.1f} % after; max error {worst_r:.3g} m / {worst_v:.3g} m/s; "
-          f"{over} over the goal")
+    print(
+        f"TOTAL: {totals['n']} trajectories, N = {config['ocp']['n_nodes']}, "
+        f"clustering {config['ocp'].get('mesh_clustering', 0.0)}, {jobs} processes: {wall:.1f} s wall; "
+        f"{100 * totals['first'] / totals['n']:.1f} % accepted before retries "
+        f"({100 * totals['first_converged'] / totals['n']:.1f} % converged on the first attempt), "
+        f"{100 * totals['solved'] / totals['n']:.1f} % after; max error {worst_r:.3g} m / {worst_v:.3g} m/s; "
+        f"{over} over the goal"
+    )
     for name, vehicle, results in verified:  # outside the timed part
         er, ev = dop853_errors(vehicle, results)
         print(f"  {name}: DOP853 (rtol 1e-10) re-integration, worst final error {er:.3g} m / {ev:.3g} m/s")
@@ -140,9 +160,12 @@ def compare(config: dict, a: dict, b: dict, n_samples: int) -> None:
                 accepted = err[0] <= problem.settings.accept_error_m and err[1] <= problem.settings.accept_error_m_s
                 row.append((sol.solve_time_s, sol.iterations, accepted, err[0]))
         ra, rb = np.array(rows[0]), np.array(rows[1])
-        print(f"{name}: time B/A {rb[:, 0].sum() / ra[:, 0].sum():.3f}; iterations {ra[:, 1].mean():.1f} / "
-              f"{rb[:, 1].mean():.1f}; accepted {int(ra[:, 2].sum())} / {int(rb[:, 2].sum())}; "
-              f"worst error {ra[:, 3].max():.3g} / {rb[:, 3].max():.3g} m", flush=True)
+        print(
+            f"{name}: time B/A {rb[:, 0].sum() / ra[:, 0].sum():.3f}; iterations {ra[:, 1].mean():.1f} / "
+            f"{rb[:, 1].mean():.1f}; accepted {int(ra[:, 2].sum())} / {int(rb[:, 2].sum())}; "
+            f"worst error {ra[:, 3].max():.3g} / {rb[:, 3].max():.3g} m",
+            flush=True,
+        )
 
 
 def main() -> None:
@@ -151,7 +174,9 @@ def main() -> None:
     parser.add_argument("--a", default="{}", help="compare: variant A as JSON")
     parser.add_argument("--b", default="{}", help="compare: variant B as JSON")
     parser.add_argument("--samples", type=int, default=30, help="compare: samples per scenario")
-    parser.add_argument("--config", default=None, help="config YAML (mesh: config/config.yaml, batch: config/paper.yaml)")
+    parser.add_argument(
+        "--config", default=None, help="config YAML (mesh: config/config.yaml, batch: config/paper.yaml)"
+    )
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--nodes", type=int, default=None, help="override ocp.n_nodes (batch)")
     parser.add_argument("--clustering", type=float, default=None, help="override ocp.mesh_clustering (batch)")

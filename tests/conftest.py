@@ -1,4 +1,5 @@
 """Shared fixtures: the default vehicle, small problems that solve in well under a second."""
+
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +13,23 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def landing_bc(downrange=1500.0, altitude=600.0, speed=15.0, pitch_deg=5.0, mass=10_000.0, tf_guess=50.0):
     """A descent-like landing towards the site at the origin (z down)."""
-    initial = np.array([-downrange, 20.0, -altitude, speed, 0.5, 5.0, np.radians(1.0), np.radians(pitch_deg),
-                        np.radians(2.0), 0.0, 0.0, 0.0, mass])
+    initial = np.array(
+        [
+            -downrange,
+            20.0,
+            -altitude,
+            speed,
+            0.5,
+            5.0,
+            np.radians(1.0),
+            np.radians(pitch_deg),
+            np.radians(2.0),
+            0.0,
+            0.0,
+            0.0,
+            mass,
+        ]
+    )
     final = np.zeros(13)
     final[8] = final[12] = np.nan
     return BoundaryConditions(initial, final, tf_guess)

@@ -1,4 +1,5 @@
 """Camera model: intrinsics, projection, poses, the OpenGL conversion."""
+
 import numpy as np
 import pytest
 

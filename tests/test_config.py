@@ -1,5 +1,6 @@
 """Config: overlays on the one set of defaults, and validation that names the key of every
 class of mistake."""
+
 import copy
 import subprocess
 import sys
@@ -7,11 +8,10 @@ import sys
 import pytest
 import yaml
 
+from conftest import ROOT
 from traj2events.config import SCHEMA_PATH, ConfigError, load_config, load_yaml, resolve_config, validate_config
 from traj2events.defaults import default_config, merge_config
 from traj2events.scenarios import ScenarioSettings
-
-from conftest import ROOT
 
 
 @pytest.fixture(scope="module")
@@ -100,16 +100,22 @@ def test_settings_json_differs_only_for_the_edited_scenario(config):
     edited = copy.deepcopy(config)
     edited["scenarios"]["descent"]["altitude_m"] = [300.0, 900.0]
     for name in ("braking", "approach"):
-        assert ScenarioSettings.from_config(config, name).to_json() == ScenarioSettings.from_config(edited, name).to_json()
-    assert ScenarioSettings.from_config(config, "descent").to_json() != ScenarioSettings.from_config(edited, "descent").to_json()
+        assert (
+            ScenarioSettings.from_config(config, name).to_json() == ScenarioSettings.from_config(edited, name).to_json()
+        )
+    assert (
+        ScenarioSettings.from_config(config, "descent").to_json()
+        != ScenarioSettings.from_config(edited, "descent").to_json()
+    )
 
 
 def test_cli_check_config_reports_the_key(tmp_path, config):
     config["camera"]["fps"] = -5
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(config))
-    run = subprocess.run([sys.executable, "-m", "traj2events.cli", "check-config", str(path)],
-                         capture_output=True, text=True)
+    run = subprocess.run(
+        [sys.executable, "-m", "traj2events.cli", "check-config", str(path)], capture_output=True, text=True
+    )
     assert run.returncode == 2
     assert "camera.fps" in run.stderr
 
@@ -124,10 +130,27 @@ def test_missing_or_broken_file_is_named(tmp_path):
 
 
 def test_motion_field_cli_names_a_missing_trajectory(tmp_path):
-    run = subprocess.run([sys.executable, "-m", "traj2events.cli", "motion-field", str(tmp_path / "nope.h5"),
-                          "--width", "8", "--height", "8", "--fov-deg", "45", "--output", str(tmp_path / "m.h5"),
-                          "--flo-dir", str(tmp_path / "flow")],
-                         capture_output=True, text=True)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "traj2events.cli",
+            "motion-field",
+            str(tmp_path / "nope.h5"),
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--fov-deg",
+            "45",
+            "--output",
+            str(tmp_path / "m.h5"),
+            "--flo-dir",
+            str(tmp_path / "flow"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert run.returncode == 2 and "nope.h5" in run.stderr
     assert not (tmp_path / "m.h5").exists() and not (tmp_path / "flow").exists()
 
@@ -172,9 +195,13 @@ def test_dataclass_defaults_come_from_the_defaults_file():
     from traj2events.tiles import LodSettings
 
     d = default_config()
-    for cls, values in ((OcpSettings, d["ocp"]), (Vehicle, d["vehicle"]), (LodSettings, d["render"]["lod"]),
-                        (ReflectanceParams, d["render"]["reflectance"]),
-                        (TerrainParams, {k: v for k, v in d["terrain"].items() if k not in ("elevation_grid", "grid_spacing_m")})):
+    for cls, values in (
+        (OcpSettings, d["ocp"]),
+        (Vehicle, d["vehicle"]),
+        (LodSettings, d["render"]["lod"]),
+        (ReflectanceParams, d["render"]["reflectance"]),
+        (TerrainParams, {k: v for k, v in d["terrain"].items() if k not in ("elevation_grid", "grid_spacing_m")}),
+    ):
         defaults = {f.name: f.default for f in fields(cls) if f.name in values}
         assert set(defaults) == set(values), cls  # every config key is a field
         assert {k: (list(v) if isinstance(v, tuple) else v) for k, v in defaults.items()} == values, cls
@@ -185,11 +212,17 @@ def test_cli_defaults_come_from_the_defaults_file():
 
     d = default_config()
     args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f"])
-    assert (args.width, args.fov_deg, args.every) == (d["camera"]["width"], d["camera"]["fov_deg"],
-                                                      d["motion_field"]["every_n_frames"])
+    assert (args.width, args.fov_deg, args.every) == (
+        d["camera"]["width"],
+        d["camera"]["fov_deg"],
+        d["motion_field"]["every_n_frames"],
+    )
     args = build_parser().parse_args(["events", "in.mkv", "-o", "e.h5"])
-    assert (args.preset, args.refractory_mode, args.window_ms) == (d["events"]["preset"], d["events"]["refractory_mode"],
-                                                                  d["events"]["window_ms"])
+    assert (args.preset, args.refractory_mode, args.window_ms) == (
+        d["events"]["preset"],
+        d["events"]["refractory_mode"],
+        d["events"]["window_ms"],
+    )
 
 
 def test_non_utf8_and_non_mapping_configs_are_named(tmp_path):

@@ -1,4 +1,5 @@
 """The emulator against the checks of event-camera.md (clean preset, 100 fps unless stated)."""
+
 from dataclasses import replace
 
 import numpy as np
@@ -22,8 +23,9 @@ def run(frames, params=CLEAN, seed=0, times=None):
     return emu.process(frames, times)
 
 
-@pytest.mark.parametrize("params", [CLEAN, replace(CLEAN, cutoff_hz=3.0), replace(CLEAN, sigma=0.05),
-                                    replace(CLEAN, refractory_s=0.01)])
+@pytest.mark.parametrize(
+    "params", [CLEAN, replace(CLEAN, cutoff_hz=3.0), replace(CLEAN, sigma=0.05), replace(CLEAN, refractory_s=0.01)]
+)
 def test_constant_input_gives_no_events(params):
     frames = np.full((50, 4, 5), 120.0)
     assert len(run(frames, params)) == 0
@@ -58,7 +60,7 @@ def test_reconstruction_stays_within_a_threshold_on_random_videos():
     recon = log_i[0].reshape(-1).copy()
     emu.process(frames[:1], [0.0])  # the first frame only sets the state
     for k in range(1, len(frames)):
-        ev = emu.process(frames[k:k + 1], [k / FPS])
+        ev = emu.process(frames[k : k + 1], [k / FPS])
         pix = ev["y"].astype(int) * 7 + ev["x"]
         np.add.at(recon, pix, np.where(ev["p"] == 1, emu.theta_on[pix], -emu.theta_off[pix]))
         bound = np.maximum(emu.theta_on, emu.theta_off)
@@ -137,8 +139,9 @@ def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
     n = 400_000
     pix, t, on = np.empty(n, np.int64), np.empty(n), np.empty(n, np.bool_)
     g_max = 1.0 - 0.75 * 20.0 / 275.0
-    k = _noise_candidates(n, np.uint64(12345), _alias_table(weights), np.zeros(len(weights), np.uint8), g_max,
-                          2.0, 0.01, pix, t, on)
+    k = _noise_candidates(
+        n, np.uint64(12345), _alias_table(weights), np.zeros(len(weights), np.uint8), g_max, 2.0, 0.01, pix, t, on
+    )
     assert k == n
     expected = n * weights / weights.sum()
     counts = np.bincount(pix, minlength=len(weights))

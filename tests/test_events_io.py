@@ -1,5 +1,6 @@
 """Event files: DSEC events.h5 (read back with h5py, the ms_to_idx invariant), the ELOPE
 .npz (numpy), EVT 3.0 and AEDAT4 (faery), and the `traj2events events` command."""
+
 import h5py
 import hdf5plugin  # noqa: F401
 import numpy as np
@@ -100,8 +101,10 @@ def test_events_command_on_a_video_a_folder_and_frames_h5(tmp_path):
     for k, f in enumerate(frames):
         Image.fromarray(f).save(folder / f"{k:04d}.png")
     assert main(["events", str(tmp_path / "in.mkv"), "-o", str(tmp_path / "v.h5"), "--preset", "clean"]) == 0
-    assert main(["events", str(folder), "-o", str(tmp_path / "i.h5"), "--preset", "clean", "--fps", "50",
-                 "--chunk", "7"]) == 0
+    assert (
+        main(["events", str(folder), "-o", str(tmp_path / "i.h5"), "--preset", "clean", "--fps", "50", "--chunk", "7"])
+        == 0
+    )
     from_video, attrs = read_events(tmp_path / "v.h5")
     from_images, _ = read_events(tmp_path / "i.h5")
     assert len(from_video) > 100 and from_video.tobytes() == from_images.tobytes()  # same frames, same events
@@ -112,8 +115,21 @@ def test_events_command_on_a_video_a_folder_and_frames_h5(tmp_path):
         f["t"] = np.arange(len(frames)) / 50.0
         f["radiance"] = frames.astype(np.float32) / 255.0 * 40.0
         f.attrs["display_white_w_m2_sr"] = 40.0
-    assert main(["events", str(tmp_path / "frames.h5"), "-o", str(tmp_path / "r.h5"), "--preset", "clean",
-                 "--frames-png", str(tmp_path / "r.png")]) == 0
+    assert (
+        main(
+            [
+                "events",
+                str(tmp_path / "frames.h5"),
+                "-o",
+                str(tmp_path / "r.h5"),
+                "--preset",
+                "clean",
+                "--frames-png",
+                str(tmp_path / "r.png"),
+            ]
+        )
+        == 0
+    )
     from_radiance, _ = read_events(tmp_path / "r.h5")
     assert abs(len(from_radiance) - len(from_video)) <= 0.05 * len(from_video)
     assert (tmp_path / "r.png").stat().st_size > 5000

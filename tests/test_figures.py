@@ -1,4 +1,5 @@
 """Pictures: the Baker et al. colour coding."""
+
 import numpy as np
 
 from traj2events.figures import flow_to_colour

@@ -3,8 +3,8 @@
 import h5py
 import numpy as np
 import pytest
-from conftest import landing_bc
 
+from conftest import landing_bc
 from traj2events.dynamics import Dynamics
 from traj2events.formats.atomic import atomic_directory, atomic_output
 from traj2events.formats.flow import read_flo, write_flo
@@ -43,9 +43,24 @@ def test_trajectory_file_layout(trajectory_file):
     with h5py.File(trajectory_file) as f:
         assert f["nodes/state"].shape[1] == 13 and f["nodes/control"].shape[1] == 4
         assert f["poses/state"].shape[0] == f["poses/t"].shape[0] == f["poses/control"].shape[0]
-        for key in ("thrust_main_N", "thrust_rcs_N", "lever_arm_m", "inertia_kgm2", "isp_s", "g_m_s2",
-                    "g0_m_s2", "fps", "initial_state", "final_state", "transcription", "N", "solver_status",
-                    "iterations", "solve_time_s", "cost"):
+        for key in (
+            "thrust_main_N",
+            "thrust_rcs_N",
+            "lever_arm_m",
+            "inertia_kgm2",
+            "isp_s",
+            "g_m_s2",
+            "g0_m_s2",
+            "fps",
+            "initial_state",
+            "final_state",
+            "transcription",
+            "N",
+            "solver_status",
+            "iterations",
+            "solve_time_s",
+            "cost",
+        ):
             assert key in f.attrs, key
         assert list(f["nodes"].attrs["state_names"])[:3] == ["x", "y", "z"]
 
@@ -106,8 +121,10 @@ def test_reading_outputs_needs_neither_solver_nor_renderer():
     import subprocess
     import sys
 
-    code = ("import sys, traj2events.formats.trajectory, traj2events.formats.events, traj2events.formats.flow, "
-            "traj2events.formats.frames, traj2events.formats.exports; "
-            "print(sorted(m for m in ('casadi', 'numba', 'pyrender', 'OpenGL', 'scipy', 'matplotlib') if m in sys.modules))")
+    code = (
+        "import sys, traj2events.formats.trajectory, traj2events.formats.events, traj2events.formats.flow, "
+        "traj2events.formats.frames, traj2events.formats.exports; "
+        "print(sorted(m for m in ('casadi', 'numba', 'pyrender', 'OpenGL', 'scipy', 'matplotlib') if m in sys.modules))"
+    )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert run.stdout.strip() == "[]"

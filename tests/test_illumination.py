@@ -1,4 +1,5 @@
 """Sun convention and the horizon-march shadows."""
+
 import numpy as np
 import pytest
 
@@ -26,6 +27,7 @@ def test_crater_shadow_has_the_analytic_length(azimuth, elevation):
     c, s = np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))
     t = np.arange(-radius, radius, 0.02)  # along the line through the centre, toward the Sun
     from traj2events.terrain import bilinear
+
     lit = bilinear(field.lit, (x[0], x[0]), x[1] - x[0], t * c, t * s, fill=1.0)
     measured = radius - t[lit < 0.5].min()
     expected = min(2 * radius - radius**2 * np.tan(np.radians(elevation)) / depth, 2 * radius)
@@ -44,7 +46,9 @@ def test_curvature_sets_the_local_sun_elevation():
     r = 1737400.0
     d = sun_direction(0.0, 2.0)
     tan_here, tan_there = local_sun_tan_elevation(np.array([0.0, 100e3]), np.array([0.0, 0.0]), d, r)
-    assert np.degrees(np.arctan(tan_there) - np.arctan(tan_here)) == pytest.approx(np.degrees(np.arctan(100e3 / r)), rel=1e-9)
+    assert np.degrees(np.arctan(tan_there) - np.arctan(tan_here)) == pytest.approx(
+        np.degrees(np.arctan(100e3 / r)), rel=1e-9
+    )
     # ... and away from it, a 2-degree Sun sets after ~61 km.
     assert local_sun_tan_elevation(np.array([-70e3]), np.array([0.0]), d, r)[0] == -np.inf
 

@@ -1,4 +1,5 @@
 """Motion field: finite differences, ray-sphere reference, signs, discrete displacement."""
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
@@ -87,7 +88,9 @@ def test_sphere_inverse_depth_against_ray_sphere_intersection(height):
     b = (b_tangent * (1 + delta))[:, None]
     a = np.array([[0.0, 0.05, -0.2]])
     b_eff = b * np.sqrt(1 + a**2)  # keep every column grazing: D scales with s
-    ref = np.array([[1.0 / float(reference_depth(ai, bi, normal, height)) for ai, bi in zip(a[0], row)] for row in b_eff])
+    ref = np.array(
+        [[1.0 / float(reference_depth(ai, bi, normal, height)) for ai, bi in zip(a[0], row)] for row in b_eff]
+    )
     h64 = inverse_depth_sphere(np.broadcast_to(a, b_eff.shape), b_eff, normal, height)
     err64 = np.abs(h64 / ref - 1)
     assert (err64 <= 1e-12 * (1 + 1 / np.sqrt(delta))[:, None]).all(), err64.max()
@@ -96,8 +99,12 @@ def test_sphere_inverse_depth_against_ray_sphere_intersection(height):
     # the tangent may round to a miss (h = 0), which is as exact as float32 can say.
     a32, b32 = np.broadcast_to(a, b_eff.shape).astype(np.float32), b_eff.astype(np.float32)
     with np.errstate(invalid="ignore"):
-        ref32 = np.array([[1.0 / float(reference_depth(float(ai), float(bi), normal, height))
-                           for ai, bi in zip(ra, rb)] for ra, rb in zip(a32, b32)])
+        ref32 = np.array(
+            [
+                [1.0 / float(reference_depth(float(ai), float(bi), normal, height)) for ai, bi in zip(ra, rb)]
+                for ra, rb in zip(a32, b32)
+            ]
+        )
     h32 = inverse_depth_sphere(a32, b32, normal, height)
     eps = np.finfo(np.float32).eps
     far = np.broadcast_to((delta >= 1e-5)[:, None], h32.shape)
@@ -151,8 +158,9 @@ def test_depth_map_inverse_depth_flags_sky():
 
 def field(v_c=(0, 0, 0), omega=(0, 0, 0), h=0.01):
     x_s, y_s = CAM.pixel_coordinates()
-    return motion_field(x_s, y_s, CAM.focal_px, np.full((CAM.height, CAM.width), h), np.array(v_c, float),
-                        np.array(omega, float))
+    return motion_field(
+        x_s, y_s, CAM.focal_px, np.full((CAM.height, CAM.width), h), np.array(v_c, float), np.array(omega, float)
+    )
 
 
 def test_descent_expands_about_the_principal_point():

@@ -1,10 +1,11 @@
 """The optimal-control problem: constraints hold, accuracy scales with N, and the edges."""
+
 import time
 
 import numpy as np
 import pytest
-from conftest import landing_bc
 
+from conftest import landing_bc
 from traj2events.dynamics import Vehicle
 from traj2events.ocp import FINAL_FIXED, LandingProblem, OcpSettings, node_fractions
 from traj2events.upsample import final_state_error, interpolate_controls
@@ -106,8 +107,12 @@ def test_not_enough_fuel_fails_fast_with_bounded_iterations():
     sol = problem.solve(landing_bc(mass=6100.0, altitude=3000.0, speed=100.0, downrange=5000.0))
     assert not sol.success
     assert sol.iterations <= 80
-    assert sol.status in {"Maximum_Iterations_Exceeded", "Infeasible_Problem_Detected",
-                          "Restoration_Failed", "Search_Direction_Becomes_Too_Small"}
+    assert sol.status in {
+        "Maximum_Iterations_Exceeded",
+        "Infeasible_Problem_Detected",
+        "Restoration_Failed",
+        "Search_Direction_Becomes_Too_Small",
+    }
     assert time.perf_counter() - start < 30  # bounded, not a stall (generous: shared machine)
 
 

@@ -1,9 +1,14 @@
 """The reflectance laws (numpy references that the shader mirrors)."""
+
 import numpy as np
 import pytest
 
-from traj2events.reflectance import (ReflectanceParams, chandrasekhar_h, hapke_radiance_factor,
-                                     lunar_lambert_radiance_factor)
+from traj2events.reflectance import (
+    ReflectanceParams,
+    chandrasekhar_h,
+    hapke_radiance_factor,
+    lunar_lambert_radiance_factor,
+)
 
 
 def test_h_function_matches_tabulated_values():

@@ -1,15 +1,15 @@
 """Rendering on OSMesa: depth against a ray cast on the mesh, a landmark where the camera
 model puts it, radiance on a flat plane against the reflectance law, determinism, sky."""
+
 import numpy as np
 import pytest
 
 from traj2events.camera import Camera, CameraPose, camera_pose
 from traj2events.illumination import Sun
 from traj2events.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.render import TerrainRenderer, _check_pyopengl  # noqa: E402  (sets PYOPENGL_PLATFORM first)
 from traj2events.terrain import GridTerrain, ProceduralTerrain, TerrainParams, fresh_crater_profile, surface_points
 from traj2events.tiles import LodSettings, TileSet
-
-from traj2events.render import TerrainRenderer, _check_pyopengl  # noqa: E402  (sets PYOPENGL_PLATFORM first)
 
 R_MOON = 1737400.0
 SUN = Sun(1.496e11, 105.0, 7.0)
@@ -23,8 +23,9 @@ def state(x=0.0, y=0.0, altitude=1000.0, roll=0.0, pitch=0.0, yaw=0.0):
     return s
 
 
-def render(terrain, camera, pose, radius=R_MOON, half_extent=140e3, sun=SUN, reflectance=ReflectanceParams(),
-           lod=LodSettings()):
+def render(
+    terrain, camera, pose, radius=R_MOON, half_extent=140e3, sun=SUN, reflectance=ReflectanceParams(), lod=LodSettings()
+):
     tiles = TileSet(terrain, sun.direction, radius, half_extent, lod)
     with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
         return renderer.render(pose), tiles
@@ -79,8 +80,13 @@ def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
     depth_render = frame.depth_m[rows.ravel(), cols.ravel()]
     assert np.all(np.isfinite(depth_cast)) and depth_cast.min() > 4000
     # Radiance stays within what the law allows (the shader clamps sliver-triangle extrapolation).
-    from traj2events.reflectance import ReflectanceParams as Params, max_radiance_factor
-    assert 0 <= frame.radiance.min() and frame.radiance.max() <= max_radiance_factor(Params()) * SUN.irradiance_w_m2 / np.pi
+    from traj2events.reflectance import ReflectanceParams as Params
+    from traj2events.reflectance import max_radiance_factor
+
+    assert (
+        0 <= frame.radiance.min()
+        and frame.radiance.max() <= max_radiance_factor(Params()) * SUN.irradiance_w_m2 / np.pi
+    )
     np.testing.assert_allclose(depth_render, depth_cast, rtol=1e-3)
 
 
@@ -121,8 +127,11 @@ def test_flat_plane_radiance_follows_the_reflectance_law(model):
     to_camera = pose.position - points
     to_camera /= np.linalg.norm(to_camera, axis=-1, keepdims=True)
     normal = np.broadcast_to([0.0, 0.0, -1.0], points.shape)
-    expected = radiance_factor(*angles(normal, np.broadcast_to(sun.direction, points.shape), to_camera),
-                               reflectance) * sun.irradiance_w_m2 / np.pi
+    expected = (
+        radiance_factor(*angles(normal, np.broadcast_to(sun.direction, points.shape), to_camera), reflectance)
+        * sun.irradiance_w_m2
+        / np.pi
+    )
     ground = frame.depth_m > 0
     assert ground.mean() > 0.9  # and no shadow anywhere: the unshadowed law holds at every pixel
     np.testing.assert_allclose(frame.radiance[ground], expected[ground], rtol=2e-3, atol=1e-3 * expected.max())
@@ -185,8 +194,15 @@ def test_rendered_crater_shadow_has_the_analytic_length():
     sun = Sun(1.496e11, 0.0, elevation)
     camera = Camera(256, 256, 45.0)
     pose = camera_pose(state(altitude=200.0))  # nadir: columns along +x, rows along +y
-    frame, _ = render(bowl, camera, pose, radius=1e12, half_extent=2e3, sun=sun,
-                      lod=LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0))
+    frame, _ = render(
+        bowl,
+        camera,
+        pose,
+        radius=1e12,
+        half_extent=2e3,
+        sun=sun,
+        lod=LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0),
+    )
     row = 128  # through the centre (y ~ 0)
     x_s, _ = camera.pixel_coordinates()
     ground_x = x_s[0] * frame.depth_m[row] / camera.focal_px  # camera X = inertial x at zero attitude

@@ -1,23 +1,22 @@
 """Sampling of boundary conditions and the continuation/retry logic."""
+
 from dataclasses import replace
 
 import numpy as np
 import pytest
-from conftest import landing_bc
 
+from conftest import ROOT, landing_bc
 from traj2events.config import load_config
 from traj2events.ocp import Solution
 from traj2events.scenarios import (
-    ScenarioSettings,
     Acceptance,
     Scenario,
+    ScenarioSettings,
     base_conditions,
     refine_guess,
     sample_conditions,
     solve_by_continuation,
 )
-
-from conftest import ROOT
 
 
 @pytest.fixture(scope="module")
@@ -55,8 +54,20 @@ def test_base_is_the_midpoint_and_the_lander_approaches_along_plus_x(braking):
 
 
 def test_scenario_rejects_reversed_range():
-    ranges = {k: (0.0, 1.0) for k in ("downrange_m", "crossrange_m", "altitude_m", "speed_forward_m_s",
-                                      "speed_cross_m_s", "speed_down_m_s", "roll_deg", "pitch_deg", "yaw_deg")}
+    ranges = {
+        k: (0.0, 1.0)
+        for k in (
+            "downrange_m",
+            "crossrange_m",
+            "altitude_m",
+            "speed_forward_m_s",
+            "speed_cross_m_s",
+            "speed_down_m_s",
+            "roll_deg",
+            "pitch_deg",
+            "yaw_deg",
+        )
+    }
     ranges["pitch_deg"] = (60.0, 45.0)
     with pytest.raises(ValueError, match="pitch_deg"):
         Scenario("x", 1, 10.0, ranges)
@@ -75,11 +86,22 @@ class ScriptedProblem:
         self.calls.append("cold" if guess is None else "warm")
         ok = self.outcomes.pop(0)
         n = self.settings.n_nodes
-        return Solution(np.linspace(0, 10, n), np.zeros((n, 13)), np.zeros((n, 4)), 1.0, ok,
-                        "Solve_Succeeded" if ok else "Maximum_Iterations_Exceeded", 5, 0.01, "hermite-simpson")
+        return Solution(
+            np.linspace(0, 10, n),
+            np.zeros((n, 13)),
+            np.zeros((n, 4)),
+            1.0,
+            ok,
+            "Solve_Succeeded" if ok else "Maximum_Iterations_Exceeded",
+            5,
+            0.01,
+            "hermite-simpson",
+        )
 
 
-BASE = Solution(np.linspace(0, 10, 10), np.zeros((10, 13)), np.zeros((10, 4)), 1.0, True, "ok", 0, 0.0, "hermite-simpson")
+BASE = Solution(
+    np.linspace(0, 10, 10), np.zeros((10, 13)), np.zeros((10, 4)), 1.0, True, "ok", 0, 0.0, "hermite-simpson"
+)
 
 
 def accurate(sol):
@@ -108,7 +130,9 @@ def test_all_strategies_failing_is_recorded_with_its_reason():
 def test_inaccurate_solution_is_refined_on_the_fine_mesh():
     coarse, fine = ScriptedProblem([True]), ScriptedProblem([True], n_nodes=20)
     errors = iter([(5.0, 0.1), (0.01, 0.001)])  # coarse misses the tolerance, fine meets it
-    r = solve_by_continuation(coarse, landing_bc(), BASE, landing_bc(), lambda s: next(errors), Acceptance(0.1, 0.01), fine)
+    r = solve_by_continuation(
+        coarse, landing_bc(), BASE, landing_bc(), lambda s: next(errors), Acceptance(0.1, 0.01), fine
+    )
     assert r.method == "warm+refined" and len(r.solution.t) == 20
     assert r.error_position_m == pytest.approx(0.01)
 

@@ -1,11 +1,20 @@
 """Procedural terrain: crater shapes, size-frequency statistics, seeding, level of detail,
 user grids and the curved-Moon geometry."""
+
 import numpy as np
 import pytest
 
-from traj2events.terrain import (GridTerrain, ProceduralTerrain, TerrainParams, degraded_crater_profile,
-                                 fresh_crater_profile, horizon_distance_m, load_elevation_grid, site_pad_weight,
-                                 surface_points)
+from traj2events.terrain import (
+    GridTerrain,
+    ProceduralTerrain,
+    TerrainParams,
+    degraded_crater_profile,
+    fresh_crater_profile,
+    horizon_distance_m,
+    load_elevation_grid,
+    site_pad_weight,
+    surface_points,
+)
 
 R_MOON = 1737400.0
 
@@ -24,8 +33,9 @@ def test_fresh_crater_depth_to_diameter_and_rim():
 
 
 def test_crater_counts_follow_the_power_law():
-    p = TerrainParams(seed=7, crater_density_k=0.08, crater_slope=2.0, crater_diameter_min_m=2.0,
-                      crater_diameter_max_m=64.0)
+    p = TerrainParams(
+        seed=7, crater_density_k=0.08, crater_slope=2.0, crater_diameter_min_m=2.0, crater_diameter_max_m=64.0
+    )
     terrain = ProceduralTerrain(p)
     box = (0.0, 2000.0)
     craters = terrain.craters_in(box, box)
@@ -71,7 +81,11 @@ def test_landing_pad_is_flat_at_the_site():
 
 
 def test_surface_points_on_the_sphere_and_tangent_at_the_site():
-    x, y, h = np.array([0.0, 1.0, 5000.0, -80000.0]), np.array([0.0, 0.0, 300.0, 1000.0]), np.array([0.0, 2.0, -40.0, 10.0])
+    x, y, h = (
+        np.array([0.0, 1.0, 5000.0, -80000.0]),
+        np.array([0.0, 0.0, 300.0, 1000.0]),
+        np.array([0.0, 2.0, -40.0, 10.0]),
+    )
     p = surface_points(x, y, h, R_MOON)
     centre = np.array([0.0, 0.0, R_MOON])
     np.testing.assert_allclose(np.linalg.norm(p - centre, axis=1), R_MOON + h, rtol=1e-13)
@@ -95,19 +109,23 @@ def test_user_grids_load_and_interpolate(tmp_path):
     centred = load_elevation_grid(tmp_path / "dem.npz")
     assert centred.origin_m == (-4.0, -3.0)
     tifffile = pytest.importorskip("tifffile")
-    tifffile.imwrite(tmp_path / "dem.tif", heights.astype(np.float32),
-                     extratags=[(33550, "d", 3, (2.0, 2.0, 0.0))])  # ModelPixelScaleTag
+    tifffile.imwrite(
+        tmp_path / "dem.tif", heights.astype(np.float32), extratags=[(33550, "d", 3, (2.0, 2.0, 0.0))]
+    )  # ModelPixelScaleTag
     tif = load_elevation_grid(tmp_path / "dem.tif")
     assert tif.spacing_m == 2.0 and isinstance(tif, GridTerrain)
     np.testing.assert_allclose(tif.heights_m, heights)
 
 
-@pytest.mark.parametrize("name, content, message", [
-    ("missing.npy", None, "does not exist"),
-    ("dem.npy", np.zeros(5), "2-D array"),
-    ("dem.npy", np.zeros((3, 3)), "spacing unknown"),
-    ("dem.txt", "x", "expected .npy"),
-])
+@pytest.mark.parametrize(
+    "name, content, message",
+    [
+        ("missing.npy", None, "does not exist"),
+        ("dem.npy", np.zeros(5), "2-D array"),
+        ("dem.npy", np.zeros((3, 3)), "spacing unknown"),
+        ("dem.txt", "x", "expected .npy"),
+    ],
+)
 def test_bad_grids_are_named(tmp_path, name, content, message):
     path = tmp_path / name
     if isinstance(content, np.ndarray):

@@ -1,4 +1,5 @@
 """Camera poses at the frame rate."""
+
 import numpy as np
 import pytest
 

@@ -1,4 +1,5 @@
 """Videos: FFV1 round trip is exact, the preview decodes, the display mapping, no leftovers."""
+
 import numpy as np
 import pytest
 

@@ -1,4 +1,5 @@
 """The real `snakemake` command on the smoke config, in a temporary directory."""
+
 import os
 import shutil
 import subprocess
@@ -18,8 +19,18 @@ SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 
 
 def snakemake(workdir, *args, env=None, check=True):
-    cmd = [str(SNAKEMAKE), "-s", str(ROOT / "Snakefile"), "--directory", str(workdir), "--cores", "2",
-           "--configfile", str(workdir / "config.yaml"), *args]
+    cmd = [
+        str(SNAKEMAKE),
+        "-s",
+        str(ROOT / "Snakefile"),
+        "--directory",
+        str(workdir),
+        "--cores",
+        "2",
+        "--configfile",
+        str(workdir / "config.yaml"),
+        *args,
+    ]
     run = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=workdir)
     if check and run.returncode != 0:
         raise AssertionError(f"snakemake failed:\n{run.stdout[-3000:]}\n{run.stderr[-3000:]}")
@@ -27,9 +38,11 @@ def snakemake(workdir, *args, env=None, check=True):
 
 
 def two_scenario_smoke():
-    """The smoke config plus a second, one-trajectory scenario (to see what an edit touches)."""
+    """The smoke overlay plus a second, one-trajectory scenario (to see what an edit touches)."""
+    from traj2events.defaults import default_config
+
     config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
-    other = dict(config["scenarios"]["descent"], n_trajectories=1)
+    other = dict(default_config()["scenarios"]["descent"], n_trajectories=1)
     config["scenarios"]["hover"] = dict(other, downrange_m=[50.0, 150.0], altitude_m=[100.0, 200.0])
     return config
 
@@ -73,10 +86,18 @@ def test_smoke_dataset_is_complete(built):
         assert f["flow_terrain"].shape == (n, 32, 32, 2) and f["displacement_terrain"].shape == (n, 32, 32, 2)
         assert np.isfinite(f["sphere_minus_terrain_rms_px_s"][0])
     assert (results / "descent" / "0001" / "motion_field.png").stat().st_size > 10_000
-    for name in ("video.mkv", "preview.mp4", "frames.png", "events.h5", "events.png", "events.npz", "events.raw",
-                 "events.aedat4"):
+    for name in (
+        "video.mkv",
+        "preview.mp4",
+        "frames.png",
+        "events.h5",
+        "events.png",
+        "events.npz",
+        "events.raw",
+        "events.aedat4",
+    ):
         assert (results / "descent" / "0001" / name).stat().st_size > 1000, name
-    assert not (results / "descent" / "0001" / "frames.h5").exists()  # temporary by default
+    assert (results / "descent" / "0001" / "frames.h5").exists()  # kept by default
     from traj2events.video import read_video
 
     with h5py.File(results / "descent" / "0001" / "trajectory.h5") as f:
@@ -114,9 +135,15 @@ def test_same_config_same_bytes(built, tmp_path):
                 if k != "solve_time_s":
                     va, vb = np.asarray(a.attrs[k]), np.asarray(b.attrs[k])
                     assert va.tobytes() == vb.tobytes(), k  # bitwise, NaN included
-    for rel in ("results/figures/trajectories.png", "results/descent/0001/video.mkv", "results/descent/0001/preview.mp4",
-                "results/descent/0001/frames.png", "results/descent/0001/motion_field.h5",
-                "results/descent/0001/events.h5", "results/descent/0001/events.raw"):
+    for rel in (
+        "results/figures/trajectories.png",
+        "results/descent/0001/video.mkv",
+        "results/descent/0001/preview.mp4",
+        "results/descent/0001/frames.png",
+        "results/descent/0001/motion_field.h5",
+        "results/descent/0001/events.h5",
+        "results/descent/0001/events.raw",
+    ):
         assert (built / rel).read_bytes() == (tmp_path / rel).read_bytes(), rel
 
 
@@ -133,23 +160,94 @@ def test_editing_one_scenario_reruns_only_its_jobs(built, tmp_path):
     assert jobs.get("base_solution") == 1 and jobs.get("sample_trajectories") == 1
 
 
-def test_code_change_reruns_the_rules_that_use_it(built, tmp_path):
+@pytest.fixture()
+def edited_source(built, tmp_path):
+    """A copy of the built dataset and of the package's source, run from that copy."""
     shutil.copytree(built, tmp_path / "wf")
-    workdir = tmp_path / "wf"
     shutil.copytree(ROOT / "src", tmp_path / "src")
     env = dict(os.environ, PYTHONPATH=str(tmp_path / "src"))
-    assert jobs_in_dry_run(workdir, env) == {}
-    figures = tmp_path / "src" / "traj2events" / "figures.py"
-    figures.write_text(figures.read_text() + "\n# a change\n")
-    jobs = jobs_in_dry_run(workdir, env)
-    # All draw with figures.py (motion_field and events also need the temporary frames again).
-    assert jobs["trajectory_summary"] == 1 and jobs["motion_field"] == 3 and jobs["render"] == 3
-    assert jobs["events"] == 3
-    assert not {"base_solution", "sample_trajectories", "camera_poses"} & set(jobs)
-    upsample = tmp_path / "src" / "traj2events" / "upsample.py"
-    upsample.write_text(upsample.read_text() + "\n# a change\n")
-    jobs = jobs_in_dry_run(workdir, env)
+    assert jobs_in_dry_run(tmp_path / "wf", env) == {}
+    package = tmp_path / "src" / "traj2events"
+
+    def edit(module, old, new):
+        path = package / module
+        text = path.read_text()
+        assert old in text, (module, old)
+        path.write_text(text.replace(old, new, 1))
+        return {k: v for k, v in jobs_in_dry_run(tmp_path / "wf", env).items() if k != "all"}
+
+    return edit
+
+
+def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
+    assert edited_source("cli.py", 'help="frames held in memory at once', 'help="frames in memory at once') == {}
+    assert (
+        edited_source("emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;') == {}
+    )
+    assert edited_source("render.py", "\nimport os\n", "\nimport os  # a comment\n") == {}
+
+
+def test_emulator_change_reruns_events_and_their_dependants_only(edited_source):
+    jobs = edited_source("emulator.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0")
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+
+
+def test_figure_change_reruns_pictures_only(edited_source):
+    jobs = edited_source("figures.py", "fig.suptitle(title)", "fig.suptitle(title, fontsize=11)")
+    assert jobs == {
+        "frames_picture": 3,
+        "motion_field_picture": 3,
+        "events_picture": 3,
+        "dataset_picture": 1,
+        "dataset_index": 2,
+    }
+
+
+def test_solver_change_reruns_the_solves_and_everything_after(edited_source):
+    jobs = edited_source("upsample.py", "def frame_times(", "def frame_times(  # moved\n")
+    assert jobs == {}  # a comment, still nothing
+    jobs = edited_source(
+        "upsample.py",
+        "from scipy.integrate import solve_ivp",
+        "from scipy.integrate import solve_ivp as _s\nsolve_ivp = _s",
+    )
     assert jobs.get("sample_trajectories") == 2 and "base_solution" not in jobs  # both scenarios
+
+
+def edit_config(workdir, change):
+    config = yaml.safe_load((workdir / "config.yaml").read_text())
+    change(config)
+    (workdir / "config.yaml").write_text(yaml.safe_dump(config))
+    return {k: v for k, v in jobs_in_dry_run(workdir).items() if k != "all"}
+
+
+def test_picture_setting_reruns_pictures_only(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("events", {}).update(window_ms=20.0))
+    assert jobs == {"events_picture": 3, "dataset_index": 2}
+
+
+def test_emulator_setting_reruns_events_only(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("events", {}).update(preset="clean"))
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+
+
+def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    jobs = edit_config(
+        tmp_path / "wf",
+        lambda c: c["scenarios"]["hover"].update(sun={"range_m": 1.496e11, "azimuth_deg": 90.0, "elevation_deg": 10.0}),
+    )
+    assert jobs == {
+        "render": 1,
+        "motion_field": 1,
+        "events": 1,
+        "frames_picture": 1,
+        "motion_field_picture": 1,
+        "events_picture": 1,
+        "dataset_index": 1,
+    }
 
 
 def test_invalid_config_stops_before_any_job(tmp_path):
@@ -163,7 +261,8 @@ def test_invalid_config_stops_before_any_job(tmp_path):
 
 
 def test_lint_passes():
-    run = subprocess.run([str(SNAKEMAKE), "--lint", "-s", str(ROOT / "Snakefile")], capture_output=True, text=True,
-                         cwd=ROOT)
+    run = subprocess.run(
+        [str(SNAKEMAKE), "--lint", "-s", str(ROOT / "Snakefile")], capture_output=True, text=True, cwd=ROOT
+    )
     assert run.returncode == 0, run.stdout + run.stderr
     assert "Congratulations" in run.stdout + run.stderr

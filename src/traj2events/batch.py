@@ -4,6 +4,7 @@ Each worker builds the NLP once, then solves its share of samples by continuatio
 the base solution, accepting a solution only when re-integrating its controls (CVODES,
 see upsample.ShootingCheck) confirms it. Results do not depend on the number of workers.
 """
+
 from __future__ import annotations
 
 import multiprocessing as mp
@@ -21,8 +22,9 @@ from .upsample import ShootingCheck
 _worker: dict = {}
 
 
-def _init_worker(vehicle: Vehicle, settings: OcpSettings, scenario: Scenario, seed: int,
-                 base_bc: BoundaryConditions, base: Solution) -> None:
+def _init_worker(
+    vehicle: Vehicle, settings: OcpSettings, scenario: Scenario, seed: int, base_bc: BoundaryConditions, base: Solution
+) -> None:
     fine = replace(settings, n_nodes=settings.refine_n_nodes, refine_n_nodes=0) if settings.refine_n_nodes else None
     check = ShootingCheck(Dynamics(vehicle))
     _worker.update(
@@ -30,15 +32,20 @@ def _init_worker(vehicle: Vehicle, settings: OcpSettings, scenario: Scenario, se
         fine_problem=LandingProblem(vehicle, fine) if fine else None,
         verify=lambda sol: check(sol.t, sol.state, sol.control),
         acceptance=Acceptance(settings.accept_error_m, settings.accept_error_m_s),
-        vehicle=vehicle, scenario=scenario, seed=seed, base_bc=base_bc, base=base,
+        vehicle=vehicle,
+        scenario=scenario,
+        seed=seed,
+        base_bc=base_bc,
+        base=base,
     )
 
 
 def _solve_one(index: int) -> SampleResult:
     w = _worker
     bc = sample_conditions(w["scenario"], w["vehicle"], w["seed"], index)
-    return solve_by_continuation(w["problem"], w["base_bc"], w["base"], bc, w["verify"], w["acceptance"],
-                                 w["fine_problem"], index)
+    return solve_by_continuation(
+        w["problem"], w["base_bc"], w["base"], bc, w["verify"], w["acceptance"], w["fine_problem"], index
+    )
 
 
 def solve_samples(
@@ -78,6 +85,10 @@ def solve_samples(
 def print_progress(result: SampleResult, done: int, total: int) -> None:
     """One line per sample on stderr (the rule's log)."""
     s = result.solution
-    print(f"[{time.strftime('%H:%M:%S')}] sample {result.index:04d} ({done}/{total}): {result.method}, "
-          f"{s.status}, {result.total_iterations} it, {result.total_time_s:.2f} s, "
-          f"error {result.error_position_m:.2e} m / {result.error_velocity_m_s:.2e} m/s", file=sys.stderr, flush=True)
+    print(
+        f"[{time.strftime('%H:%M:%S')}] sample {result.index:04d} ({done}/{total}): {result.method}, "
+        f"{s.status}, {result.total_iterations} it, {result.total_time_s:.2f} s, "
+        f"error {result.error_position_m:.2e} m / {result.error_velocity_m_s:.2e} m/s",
+        file=sys.stderr,
+        flush=True,
+    )

@@ -5,6 +5,7 @@ along X and rows along Y; a pixel (column j, row i) has its centre at
     x_s = j + 0.5 - W/2,   y_s = i + 0.5 - H/2     (px, principal point at the centre)
 and projection is x_s = f X / Z, y_s = f Y / Z with f = W / (2 tan(fov/2)).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

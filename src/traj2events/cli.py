@@ -1,6 +1,7 @@
 """Command line: `traj2events SUBCOMMAND --help`. Each subcommand parses its arguments and
 calls one stage function (traj2events.stages); the workflow's rules call these, and each
 can be run by hand. Defaults come from defaults.yaml, like the workflow's."""
+
 from __future__ import annotations
 
 import os
@@ -43,8 +44,9 @@ def cmd_sample(args) -> int:
 
     if args.jobs < 1:
         raise ValueError(f"sample: --jobs: expected >= 1, got {args.jobs}")
-    sample_trajectories(ScenarioSettings.from_json(_settings_text(args.settings)), args.base, args.output, args.table,
-                        args.jobs)
+    sample_trajectories(
+        ScenarioSettings.from_json(_settings_text(args.settings)), args.base, args.output, args.table, args.jobs
+    )
     return 0
 
 
@@ -60,8 +62,9 @@ def cmd_upsample(args) -> int:
 def cmd_render(args) -> int:
     from .stages.render import RenderSettings, render_trajectory
 
-    render_trajectory(args.trajectory, RenderSettings.from_json(_settings_text(args.settings)), args.frames,
-                      args.video, args.preview)
+    render_trajectory(
+        args.trajectory, RenderSettings.from_json(_settings_text(args.settings)), args.frames, args.video, args.preview
+    )
     return 0
 
 
@@ -69,28 +72,50 @@ def cmd_motion_field(args) -> int:
     from .camera import Camera
     from .stages.motion_field import motion_field
 
-    motion_field(args.trajectory, Camera(args.width, args.height, args.fov_deg), args.moon_radius_m, args.every,
-                 args.output, args.flo_dir, args.frames)
+    motion_field(
+        args.trajectory,
+        Camera(args.width, args.height, args.fov_deg),
+        args.moon_radius_m,
+        args.every,
+        args.output,
+        args.flo_dir,
+        args.frames,
+    )
     return 0
 
 
 def cmd_events(args) -> int:
     from .stages.events import emulate, emulator_params, export_events, frame_source
 
-    params = emulator_params(args.preset, refractory_s=args.refractory_s, refractory_mode=args.refractory_mode,
-                             hot_pixel_fraction=args.hot_pixel_fraction, hot_pixel_hz=args.hot_pixel_hz)
+    params = emulator_params(
+        args.preset,
+        refractory_s=args.refractory_s,
+        refractory_mode=args.refractory_mode,
+        hot_pixel_fraction=args.hot_pixel_fraction,
+        hot_pixel_hz=args.hot_pixel_hz,
+    )
     source = frame_source(args.input, args.chunk, args.fps, args.white)
     from .progress import log
 
-    log(f"{args.input}: {source.width} x {source.height} {source.kind} -> {args.output} "
-        f"(preset {args.preset}, seed {args.seed})")
-    _, _, t_last = emulate(source, params, args.seed, args.output, args.preset, str(args.input),
-                           progress_every=args.chunk * 10)
+    log(
+        f"{args.input}: {source.width} x {source.height} {source.kind} -> {args.output} "
+        f"(preset {args.preset}, seed {args.seed})"
+    )
+    _, _, t_last = emulate(
+        source, params, args.seed, args.output, args.preset, str(args.input), progress_every=args.chunk * 10
+    )
     if args.frames_png:
         from .stages.pictures import events_picture
 
-        events_picture(args.output, t_last, source.width, source.height, args.window_ms,
-                       args.title or str(args.output), args.frames_png)
+        events_picture(
+            args.output,
+            t_last,
+            source.width,
+            source.height,
+            args.window_ms,
+            args.title or str(args.output),
+            args.frames_png,
+        )
     frames = str(args.input) if Path(args.input).suffix == ".h5" else None
     export_events(args.output, args.npz, args.evt3, args.aedat4, args.trajectory, frames)
     return 0
@@ -104,8 +129,9 @@ def cmd_picture(args) -> int:
     elif args.kind == "motion-field":
         from .camera import Camera
 
-        pictures.motion_field_picture(args.trajectory, Camera(args.width, args.height, args.fov_deg),
-                                      args.moon_radius_m, args.output, args.video)
+        pictures.motion_field_picture(
+            args.trajectory, Camera(args.width, args.height, args.fov_deg), args.moon_radius_m, args.output, args.video
+        )
     elif args.kind == "events":
         pictures.trajectory_events_picture(args.events, args.trajectory, args.window_ms, args.output)
     else:
@@ -131,10 +157,15 @@ def _add_camera(p: argparse.ArgumentParser) -> None:
     camera, field = section("camera"), section("motion_field")
     p.add_argument("--width", type=int, default=camera["width"], help="image width, px (default %(default)s)")
     p.add_argument("--height", type=int, default=camera["height"], help="image height, px (default %(default)s)")
-    p.add_argument("--fov-deg", type=float, default=camera["fov_deg"],
-                   help="horizontal field of view, deg (default %(default)s)")
-    p.add_argument("--moon-radius-m", type=float, default=field["moon_radius_m"],
-                   help="radius of the sphere through the landing site, m (default %(default)s)")
+    p.add_argument(
+        "--fov-deg", type=float, default=camera["fov_deg"], help="horizontal field of view, deg (default %(default)s)"
+    )
+    p.add_argument(
+        "--moon-radius-m",
+        type=float,
+        default=field["moon_radius_m"],
+        help="radius of the sphere through the landing site, m (default %(default)s)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -149,7 +180,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("check-config", help="validate config files (overlays on the defaults) against the schema")
-    p.add_argument("config", nargs="+", help="config YAML files, merged in order on the defaults, e.g. config/smoke.yaml")
+    p.add_argument(
+        "config", nargs="+", help="config YAML files, merged in order on the defaults, e.g. config/smoke.yaml"
+    )
     p.set_defaults(func=cmd_check_config)
 
     settings_help = "scenario settings as JSON (or @file): vehicle, ocp, scenario, seed"
@@ -170,59 +203,98 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--solutions", required=True, help="solutions.h5 from `traj2events sample`")
     p.add_argument("--id", type=int, required=True, help="sample index")
     p.add_argument("--fps", type=float, default=section("camera")["fps"], help="frame rate, Hz (default %(default)s)")
-    p.add_argument("--method", choices=("reintegrate", "spline"), default=section("upsampling")["method"],
-                   help="reintegrate the dynamics (exact) or the paper's cubic spline (default %(default)s)")
+    p.add_argument(
+        "--method",
+        choices=("reintegrate", "spline"),
+        default=section("upsampling")["method"],
+        help="reintegrate the dynamics (exact) or the paper's cubic spline (default %(default)s)",
+    )
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
     p.set_defaults(func=cmd_upsample)
 
-    p = sub.add_parser("render", help="render the lunar surface from every pose of a trajectory (radiance, depth, videos)")
+    p = sub.add_parser(
+        "render", help="render the lunar surface from every pose of a trajectory (radiance, depth, videos)"
+    )
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
-    p.add_argument("--settings", required=True, help="render settings as JSON (or @file): camera, terrain, sun, "
-                   "reflectance, lod, display (the workflow builds it from the config)")
+    p.add_argument(
+        "--settings",
+        required=True,
+        help="render settings as JSON (or @file): camera, terrain, sun, "
+        "reflectance, lod, display (the workflow builds it from the config)",
+    )
     p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
     p.add_argument("--preview", required=True, help="preview.mp4: H.264 of the same, to look at")
     p.set_defaults(func=cmd_render)
 
-    p = sub.add_parser("motion-field", help="ground-truth motion field of one trajectory (sphere, and terrain-true "
-                       "from frames.h5)")
+    p = sub.add_parser(
+        "motion-field", help="ground-truth motion field of one trajectory (sphere, and terrain-true from frames.h5)"
+    )
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
     _add_camera(p)
-    p.add_argument("--every", type=int, default=field["every_n_frames"],
-                   help="write every n-th frame's field (default %(default)s)")
+    p.add_argument(
+        "--every",
+        type=int,
+        default=field["every_n_frames"],
+        help="write every n-th frame's field (default %(default)s)",
+    )
     p.add_argument("--frames", help="frames.h5 from `traj2events render`: adds the terrain-true field from its depth")
     p.add_argument("--output", "-o", required=True, help="motion_field.h5")
     p.add_argument("--flo-dir", required=True, help="folder for the Middlebury .flo displacements")
     p.set_defaults(func=cmd_motion_field)
 
-    p = sub.add_parser("events", help="emulate an event camera on a video, a folder of images or frames.h5",
-                       description="Turn frames into the event stream of an event camera (the pixel model of "
-                       "docs/events.md). INPUT: frames.h5 from `traj2events render` (linear radiance, the HDR "
-                       "path), any video ffmpeg reads (8-bit grey, as v2e), or a folder of images (8-bit grey, "
-                       "sorted by name; needs --fps). Writes events.h5 in the DSEC layout.")
+    p = sub.add_parser(
+        "events",
+        help="emulate an event camera on a video, a folder of images or frames.h5",
+        description="Turn frames into the event stream of an event camera (the pixel model of "
+        "docs/events.md). INPUT: frames.h5 from `traj2events render` (linear radiance, the HDR "
+        "path), any video ffmpeg reads (8-bit grey, as v2e), or a folder of images (8-bit grey, "
+        "sorted by name; needs --fps). Writes events.h5 in the DSEC layout.",
+    )
     p.add_argument("input", help="frames.h5, a video file, or a folder of images")
     p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc/zstd)")
-    p.add_argument("--preset", choices=("paper", "clean"), default=events["preset"],
-                   help="paper: the paper's Table 2 (thresholds 0.25, sigma 0.03, 5 Hz shot noise, 0.1 Hz leak, "
-                   "3 Hz low-pass); clean: no noise, no low-pass, no mismatch (default %(default)s)")
+    p.add_argument(
+        "--preset",
+        choices=("paper", "clean"),
+        default=events["preset"],
+        help="paper: the paper's Table 2 (thresholds 0.25, sigma 0.03, 5 Hz shot noise, 0.1 Hz leak, "
+        "3 Hz low-pass); clean: no noise, no low-pass, no mismatch (default %(default)s)",
+    )
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
     p.add_argument("--white", type=float, help="radiance at full scale for frames.h5 (default: its display white)")
-    p.add_argument("--refractory-s", type=float, default=events["refractory_s"],
-                   help="refractory period, s (default %(default)s)")
-    p.add_argument("--refractory-mode", choices=("drop", "defer"), default=events["refractory_mode"],
-                   help="suppressed crossings: dropped (ESIM) or pending (v2e) (default %(default)s)")
-    p.add_argument("--hot-pixel-fraction", type=float, default=events["hot_pixel_fraction"],
-                   help="fraction of hot pixels (default %(default)s)")
-    p.add_argument("--hot-pixel-hz", type=float, default=events["hot_pixel_hz"],
-                   help="rate of the hot pixels, Hz (default %(default)s)")
+    p.add_argument(
+        "--refractory-s", type=float, default=events["refractory_s"], help="refractory period, s (default %(default)s)"
+    )
+    p.add_argument(
+        "--refractory-mode",
+        choices=("drop", "defer"),
+        default=events["refractory_mode"],
+        help="suppressed crossings: dropped (ESIM) or pending (v2e) (default %(default)s)",
+    )
+    p.add_argument(
+        "--hot-pixel-fraction",
+        type=float,
+        default=events["hot_pixel_fraction"],
+        help="fraction of hot pixels (default %(default)s)",
+    )
+    p.add_argument(
+        "--hot-pixel-hz",
+        type=float,
+        default=events["hot_pixel_hz"],
+        help="rate of the hot pixels, Hz (default %(default)s)",
+    )
     p.add_argument("--chunk", type=int, default=64, help="frames held in memory at once (default 64)")
     p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
-    p.add_argument("--window-ms", type=float, default=events["window_ms"],
-                   help="event-frame window, ms (default %(default)s)")
+    p.add_argument(
+        "--window-ms", type=float, default=events["window_ms"], help="event-frame window, ms (default %(default)s)"
+    )
     p.add_argument("--title", help="title of the event-frame figure")
-    p.add_argument("--npz", help="also write an ELOPE-style .npz (events, and with --trajectory: timestamps, traj; "
-                   "from frames.h5: range_meter)")
+    p.add_argument(
+        "--npz",
+        help="also write an ELOPE-style .npz (events, and with --trajectory: timestamps, traj; "
+        "from frames.h5: range_meter)",
+    )
     p.add_argument("--trajectory", help="trajectory.h5, for the .npz's timestamps and traj")
     p.add_argument("--evt3", help="also write Prophesee EVT 3.0 .raw (via faery)")
     p.add_argument("--aedat4", help="also write AEDAT4 (via faery)")

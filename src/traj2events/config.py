@@ -6,6 +6,7 @@ validates the merged config against config.schema.yaml (beside this module) befo
 job runs; `validate_config` turns the first problem into one line such as
 ``config key 'ocp.n_nodes': expected integer, got str 'forty'``.
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -66,16 +67,24 @@ def _semantic_errors(config: dict) -> list[str]:
     tilt = config["vehicle"]["tilt_max_deg"]
     for name, sc in config["scenarios"].items():
         if name in RESERVED_SCENARIO_NAMES:
-            errors.append(f"config key 'scenarios.{name}': the name '{name}' is reserved for results/{name}/ "
-                          f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})")
+            errors.append(
+                f"config key 'scenarios.{name}': the name '{name}' is reserved for results/{name}/ "
+                f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
+            )
         for key in RANGE_KEYS:
             lo, hi = sc[key]
             if lo > hi:
-                errors.append(f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}")
-        worst = math.cos(math.radians(max(map(abs, sc["roll_deg"])))) * math.cos(math.radians(max(map(abs, sc["pitch_deg"]))))
+                errors.append(
+                    f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}"
+                )
+        worst = math.cos(math.radians(max(map(abs, sc["roll_deg"])))) * math.cos(
+            math.radians(max(map(abs, sc["pitch_deg"])))
+        )
         if worst < math.cos(math.radians(tilt)):
-            errors.append(f"config keys 'scenarios.{name}.pitch_deg'/'roll_deg': initial tilt exceeds "
-                          f"vehicle.tilt_max_deg = {tilt} (cos(roll) cos(pitch) must stay >= cos(tilt_max))")
+            errors.append(
+                f"config keys 'scenarios.{name}.pitch_deg'/'roll_deg': initial tilt exceeds "
+                f"vehicle.tilt_max_deg = {tilt} (cos(roll) cos(pitch) must stay >= cos(tilt_max))"
+            )
     if config["vehicle"]["dry_mass_kg"] >= config["vehicle"]["mass_kg"]:
         errors.append("config key 'vehicle.dry_mass_kg': expected less than vehicle.mass_kg")
     return errors
@@ -84,7 +93,9 @@ def _semantic_errors(config: dict) -> list[str]:
 def validate_config(config: Any, schema: dict | None = None) -> None:
     """Raise ConfigError naming the first offending key (schema first, then semantics)."""
     validator = jsonschema.Draft202012Validator(schema if schema is not None else load_yaml(SCHEMA_PATH))
-    errors = sorted(validator.iter_errors(config), key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path))))
+    errors = sorted(
+        validator.iter_errors(config), key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path)))
+    )
     if errors:
         raise ConfigError(_describe(errors[0]))
     semantic = _semantic_errors(config)

@@ -1,5 +1,6 @@
 """The default configuration, defaults.yaml beside this module: the one source of every
 default. Config files are overlays on it: `merge_config(defaults, overlay)`."""
+
 from __future__ import annotations
 
 import copy

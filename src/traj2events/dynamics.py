@@ -16,6 +16,7 @@ Two deliberate deviations from the paper's printed equations (paper.md):
     optimiser "creates fuel" by firing backwards).
 The optimiser sees |u| through a smooth split u = u_plus - u_minus (see ocp.py).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -25,8 +26,16 @@ import numpy as np
 
 from .state import CONTROL_NAMES, N_CONTROL, N_STATE, STATE_NAMES, Vehicle, rotation_body_to_inertial, rotation_matrix
 
-__all__ = ["CONTROL_NAMES", "N_CONTROL", "N_STATE", "STATE_NAMES", "Vehicle", "rotation_matrix", "Dynamics",
-           "split_control_dynamics"]
+__all__ = [
+    "CONTROL_NAMES",
+    "N_CONTROL",
+    "N_STATE",
+    "STATE_NAMES",
+    "Vehicle",
+    "rotation_matrix",
+    "Dynamics",
+    "split_control_dynamics",
+]
 
 
 def _state_derivative_sx(vehicle: Vehicle) -> ca.Function:

@@ -31,6 +31,7 @@ Speed: the per-pixel work runs in numba kernels (`_advance`: one pass over the f
 `_emit`: one over the pixels that crossed; `_noise_candidates`: one per noise candidate),
 compiled on first use and cached beside this file.
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
@@ -111,9 +112,25 @@ def _rng(seed: int, *key: int) -> np.random.Generator:
 
 # --- compiled per-pixel kernels (numba): one pass over the frame, then one over the events --
 
+
 @njit(cache=True, nogil=True)
-def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_step, cutoff_hz, dt,
-             count, x0, x1, active, log_lut, gain_lut):
+def _advance(
+    intensity0,
+    intensity1,
+    filtered,
+    base,
+    theta_on,
+    theta_off,
+    leak_step,
+    cutoff_hz,
+    dt,
+    count,
+    x0,
+    x1,
+    active,
+    log_lut,
+    gain_lut,
+):
     """Low-pass and log per pixel, the leak's drift of base, and the number of threshold
     crossings (count > 0: ON, < 0: OFF). Updates filtered and base in place; lists the
     pixels with crossings in `active`, with their count, x0 and x1 in the same slots
@@ -158,8 +175,24 @@ def _advance(intensity0, intensity1, filtered, base, theta_on, theta_off, leak_s
 
 
 @njit(cache=True, nogil=True)
-def _emit(active, n_active, count, x0, x1, theta_on, theta_off, base, last_event, t0, dt, refractory_s, defer,
-          out_pix, out_t, out_p):
+def _emit(
+    active,
+    n_active,
+    count,
+    x0,
+    x1,
+    theta_on,
+    theta_off,
+    base,
+    last_event,
+    t0,
+    dt,
+    refractory_s,
+    defer,
+    out_pix,
+    out_t,
+    out_p,
+):
     """Events of the active pixels: the j-th crossing of a pixel at the time its own line
     x0 -> x1 reaches j thresholds (clipped to the interval: a level already passed fires at
     t0), the refractory period applied in time order per pixel, base moved by every
@@ -244,6 +277,7 @@ def _alias_table(weights):
 def _prefetch(typingctx, array, index):
     """Ask the CPU to start loading array[index] into cache (LLVM's prefetch; no effect
     on results): random reads issued this way ahead of use overlap their memory latency."""
+
     def codegen(context, builder, signature, args):
         array_type = signature.args[0]
         data = context.make_array(array_type)(context, builder, args[0])
@@ -251,10 +285,12 @@ def _prefetch(typingctx, array, index):
         byte_pointer = ir.IntType(8).as_pointer()
         int32 = ir.IntType(32)
         function = cgutils.get_or_insert_function(
-            builder.module, ir.FunctionType(ir.VoidType(), [byte_pointer, int32, int32, int32]), "llvm.prefetch.p0i8")
+            builder.module, ir.FunctionType(ir.VoidType(), [byte_pointer, int32, int32, int32]), "llvm.prefetch.p0i8"
+        )
         # read, keep in all cache levels, data cache
         builder.call(function, [builder.bitcast(pointer, byte_pointer), int32(0), int32(3), int32(1)])
         return context.get_dummy_value()
+
     return types.void(array, index), codegen
 
 
@@ -369,8 +405,16 @@ class EventEmulator:
         self.width, self.height, self.params, self.seed = width, height, params, seed
         n = width * height
         rng = _rng(seed, 0)
-        self.theta_on = np.maximum(rng.normal(params.theta_on, params.sigma, n), 0.01) if params.sigma else np.full(n, params.theta_on)
-        self.theta_off = np.maximum(rng.normal(params.theta_off, params.sigma, n), 0.01) if params.sigma else np.full(n, params.theta_off)
+        self.theta_on = (
+            np.maximum(rng.normal(params.theta_on, params.sigma, n), 0.01)
+            if params.sigma
+            else np.full(n, params.theta_on)
+        )
+        self.theta_off = (
+            np.maximum(rng.normal(params.theta_off, params.sigma, n), 0.01)
+            if params.sigma
+            else np.full(n, params.theta_off)
+        )
         self.leak_rate = params.leak_hz * 10.0 ** (0.1 * rng.standard_normal(n)) if params.leak_hz else np.zeros(n)
         self.leak_phase = rng.uniform(0.0, 1.0, n)
         # Shot noise per pixel scales with theta_nominal / theta(x) (frozen: computed once).
@@ -405,13 +449,22 @@ class EventEmulator:
         frames = np.asarray(frames_dn)
         times = np.asarray(times_s, dtype=np.float64)
         if frames.ndim != 3 or frames.shape[1:] != (self.height, self.width) or len(times) != len(frames):
-            raise ValueError(f"frames: expected (K, {self.height}, {self.width}) with K timestamps, "
-                             f"got {frames.shape} and {times.shape}")
+            raise ValueError(
+                f"frames: expected (K, {self.height}, {self.width}) with K timestamps, "
+                f"got {frames.shape} and {times.shape}"
+            )
         chunks = []
         if frames.dtype.kind == "f" and not (np.all(np.isfinite(frames)) and frames.min(initial=0.0) >= 0):
-            bad = int(np.argmax(~np.isfinite(frames).reshape(len(frames), -1).all(axis=1) | (frames.reshape(len(frames), -1).min(axis=1) < 0)))
-            raise ValueError(f"frames: expected finite values >= 0 (intensity), frame {bad} of this chunk "
-                             f"(t = {times[bad]:.6f} s) has NaN, inf or negative values")
+            bad = int(
+                np.argmax(
+                    ~np.isfinite(frames).reshape(len(frames), -1).all(axis=1)
+                    | (frames.reshape(len(frames), -1).min(axis=1) < 0)
+                )
+            )
+            raise ValueError(
+                f"frames: expected finite values >= 0 (intensity), frame {bad} of this chunk "
+                f"(t = {times[bad]:.6f} s) has NaN, inf or negative values"
+            )
         for frame, t in zip(frames, times):
             # 8-bit frames stay 8-bit (the kernel reads tables); anything else is float DN.
             intensity = frame.reshape(-1).copy() if frame.dtype == np.uint8 else frame.reshape(-1).astype(np.float64)
@@ -422,7 +475,9 @@ class EventEmulator:
                 raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
             chunks.append(self._interval_events(intensity, float(t)))
         # Joined as bytes: NumPy copies the 13-byte packed records one by one, bytes in bulk (3-4x).
-        return np.concatenate([c.view(np.uint8) for c in chunks]).view(EVENT_DTYPE) if chunks else np.empty(0, EVENT_DTYPE)
+        return (
+            np.concatenate([c.view(np.uint8) for c in chunks]).view(EVENT_DTYPE) if chunks else np.empty(0, EVENT_DTYPE)
+        )
 
     def _start(self, intensity: np.ndarray, t: float) -> None:
         log_i = log_intensity_8bit(intensity)
@@ -442,21 +497,52 @@ class EventEmulator:
             gain_lut = lowpass_gain(0.5 * np.arange(511.0), p.cutoff_hz, dt)  # by I0 + I1
         else:
             log_lut = gain_lut = _NO_TABLE
-        n_active = _advance(self._intensity, intensity, self._filtered, self._base, self.theta_on, self.theta_off,
-                            self._leak_step, float(p.cutoff_hz), dt, self._count, self._x0, self._x1, self._active,
-                            log_lut, gain_lut)
+        n_active = _advance(
+            self._intensity,
+            intensity,
+            self._filtered,
+            self._base,
+            self.theta_on,
+            self.theta_off,
+            self._leak_step,
+            float(p.cutoff_hz),
+            dt,
+            self._count,
+            self._x0,
+            self._x1,
+            self._active,
+            log_lut,
+            gain_lut,
+        )
         n_events = int(np.abs(self._count[:n_active]).sum())
         pix = np.empty(n_events, np.int64)
         t = np.empty(n_events, np.float64)
         on = np.empty(n_events, np.bool_)
-        k = _emit(self._active, n_active, self._count, self._x0, self._x1, self.theta_on, self.theta_off, self._base,
-                  self._last_event, t0, dt, float(p.refractory_s), p.refractory_mode == "defer", pix, t, on)
+        k = _emit(
+            self._active,
+            n_active,
+            self._count,
+            self._x0,
+            self._x1,
+            self.theta_on,
+            self.theta_off,
+            self._base,
+            self._last_event,
+            t0,
+            dt,
+            float(p.refractory_s),
+            p.refractory_mode == "defer",
+            pix,
+            t,
+            on,
+        )
         parts = [(pix[:k], t[:k], on[:k])]
         self._intensity, self._t = intensity, t1
         self._interval += 1
         parts += [self._shot_noise(intensity, t0, dt), self._hot_pixel_events(t0, dt)]
-        return _assemble(*(np.concatenate([q[j] for q in parts]) for j in range(3)), self.width,
-                         self.width * self.height)
+        return _assemble(
+            *(np.concatenate([q[j] for q in parts]) for j in range(3)), self.width, self.width * self.height
+        )
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its

@@ -1,5 +1,6 @@
 """Figures (pure: data in, matplotlib figure out): the dataset figure, the motion-field,
 frame and event-frame mosaics."""
+
 from __future__ import annotations
 
 import matplotlib
@@ -17,8 +18,12 @@ def height_pitch_bands(samples: list[dict], n_points: int = 101) -> dict[str, np
     pitch = np.array([np.interp(tau, s["t"] / s["t"][-1], np.degrees(s["state"][:, 7])) for s in samples])
     return {
         "tau": tau,
-        "height": height, "height_mean": height.mean(axis=0), "height_std": height.std(axis=0),
-        "pitch": pitch, "pitch_mean": pitch.mean(axis=0), "pitch_std": pitch.std(axis=0),
+        "height": height,
+        "height_mean": height.mean(axis=0),
+        "height_std": height.std(axis=0),
+        "pitch": pitch,
+        "pitch_mean": pitch.mean(axis=0),
+        "pitch_std": pitch.std(axis=0),
     }
 
 
@@ -28,8 +33,7 @@ def solved_samples(solution_set: dict) -> dict[int, dict]:
 
 def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
     """Height and pitch against normalised time per scenario: one sample, mean, +-3 sigma."""
-    fig, axes = plt.subplots(2, len(solution_sets), figsize=(4.2 * len(solution_sets), 6), squeeze=False,
-                             sharex=True)
+    fig, axes = plt.subplots(2, len(solution_sets), figsize=(4.2 * len(solution_sets), 6), squeeze=False, sharex=True)
     for col, data in enumerate(solution_sets):
         solved = solved_samples(data)
         name = data["attrs"]["scenario"]
@@ -40,8 +44,9 @@ def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
         for row, key, unit in ((0, "height", "height H = -z (m)"), (1, "pitch", "pitch theta (deg)")):
             ax = axes[row, col]
             mean, std = b[f"{key}_mean"], b[f"{key}_std"]
-            ax.fill_between(b["tau"], mean - 3 * std, mean + 3 * std, color="tab:blue", alpha=0.2,
-                            label="mean +- 3 sigma")
+            ax.fill_between(
+                b["tau"], mean - 3 * std, mean + 3 * std, color="tab:blue", alpha=0.2, label="mean +- 3 sigma"
+            )
             ax.plot(b["tau"], mean, color="tab:blue", label="mean")
             ax.plot(b["tau"], b[key][0], color="tab:orange", ls="--", label=f"sample {next(iter(solved)):04d}")
             ax.set_ylabel(unit)
@@ -57,8 +62,14 @@ def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
 
 def _colour_wheel() -> np.ndarray:
     """The Middlebury colour wheel (Baker et al. 2007): 55 hues, RGB in [0, 1]."""
-    segments = [(15, (1, 0, 0), (1, 1, 0)), (6, (1, 1, 0), (0, 1, 0)), (4, (0, 1, 0), (0, 1, 1)),
-                (11, (0, 1, 1), (0, 0, 1)), (13, (0, 0, 1), (1, 0, 1)), (6, (1, 0, 1), (1, 0, 0))]
+    segments = [
+        (15, (1, 0, 0), (1, 1, 0)),
+        (6, (1, 1, 0), (0, 1, 0)),
+        (4, (0, 1, 0), (0, 1, 1)),
+        (11, (0, 1, 1), (0, 0, 1)),
+        (13, (0, 0, 1), (1, 0, 1)),
+        (6, (1, 0, 1), (1, 0, 0)),
+    ]
     wheel = []
     for n, start, end in segments:
         s = np.arange(n)[:, None] / n
@@ -86,8 +97,15 @@ def flow_to_colour(flow: np.ndarray, max_flow: float | None = None) -> np.ndarra
     return np.round(255 * colour).astype(np.uint8)
 
 
-def motion_field_mosaic(times: list[float], flows: list[np.ndarray], terrain: list[np.ndarray], labels: list[str],
-                        title: str, n_arrows: int = 16, backgrounds: list[np.ndarray] | None = None) -> plt.Figure:
+def motion_field_mosaic(
+    times: list[float],
+    flows: list[np.ndarray],
+    terrain: list[np.ndarray],
+    labels: list[str],
+    title: str,
+    n_arrows: int = 16,
+    backgrounds: list[np.ndarray] | None = None,
+) -> plt.Figure:
     """Colour-wheel image (top) and a sparse quiver plot (bottom) of each field, px/s,
     drawn over the rendered frame when `backgrounds` (8-bit images) are given."""
     fig, axes = plt.subplots(2, len(flows), figsize=(3.0 * len(flows), 6.2), squeeze=False)
@@ -98,7 +116,7 @@ def motion_field_mosaic(times: list[float], flows: list[np.ndarray], terrain: li
         axes[0, col].set_title(f"{label}: t = {t:.1f} s\n99th pct. {top:.3g} px/s", fontsize=9)
         height, width = speed.shape
         step = max(1, max(height, width) // n_arrows)
-        rows, cols = np.mgrid[step // 2:height:step, step // 2:width:step]
+        rows, cols = np.mgrid[step // 2 : height : step, step // 2 : width : step]
         ax = axes[1, col]
         if backgrounds is not None:
             ax.imshow(backgrounds[col], cmap="gray", vmin=0, vmax=255)
@@ -142,8 +160,9 @@ def event_frame(events: np.ndarray, width: int, height: int, t_start_us: int, t_
     return image
 
 
-def event_mosaic(times_s: list[float], frames: list[np.ndarray], counts: list[int], labels: list[str], title: str,
-                 window_ms: float) -> plt.Figure:
+def event_mosaic(
+    times_s: list[float], frames: list[np.ndarray], counts: list[int], labels: list[str], title: str, window_ms: float
+) -> plt.Figure:
     """The paper's event-frame mosaic: one accumulated window per time, side by side."""
     fig, axes = plt.subplots(1, len(frames), figsize=(3.0 * len(frames), 3.5), squeeze=False)
     for ax, t, frame, count, label in zip(axes[0], times_s, frames, counts, labels):

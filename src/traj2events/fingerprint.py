@@ -7,6 +7,7 @@ tree without docstrings (comments are not in the tree), plus the package's data 
 module names (the shaders). The YAML files are left out: their values reach the rules as
 config, through `params`.
 """
+
 from __future__ import annotations
 
 import ast
@@ -41,7 +42,7 @@ def imported_modules(name: str, tree: ast.AST, path: Path) -> set[str]:
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package.split(".")
-                base = base[:len(base) - (node.level - 1)]
+                base = base[: len(base) - (node.level - 1)]
                 target = ".".join(base + ([node.module] if node.module else []))
             else:
                 target = node.module or ""
@@ -76,8 +77,12 @@ def _without_docstrings(tree: ast.AST) -> ast.AST:
     for node in ast.walk(tree):
         if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
             body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
-                    and isinstance(body[0].value.value, str):
+            if (
+                body
+                and isinstance(body[0], ast.Expr)
+                and isinstance(body[0].value, ast.Constant)
+                and isinstance(body[0].value.value, str)
+            ):
                 node.body = body[1:] or [ast.Pass()]
     return tree
 
@@ -86,8 +91,13 @@ def data_files(tree: ast.AST) -> list[Path]:
     """Package data (files, or the files of a folder) named by a string in the code; YAML excluded."""
     files: set[Path] = set()
     for node in ast.walk(tree):
-        if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value \
-                and "/" not in node.value and not node.value.startswith("."):
+        if (
+            isinstance(node, ast.Constant)
+            and isinstance(node.value, str)
+            and node.value
+            and "/" not in node.value
+            and not node.value.startswith(".")
+        ):
             candidate = PACKAGE_DIR / node.value
             if candidate.is_dir() and not (candidate / "__init__.py").exists():
                 files.update(p for p in candidate.iterdir() if p.is_file())

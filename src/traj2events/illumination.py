@@ -20,6 +20,7 @@ Sweeping the grid row by row from the Sun's side, with linear interpolation acro
 row, costs O(cells). A point is lit when h(P) > S(P); the lit fraction ramps linearly
 over one step's rise of the ray, which places the shadow edge inside a cell.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -86,12 +87,19 @@ class ShadowField:
 
     def obstruction_at(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
         """Bilinear O at points inside the grid; -inf outside (callers pass a parent)."""
-        return bilinear(self.obstruction_m, (self.x_m[0], self.y_m[0]), self.x_m[1] - self.x_m[0], x_m, y_m,
-                        fill=-np.inf)
+        return bilinear(
+            self.obstruction_m, (self.x_m[0], self.y_m[0]), self.x_m[1] - self.x_m[0], x_m, y_m, fill=-np.inf
+        )
 
 
-def shadow_field(x_m: np.ndarray, y_m: np.ndarray, heights_m: np.ndarray, sun_dir: np.ndarray, radius_m: float,
-                 beyond: Boundary = no_obstruction) -> ShadowField:
+def shadow_field(
+    x_m: np.ndarray,
+    y_m: np.ndarray,
+    heights_m: np.ndarray,
+    sun_dir: np.ndarray,
+    radius_m: float,
+    beyond: Boundary = no_obstruction,
+) -> ShadowField:
     """Sweep the regular grid (x along axis 0, y along axis 1, equal spacing) toward the Sun.
     `beyond(x, y)` gives the obstruction height O at points outside the grid (from a
     coarser field, or nothing)."""

@@ -17,6 +17,7 @@ Arrays: x_s is a row (1, W) and y_s a column (H, 1); terms that depend on one of
 only are computed on the row or column and broadcast, which keeps a 1024 x 1024 field to
 a handful of full-size operations.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -127,8 +128,9 @@ def motion_field(
     return u, v
 
 
-def sphere_flow(camera: Camera, state: np.ndarray, radius_m: float = MOON_RADIUS_M,
-                dtype=np.float32) -> tuple[np.ndarray, np.ndarray]:
+def sphere_flow(
+    camera: Camera, state: np.ndarray, radius_m: float = MOON_RADIUS_M, dtype=np.float32
+) -> tuple[np.ndarray, np.ndarray]:
     """Instantaneous field (H, W, 2) px/s over the sphere for one 13-state, and the
     terrain mask (H, W) (False: sky, rotation-only flow)."""
     pose = camera_pose(state)
@@ -150,8 +152,9 @@ def depth_flow(camera: Camera, state: np.ndarray, depth_m: np.ndarray) -> tuple[
     return np.stack([u, v], axis=-1), h > 0
 
 
-def sphere_displacement(camera: Camera, state_k: np.ndarray, state_next: np.ndarray,
-                        radius_m: float = MOON_RADIUS_M) -> tuple[np.ndarray, np.ndarray]:
+def sphere_displacement(
+    camera: Camera, state_k: np.ndarray, state_next: np.ndarray, radius_m: float = MOON_RADIUS_M
+) -> tuple[np.ndarray, np.ndarray]:
     """Exact displacement (H, W, 2) in px from frame k to frame k+1, and the mask of pixels
     whose surface point is on the sphere at k and in front of, and not hidden by the limb
     from, camera k+1. Sky pixels move as directions at infinity (rotation only). float64."""
@@ -167,8 +170,9 @@ def sphere_displacement(camera: Camera, state_k: np.ndarray, state_next: np.ndar
     return displacement, (h > 0) & in_front & facing
 
 
-def depth_displacement(camera: Camera, state_k: np.ndarray, state_next: np.ndarray,
-                       depth_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def depth_displacement(
+    camera: Camera, state_k: np.ndarray, state_next: np.ndarray, depth_m: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Exact displacement (H, W, 2) in px from frame k to k+1 of the surface seen in a
     depth map (metric depth along the boresight at k; 0 = sky, moved as a direction), and
     the mask of terrain pixels in front of camera k+1. Occlusion at k+1 is not checked. float64."""

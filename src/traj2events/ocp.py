@@ -10,11 +10,13 @@ the mean of its nodes: quadratic interpolants overshoot their bounds where contr
 saturate, trajectories.md), or trapezoidal; Hermite-Simpson in the compressed form
 (midpoint states substituted). Nodes may cluster toward both ends (`mesh_clustering`),
 where landings turn fastest. The problem is solved in nondimensional variables (1000 m,
-100 m/s, 10 s, 1e4 kg), which IPOPT needs far fewer iterations for, with MUMPS' own scaling off (bounded iteration counts for every t_f
-guess) and constant bounds given to IPOPT as variable bounds (they then hold at every
-iterate, and the KKT system is smaller). It is built once and solved many times with
+100 m/s, 10 s, 1e4 kg), which IPOPT needs far fewer iterations for, with MUMPS' own
+scaling off (bounded iteration counts for every t_f guess) and constant bounds given to
+IPOPT as variable bounds (they then hold at every iterate, and the KKT system is
+smaller). It is built once and solved many times with
 new boundary conditions.
 """
+
 from __future__ import annotations
 
 import time
@@ -220,9 +222,7 @@ class LandingProblem:
         return bc.tf_guess_s * self.fractions, state, control
 
     # -- solve -------------------------------------------------------------------------
-    def solve(
-        self, bc: BoundaryConditions, guess: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-    ) -> Solution:
+    def solve(self, bc: BoundaryConditions, guess: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None) -> Solution:
         """Solve for `bc`, starting from `guess` = (t, state, control) or a cold guess."""
         opti = self._opti
         t_guess, state_guess, control_guess = guess if guess is not None else self.cold_guess(bc)

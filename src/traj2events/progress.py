@@ -1,4 +1,5 @@
 """Progress lines on stderr (the workflow's per-job log files)."""
+
 from __future__ import annotations
 
 import sys

@@ -18,6 +18,7 @@ Lunar-Lambert (McEwen 1991, 1996):
     L(g) = 1 - 0.019 g + 2.42e-4 g^2 - 1.46e-6 g^3     (g in degrees; clipped to [0, 1],
            the polynomial leaves it beyond ~110 deg where the fit has no data)
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -73,14 +74,18 @@ def hapke_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p:
     w = p.single_scattering_albedo
     g = np.arccos(np.clip(cos_g, -1.0, 1.0))
     opposition = p.opposition_b0 / (1.0 + np.tan(g / 2.0) / p.opposition_h)
-    phase = 0.5 * (1 + p.phase_c) * henyey_greenstein(p.phase_b, cos_g) + 0.5 * (1 - p.phase_c) * henyey_greenstein(-p.phase_b, cos_g)
+    phase = 0.5 * (1 + p.phase_c) * henyey_greenstein(p.phase_b, cos_g) + 0.5 * (1 - p.phase_c) * henyey_greenstein(
+        -p.phase_b, cos_g
+    )
     multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0
     with np.errstate(invalid="ignore", divide="ignore"):
         rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple)
     return np.where((mu0 > 0) & (mu > 0), rf, 0.0)
 
 
-def lunar_lambert_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams) -> np.ndarray:
+def lunar_lambert_radiance_factor(
+    mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams
+) -> np.ndarray:
     mu0, mu, cos_g = (np.asarray(a, dtype=float) for a in (mu0, mu, cos_g))
     g = np.degrees(np.arccos(np.clip(cos_g, -1.0, 1.0)))
     limb = np.clip(1.0 - 0.019 * g + 2.42e-4 * g**2 - 1.46e-6 * g**3, 0.0, 1.0)  # the fit turns negative past ~110 deg

@@ -12,6 +12,7 @@ that adapts pyrender 0.1.45 to that setting (tested in tests/test_render.py):
     radiance (W m^-2 sr^-1) and depth along the boresight (m, computed in the shader,
     0 for sky) as float32 (a two-channel buffer: half the bytes of RGBA).
 """
+
 from __future__ import annotations
 
 import os
@@ -35,8 +36,10 @@ def _check_pyopengl() -> None:
 
     version = tuple(int(p) for p in OpenGL.__version__.split(".")[:3] if p.isdigit())
     if version < (3, 1, 5):
-        raise RuntimeError(f"PyOpenGL {OpenGL.__version__} cannot drive OSMesa (pyrender pins 3.1.0); "
-                           "install PyOpenGL>=3.1.5 (bash setup.sh does)")
+        raise RuntimeError(
+            f"PyOpenGL {OpenGL.__version__} cannot drive OSMesa (pyrender pins 3.1.0); "
+            "install PyOpenGL>=3.1.5 (bash setup.sh does)"
+        )
 
 
 def _import_pyrender():
@@ -45,8 +48,10 @@ def _import_pyrender():
 
     platform = type(OpenGL.platform.PLATFORM).__name__
     if os.environ["PYOPENGL_PLATFORM"] == "osmesa" and "OSMesa" not in platform:
-        raise RuntimeError(f"OpenGL was imported with the {platform} before traj2events.render set "
-                           "PYOPENGL_PLATFORM=osmesa; set it in the environment or import traj2events.render first")
+        raise RuntimeError(
+            f"OpenGL was imported with the {platform} before traj2events.render set "
+            "PYOPENGL_PLATFORM=osmesa; set it in the environment or import traj2events.render first"
+        )
     import pyrender
 
     return pyrender
@@ -77,14 +82,17 @@ def _make_float_renderer_class(pyrender):
                 gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self._main_cb)
                 gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RG32F, self.viewport_width, self.viewport_height)
                 gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self._main_db)
-                gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT32F, self.viewport_width,
-                                         self.viewport_height)
+                gl.glRenderbufferStorage(
+                    gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT32F, self.viewport_width, self.viewport_height
+                )
                 self._main_fb = gl.glGenFramebuffers(1)
                 gl.glBindFramebuffer(gl.GL_DRAW_FRAMEBUFFER, self._main_fb)
-                gl.glFramebufferRenderbuffer(gl.GL_DRAW_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER,
-                                             self._main_cb)
-                gl.glFramebufferRenderbuffer(gl.GL_DRAW_FRAMEBUFFER, gl.GL_DEPTH_ATTACHMENT, gl.GL_RENDERBUFFER,
-                                             self._main_db)
+                gl.glFramebufferRenderbuffer(
+                    gl.GL_DRAW_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER, self._main_cb
+                )
+                gl.glFramebufferRenderbuffer(
+                    gl.GL_DRAW_FRAMEBUFFER, gl.GL_DEPTH_ATTACHMENT, gl.GL_RENDERBUFFER, self._main_db
+                )
                 if gl.glCheckFramebufferStatus(gl.GL_DRAW_FRAMEBUFFER) != gl.GL_FRAMEBUFFER_COMPLETE:
                     raise RuntimeError("OSMesa: float32 framebuffer incomplete")
                 # pyrender draws into _main_fb_ms; point it at the single-sample buffer.
@@ -119,8 +127,10 @@ def _make_float_renderer_class(pyrender):
                 for primitive in node.mesh.primitives:
                     if program is None:
                         program = self._program_cache.get_program(
-                            vertex_shader="terrain.vert", fragment_shader="terrain.frag",
-                            defines={"NORMAL_LOC": 1, "TEXCOORD_0_LOC": 2, "INST_M_LOC": 3})
+                            vertex_shader="terrain.vert",
+                            fragment_shader="terrain.frag",
+                            defines={"NORMAL_LOC": 1, "TEXCOORD_0_LOC": 2, "INST_M_LOC": 3},
+                        )
                         if not program._in_context():
                             program._add_to_context()
                         program._bind()
@@ -156,8 +166,9 @@ class TerrainRenderer:
     """Renders a TileSet from camera poses. One OSMesa context; tiles are uploaded once
     and kept while they are in use."""
 
-    def __init__(self, tiles: TileSet, camera: Camera, sun: Sun, reflectance: ReflectanceParams,
-                 max_cached_tiles: int = 4000):
+    def __init__(
+        self, tiles: TileSet, camera: Camera, sun: Sun, reflectance: ReflectanceParams, max_cached_tiles: int = 4000
+    ):
         pyrender = _import_pyrender()
         from pyrender.platforms.osmesa import OSMesaPlatform
         from pyrender.shader_program import ShaderProgramCache
@@ -183,9 +194,12 @@ class TerrainRenderer:
         if key not in self._nodes:
             t = self.tiles.tile(key)
             prim = self._pyrender.Primitive(
-                positions=t.vertices.astype(np.float32), normals=t.normals.astype(np.float32),
+                positions=t.vertices.astype(np.float32),
+                normals=t.normals.astype(np.float32),
                 texcoord_0=np.stack([t.lit, np.zeros_like(t.lit)], axis=1).astype(np.float32),
-                indices=t.faces, mode=self._pyrender.constants.GLTF.TRIANGLES)
+                indices=t.faces,
+                mode=self._pyrender.constants.GLTF.TRIANGLES,
+            )
             pose = np.eye(4)
             pose[:3, 3] = t.centre
             self._nodes[key] = self._scene.add(self._pyrender.Mesh([prim]), pose=pose)
@@ -232,8 +246,10 @@ class TerrainRenderer:
         """Drop the least recently drawn tiles beyond the cap (never this frame's)."""
         if len(self._nodes) <= self.max_cached_tiles:
             return
-        old = sorted((k for k in self._nodes if self._last_used.get(k, 0) < self._frame_count),
-                     key=lambda k: (self._last_used.get(k, 0), k))
+        old = sorted(
+            (k for k in self._nodes if self._last_used.get(k, 0) < self._frame_count),
+            key=lambda k: (self._last_used.get(k, 0), k),
+        )
         for key in old[: len(self._nodes) - self.max_cached_tiles]:
             self._scene.remove_node(self._nodes.pop(key))
             self._last_used.pop(key, None)

@@ -7,10 +7,11 @@ range's midpoint; sample i draws uniformly from the ranges with a generator seed
 The lander starts `downrange_m` before the site on the -x side, flying towards +x;
 positive pitch tilts the thrust backwards (braking) and the camera forwards.
 """
+
 from __future__ import annotations
 
-import zlib
 import json
+import zlib
 from dataclasses import asdict, dataclass, field, replace
 from typing import Callable
 
@@ -51,7 +52,9 @@ class Scenario:
     @classmethod
     def from_config(cls, name: str, cfg: dict) -> "Scenario":
         ranges = {k: (float(cfg[k][0]), float(cfg[k][1])) for k in RANGE_KEYS}
-        return cls(name=name, n_trajectories=int(cfg["n_trajectories"]), tf_guess_s=float(cfg["tf_guess_s"]), ranges=ranges)
+        return cls(
+            name=name, n_trajectories=int(cfg["n_trajectories"]), tf_guess_s=float(cfg["tf_guess_s"]), ranges=ranges
+        )
 
     def to_dict(self) -> dict:
         d = asdict(self)
@@ -61,12 +64,23 @@ class Scenario:
 
 def boundary_conditions(values: dict[str, float], vehicle: Vehicle, tf_guess_s: float) -> BoundaryConditions:
     """Initial and final states from drawn range values (SI, degrees -> radians)."""
-    initial = np.array([
-        -values["downrange_m"], values["crossrange_m"], -values["altitude_m"],
-        values["speed_forward_m_s"], values["speed_cross_m_s"], values["speed_down_m_s"],
-        np.radians(values["roll_deg"]), np.radians(values["pitch_deg"]), np.radians(values["yaw_deg"]),
-        0.0, 0.0, 0.0, vehicle.mass_kg,
-    ])
+    initial = np.array(
+        [
+            -values["downrange_m"],
+            values["crossrange_m"],
+            -values["altitude_m"],
+            values["speed_forward_m_s"],
+            values["speed_cross_m_s"],
+            values["speed_down_m_s"],
+            np.radians(values["roll_deg"]),
+            np.radians(values["pitch_deg"]),
+            np.radians(values["yaw_deg"]),
+            0.0,
+            0.0,
+            0.0,
+            vehicle.mass_kg,
+        ]
+    )
     final = np.zeros(N_STATE)
     final[8] = np.nan  # yaw free
     final[12] = np.nan  # mass free
@@ -87,8 +101,9 @@ def sample_generator(seed: int, scenario_name: str, index: int) -> np.random.Gen
 def sample_conditions(scenario: Scenario, vehicle: Vehicle, seed: int, index: int) -> BoundaryConditions:
     """Boundary conditions of sample `index`, uniform over the scenario's ranges."""
     draws = sample_generator(seed, scenario.name, index).uniform(size=len(RANGE_KEYS))
-    values = {k: lo + d * (hi - lo) for k, d, (lo, hi) in
-              zip(RANGE_KEYS, draws, (scenario.ranges[k] for k in RANGE_KEYS))}
+    values = {
+        k: lo + d * (hi - lo) for k, d, (lo, hi) in zip(RANGE_KEYS, draws, (scenario.ranges[k] for k in RANGE_KEYS))
+    }
     return boundary_conditions(values, vehicle, scenario.tf_guess_s)
 
 
@@ -167,8 +182,10 @@ def solve_by_continuation(
         errors = verify(sol)
         if errors[0] <= acceptance.position_m and errors[1] <= acceptance.velocity_m_s:
             return True
-        reason = (f"re-integration error {errors[0]:.3g} m / {errors[1]:.3g} m/s exceeds "
-                  f"{acceptance.position_m} m / {acceptance.velocity_m_s} m/s (N = {len(sol.t)})")
+        reason = (
+            f"re-integration error {errors[0]:.3g} m / {errors[1]:.3g} m/s exceeds "
+            f"{acceptance.position_m} m / {acceptance.velocity_m_s} m/s (N = {len(sol.t)})"
+        )
         return False
 
     def attempt(strategy) -> bool:
@@ -201,10 +218,27 @@ def solve_by_continuation(
     for name, strategy in (("warm", warm), ("homotopy-%d" % homotopy_steps, homotopy), ("cold", cold)):
         if attempt(strategy):
             method = name + ("+refined" if len(log[-1].t) != problem.settings.n_nodes else "")
-            return SampleResult(index, bc, log[-1], method, len(log), sum(s.iterations for s in log),
-                                sum(s.solve_time_s for s in log), *errors)
-    return SampleResult(index, bc, log[-1], "failed", len(log), sum(s.iterations for s in log),
-                        sum(s.solve_time_s for s in log), *errors, reason=reason)
+            return SampleResult(
+                index,
+                bc,
+                log[-1],
+                method,
+                len(log),
+                sum(s.iterations for s in log),
+                sum(s.solve_time_s for s in log),
+                *errors,
+            )
+    return SampleResult(
+        index,
+        bc,
+        log[-1],
+        "failed",
+        len(log),
+        sum(s.iterations for s in log),
+        sum(s.solve_time_s for s in log),
+        *errors,
+        reason=reason,
+    )
 
 
 @dataclass(frozen=True)
@@ -220,18 +254,30 @@ class ScenarioSettings:
     def from_config(cls, config: dict, name: str) -> "ScenarioSettings":
         vehicle = dict(config["vehicle"])
         vehicle["inertia_kgm2"] = tuple(vehicle["inertia_kgm2"])
-        return cls(Vehicle(**vehicle), OcpSettings(**config["ocp"]),
-                   Scenario.from_config(name, config["scenarios"][name]), int(config["seed"]))
+        return cls(
+            Vehicle(**vehicle),
+            OcpSettings(**config["ocp"]),
+            Scenario.from_config(name, config["scenarios"][name]),
+            int(config["seed"]),
+        )
 
     def to_json(self) -> str:
-        return json.dumps({"vehicle": self.vehicle.to_dict(), "ocp": self.ocp.to_dict(),
-                           "scenario": self.scenario.to_dict(), "seed": self.seed}, sort_keys=True)
+        return json.dumps(
+            {
+                "vehicle": self.vehicle.to_dict(),
+                "ocp": self.ocp.to_dict(),
+                "scenario": self.scenario.to_dict(),
+                "seed": self.seed,
+            },
+            sort_keys=True,
+        )
 
     @classmethod
     def from_json(cls, text: str) -> "ScenarioSettings":
         d = json.loads(text)
         sc = d["scenario"]
-        scenario = Scenario(sc["name"], sc["n_trajectories"], sc["tf_guess_s"],
-                            {k: tuple(v) for k, v in sc["ranges"].items()})
+        scenario = Scenario(
+            sc["name"], sc["n_trajectories"], sc["tf_guess_s"], {k: tuple(v) for k, v in sc["ranges"].items()}
+        )
         vehicle = dict(d["vehicle"], inertia_kgm2=tuple(d["vehicle"]["inertia_kgm2"]))
         return cls(Vehicle(**vehicle), OcpSettings(**d["ocp"]), scenario, int(d["seed"]))

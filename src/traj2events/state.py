@@ -7,6 +7,7 @@ Inertial frame: origin at the landing site, z down (docs/geometry.md); body fram
 forward, y right, z down; attitude roll-pitch-yaw with R_iv = Rz(psi) Ry(theta) Rx(phi).
 Physical control order: uT in [0, 1] (main engine), u_phi, u_theta, u_psi in [-1, 1].
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass

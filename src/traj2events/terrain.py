@@ -19,6 +19,7 @@ Evaluation takes the grid spacing: craters narrower than two spacings and roughn
 shorter than two spacings are left out, which is the level of detail (a coarse tile is
 a low-pass version of the fine one, not a different surface).
 """
+
 from __future__ import annotations
 
 import os
@@ -109,6 +110,7 @@ def _hash_uniform(seed: int, stream: int, i: np.ndarray, j: np.ndarray) -> np.nd
 
 # --- procedural terrain --------------------------------------------------------------------
 
+
 @dataclass(frozen=True)
 class Craters:
     """A crater catalogue as arrays (one entry per crater)."""
@@ -136,8 +138,9 @@ class ProceduralTerrain:
         n = int(np.ceil(np.log2(params.crater_diameter_max_m / params.crater_diameter_min_m)))
         self.octave_diameters_m = params.crater_diameter_min_m * 2.0 ** np.arange(max(n, 1))
 
-    def craters_in(self, x_range: tuple[float, float], y_range: tuple[float, float],
-                   min_diameter_m: float = 0.0) -> Craters:
+    def craters_in(
+        self, x_range: tuple[float, float], y_range: tuple[float, float], min_diameter_m: float = 0.0
+    ) -> Craters:
         """Every crater (diameter >= min_diameter_m) whose shape reaches into the box."""
         p = self.params
         parts = []
@@ -159,11 +162,20 @@ class ProceduralTerrain:
             parts.append(self._craters(ci, cj, cell, d_lo, d_hi, u, v, w, z))
         if not parts:
             return Craters(*(np.empty(0) for _ in range(3)), np.empty(0, bool), np.empty(0), np.empty(0))
-        c = Craters(*(np.concatenate([getattr(q, f) for q in parts])
-                      for f in ("x_m", "y_m", "diameter_m", "fresh", "depth_m", "rim_m")))
+        c = Craters(
+            *(
+                np.concatenate([getattr(q, f) for q in parts])
+                for f in ("x_m", "y_m", "diameter_m", "fresh", "depth_m", "rim_m")
+            )
+        )
         r = c.reach_m
-        keep = ((c.diameter_m >= min_diameter_m) & (c.x_m + r >= x_range[0]) & (c.x_m - r <= x_range[1])
-                & (c.y_m + r >= y_range[0]) & (c.y_m - r <= y_range[1]))
+        keep = (
+            (c.diameter_m >= min_diameter_m)
+            & (c.x_m + r >= x_range[0])
+            & (c.x_m - r <= x_range[1])
+            & (c.y_m + r >= y_range[0])
+            & (c.y_m - r <= y_range[1])
+        )
         return Craters(*(getattr(c, f)[keep] for f in ("x_m", "y_m", "diameter_m", "fresh", "depth_m", "rim_m")))
 
     def _craters(self, i, j, cell, d_lo, d_hi, u, v, w, z) -> Craters:
@@ -186,8 +198,9 @@ class ProceduralTerrain:
         craters = self.craters_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()), min_diameter_m=2 * spacing_m)
         flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
         grid = _as_regular_grid(x_m, y_m)
-        for cx, cy, d, fresh, depth, rim, reach in zip(craters.x_m, craters.y_m, craters.diameter_m, craters.fresh,
-                                                       craters.depth_m, craters.rim_m, craters.reach_m):
+        for cx, cy, d, fresh, depth, rim, reach in zip(
+            craters.x_m, craters.y_m, craters.diameter_m, craters.fresh, craters.depth_m, craters.rim_m, craters.reach_m
+        ):
             idx = _points_near(grid, flat_x, flat_y, cx, cy, reach)
             rho = np.hypot(flat_x[idx] - cx, flat_y[idx] - cy) / (d / 2)
             flat_h[idx] += fresh_crater_profile(rho, depth, rim) if fresh else degraded_crater_profile(rho, depth)
@@ -272,6 +285,7 @@ def site_pad_weight(x_m: np.ndarray, y_m: np.ndarray, radius_m: float) -> np.nda
 
 # --- a user-supplied elevation grid --------------------------------------------------------
 
+
 @dataclass(frozen=True)
 class GridTerrain:
     """Heights on a regular grid (rows along x, columns along y), bilinear in between and
@@ -285,8 +299,9 @@ class GridTerrain:
         return bilinear(self.heights_m, self.origin_m, self.spacing_m, x_m, y_m, fill=0.0)
 
 
-def bilinear(values: np.ndarray, origin: tuple[float, float], spacing: float, x: np.ndarray, y: np.ndarray,
-             fill: float) -> np.ndarray:
+def bilinear(
+    values: np.ndarray, origin: tuple[float, float], spacing: float, x: np.ndarray, y: np.ndarray, fill: float
+) -> np.ndarray:
     """Bilinear interpolation of a regular grid (axis 0 along x, axis 1 along y, equal
     spacing, values[0, 0] at `origin`) at points (x, y); `fill` outside the grid."""
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
@@ -298,13 +313,15 @@ def bilinear(values: np.ndarray, origin: tuple[float, float], spacing: float, x:
     fu, fv = np.clip(u - i, 0, 1), np.clip(v - j, 0, 1)
     i1, j1 = np.minimum(i + 1, n0 - 1), np.minimum(j + 1, n1 - 1)
     with np.errstate(invalid="ignore"):
-        val = ((values[i, j] * (1 - fu) + values[i1, j] * fu) * (1 - fv)
-               + (values[i, j1] * (1 - fu) + values[i1, j1] * fu) * fv)
+        val = (values[i, j] * (1 - fu) + values[i1, j] * fu) * (1 - fv) + (
+            values[i, j1] * (1 - fu) + values[i1, j1] * fu
+        ) * fv
     return np.where(inside, val, fill)
 
 
-def load_elevation_grid(path: str | os.PathLike, spacing_m: float | None = None,
-                        origin_m: tuple[float, float] | None = None) -> GridTerrain:
+def load_elevation_grid(
+    path: str | os.PathLike, spacing_m: float | None = None, origin_m: tuple[float, float] | None = None
+) -> GridTerrain:
     """A user elevation grid: `.npy` (heights; spacing_m required), `.npz` (keys
     `heights_m`, `spacing_m`, optional `origin_m`) or GeoTIFF (spacing from the
     ModelPixelScale tag when not given). Centred on the site unless origin_m is given."""
@@ -335,8 +352,9 @@ def load_elevation_grid(path: str | os.PathLike, spacing_m: float | None = None,
         raise ValueError(f"terrain.elevation_grid: {path}: expected .npy, .npz, .tif or .tiff")
     heights = np.asarray(heights, dtype=np.float64)
     if heights.ndim != 2 or min(heights.shape) < 2 or not np.all(np.isfinite(heights)):
-        raise ValueError(f"terrain.elevation_grid: {path}: expected a finite 2-D array of heights, "
-                         f"got shape {heights.shape}")
+        raise ValueError(
+            f"terrain.elevation_grid: {path}: expected a finite 2-D array of heights, got shape {heights.shape}"
+        )
     if spacing_m is None or not spacing_m > 0:
         raise ValueError(f"terrain.elevation_grid: {path}: grid spacing unknown; give terrain.grid_spacing_m > 0")
     if origin_m is None:
@@ -346,10 +364,13 @@ def load_elevation_grid(path: str | os.PathLike, spacing_m: float | None = None,
 
 # --- geometry on the curved Moon -----------------------------------------------------------
 
+
 def surface_points(x_m: np.ndarray, y_m: np.ndarray, height_m: np.ndarray, radius_m: float) -> np.ndarray:
     """Inertial positions (..., 3) of terrain points: on the ray from the Moon's centre
     (0, 0, R) through (x, y, 0), at distance R + h from the centre (z down)."""
-    x_m, y_m, height_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float), np.asarray(height_m, float))
+    x_m, y_m, height_m = np.broadcast_arrays(
+        np.asarray(x_m, float), np.asarray(y_m, float), np.asarray(height_m, float)
+    )
     norm = np.sqrt(x_m**2 + y_m**2 + radius_m**2)
     scale = (radius_m + height_m) / norm
     # z = R - (R + h) R / norm, written without cancelling R - R for small x, y, h.

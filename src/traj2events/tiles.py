@@ -18,6 +18,7 @@ grid extended by `margin` cells toward the Sun, with the parent tile's obstructi
 beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
 and nearby fine relief at the tile's own.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -65,8 +66,14 @@ class TileSet:
         """Tiles built and held in the cache."""
         return len(self._cache)
 
-    def __init__(self, terrain: Terrain, sun_dir: np.ndarray, radius_m: float, half_extent_m: float,
-                 lod: LodSettings = LodSettings()):
+    def __init__(
+        self,
+        terrain: Terrain,
+        sun_dir: np.ndarray,
+        radius_m: float,
+        half_extent_m: float,
+        lod: LodSettings = LodSettings(),
+    ):
         self.terrain = terrain
         self.sun_dir = np.asarray(sun_dir, float)
         self.radius_m = radius_m
@@ -130,8 +137,9 @@ class TileSet:
         verts = points[core].reshape(-1, 3)
         norms = normals[inner].reshape(-1, 3)
         lit = shadow.lit[core].reshape(-1)
-        verts, norms, lit, faces = _add_skirts(verts, norms, lit, self.faces, n + 1,
-                                               self.lod.skirt_cells * spacing, self.radius_m)
+        verts, norms, lit, faces = _add_skirts(
+            verts, norms, lit, self.faces, n + 1, self.lod.skirt_cells * spacing, self.radius_m
+        )
         centre = verts[: (n + 1) ** 2].mean(axis=0)
         radius = float(np.max(np.linalg.norm(verts - centre, axis=1)))
         return Tile(key, spacing, centre, radius, verts - centre, norms, lit, faces, shadow, h[core])
@@ -167,8 +175,13 @@ class TileSet:
                 cell_px = np.where(far, cell_px * np.sqrt(np.maximum(cos_view, 0.05)), cell_px)
             split = inside & (cell_px > self.lod.pixels_per_cell) & (frontier[0][0] < max_level)
             chosen.extend(k for k, keep, s in zip(frontier, inside, split) if keep and not s)
-            frontier = [(level + 1, 2 * i + a, 2 * j + b) for (level, i, j), s in zip(frontier, split) if s
-                        for a in (0, 1) for b in (0, 1)]
+            frontier = [
+                (level + 1, 2 * i + a, 2 * j + b)
+                for (level, i, j), s in zip(frontier, split)
+                if s
+                for a in (0, 1)
+                for b in (0, 1)
+            ]
         return chosen
 
     def _relief_bound(self) -> float:
@@ -210,8 +223,12 @@ def _add_skirts(verts, norms, lit, faces, n, depth_m, radius_m):
     k1 = (k + 1) % len(ring)
     top0, top1, bot0, bot1 = ring[k], ring[k1], base + k, base + k1
     skirt_faces = np.concatenate([np.stack([top0, bot0, bot1], 1), np.stack([top0, bot1, top1], 1)])
-    return (np.concatenate([verts, skirt]), np.concatenate([norms, norms[ring]]), np.concatenate([lit, lit[ring]]),
-            np.concatenate([faces, skirt_faces.astype(np.uint32)]))
+    return (
+        np.concatenate([verts, skirt]),
+        np.concatenate([norms, norms[ring]]),
+        np.concatenate([lit, lit[ring]]),
+        np.concatenate([faces, skirt_faces.astype(np.uint32)]),
+    )
 
 
 def _frustum_planes(camera: Camera) -> np.ndarray:
@@ -219,8 +236,14 @@ def _frustum_planes(camera: Camera) -> np.ndarray:
     Y right = rows, Z boresight); a point p is inside when planes @ p >= 0."""
     hx = np.arctan(camera.width / 2 / camera.focal_px)
     hy = np.arctan(camera.height / 2 / camera.focal_px)
-    return np.array([[np.cos(hx), 0, np.sin(hx)], [-np.cos(hx), 0, np.sin(hx)],
-                     [0, np.cos(hy), np.sin(hy)], [0, -np.cos(hy), np.sin(hy)]])
+    return np.array(
+        [
+            [np.cos(hx), 0, np.sin(hx)],
+            [-np.cos(hx), 0, np.sin(hx)],
+            [0, np.cos(hy), np.sin(hy)],
+            [0, -np.cos(hy), np.sin(hy)],
+        ]
+    )
 
 
 def _line_of_sight_limit(cam: np.ndarray, radius_m: float, relief_m: float) -> float:

@@ -7,6 +7,7 @@ attitude and rates then agree with each other exactly (up to the integrator's
 tolerance), which the motion field needs. Option: the paper's cubic spline through
 the node states (0.1-0.2 m and up to 0.35 deg off the true motion, trajectories.md).
 """
+
 from __future__ import annotations
 
 import casadi as ca
@@ -115,8 +116,9 @@ class ShootingCheck:
         # One interval in normalised time tau in [0, 1], controls linear from u_a to u_b.
         ode = h * dynamics.casadi(scale * x, u_a + tau * (u_b - u_a)) / scale
         p = ca.vertcat(u_a, u_b, h)
-        step = ca.integrator("step", "cvodes", {"x": x, "p": p, "t": tau, "ode": ode}, 0.0, 1.0,
-                             {"abstol": tol, "reltol": tol})
+        step = ca.integrator(
+            "step", "cvodes", {"x": x, "p": p, "t": tau, "ode": ode}, 0.0, 1.0, {"abstol": tol, "reltol": tol}
+        )
         self._interval = ca.Function("interval", [x, p], [step(x0=x, p=p)["xf"]])
         self._chains: dict[int, ca.Function] = {}
 

@@ -1,5 +1,6 @@
 """Display frames and videos: 8-bit tone mapping, lossless FFV1 and an H.264 preview,
 through ffmpeg (ffmpeg-python builds the command lines)."""
+
 from __future__ import annotations
 
 import os
@@ -35,8 +36,17 @@ class VideoWriter:
         if kind == "ffv1":
             out = source.output(str(self.tmp), format="matroska", vcodec="ffv1", level=3, pix_fmt="gray", **common)
         elif kind == "h264":
-            out = source.output(str(self.tmp), format="mp4", vcodec="libx264", pix_fmt="yuv420p", crf=18,
-                                preset="veryfast", threads=1, vf="pad=ceil(iw/2)*2:ceil(ih/2)*2", **common)
+            out = source.output(
+                str(self.tmp),
+                format="mp4",
+                vcodec="libx264",
+                pix_fmt="yuv420p",
+                crf=18,
+                preset="veryfast",
+                threads=1,
+                vf="pad=ceil(iw/2)*2:ceil(ih/2)*2",
+                **common,
+            )
         else:
             raise ValueError(f"video kind: expected 'ffv1' or 'h264', got {kind!r}")
         self._process = out.overwrite_output().global_args("-loglevel", "error").run_async(pipe_stdin=True)
@@ -89,7 +99,9 @@ def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
     try:
         probe = ffmpeg.probe(str(path))
     except ffmpeg.Error as exc:
-        raise ValueError(f"{path}: not a video ffmpeg can read ({exc.stderr.decode(errors='replace').strip()[-200:]})") from None
+        raise ValueError(
+            f"{path}: not a video ffmpeg can read ({exc.stderr.decode(errors='replace').strip()[-200:]})"
+        ) from None
     stream = next((s for s in probe["streams"] if s["codec_type"] == "video"), None)
     if stream is None:
         raise ValueError(f"{path}: has no video stream")
@@ -105,8 +117,12 @@ def iter_video(path: str | os.PathLike, chunk: int = 64):
     import ffmpeg
 
     width, height, _, _ = video_info(path)
-    process = (ffmpeg.input(str(path)).output("pipe:", format="rawvideo", pix_fmt="gray")
-               .global_args("-loglevel", "error").run_async(pipe_stdout=True))
+    process = (
+        ffmpeg.input(str(path))
+        .output("pipe:", format="rawvideo", pix_fmt="gray")
+        .global_args("-loglevel", "error")
+        .run_async(pipe_stdout=True)
+    )
     size = width * height
     try:
         while True:

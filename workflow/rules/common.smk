@@ -23,9 +23,7 @@ config.update(_resolved)
 
 # Rules call the `traj2events` command that sits beside the Python running Snakemake
 # (e.g. .venv/bin), so that `.venv/bin/snakemake` works without activating the venv.
-shell.prefix(
-    f"set -euo pipefail; export PATH={shlex.quote(str(Path(sys.executable).parent))}:\"$PATH\"; "
-)
+shell.prefix(f'set -euo pipefail; export PATH={shlex.quote(str(Path(sys.executable).parent))}:"$PATH"; ')
 SCENARIOS = list(config["scenarios"])
 ENV = "../../envs/trajectories.yaml"
 
@@ -36,7 +34,7 @@ wildcard_constraints:
 
 
 def code(stage):
-    """Fingerprint of the code a rule runs: the stage module and what it imports."""
+    """Fingerprint of the code behind a stage (its module and what that imports)."""
     return code_fingerprint(f"traj2events.stages.{stage}")
 
 

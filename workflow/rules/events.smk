@@ -7,17 +7,17 @@ rule events:
         frames="results/{scenario}/{id}/frames.h5",
         trajectory="results/{scenario}/{id}/trajectory.h5",
     output:
-        events="results/{scenario}/{id}/events.h5",
         **export_outputs("results/{scenario}/{id}"),
+        events="results/{scenario}/{id}/events.h5",
+    log:
+        "results/logs/{scenario}/{id}/events.log",
+    conda:
+        ENV
     params:
         options=event_options,
         seed=event_seed,
         exports=export_flags,
         code=code("events"),
-    log:
-        "results/logs/{scenario}/{id}/events.log",
-    conda:
-        ENV
     shell:
         "traj2events events {input.frames} --output {output.events} --seed {params.seed} {params.options} "
         "--trajectory {input.trajectory} {params.exports} 2> {log}"

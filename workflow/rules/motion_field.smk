@@ -9,14 +9,14 @@ rule motion_field:
     output:
         field="results/{scenario}/{id}/motion_field.h5",
         flo=directory("results/{scenario}/{id}/flow"),
-    params:
-        camera=camera_options,
-        every=config["motion_field"]["every_n_frames"],
-        code=code("motion_field"),
     log:
         "results/logs/{scenario}/{id}/motion_field.log",
     conda:
         ENV
+    params:
+        camera=camera_options,
+        every=config["motion_field"]["every_n_frames"],
+        code=code("motion_field"),
     shell:
         "traj2events motion-field {input.trajectory} --frames {input.frames} {params.camera} "
         "--every {params.every} --output {output.field} --flo-dir {output.flo} 2> {log}"

@@ -14,12 +14,12 @@ rule frames_picture:
             category="Frames",
             subcategory="{scenario}",
         ),
-    params:
-        code=code("pictures"),
     log:
         "results/logs/{scenario}/{id}/frames_picture.log",
     conda:
         ENV
+    params:
+        code=code("pictures"),
     shell:
         "traj2events picture frames {input.trajectory} --video {input.video} --output {output} 2> {log}"
 
@@ -35,13 +35,13 @@ rule motion_field_picture:
             category="Motion field",
             subcategory="{scenario}",
         ),
-    params:
-        camera=camera_options,
-        code=code("pictures"),
     log:
         "results/logs/{scenario}/{id}/motion_field_picture.log",
     conda:
         ENV
+    params:
+        camera=camera_options,
+        code=code("pictures"),
     shell:
         "traj2events picture motion-field {input.trajectory} {params.camera} --video {input.video} "
         "--output {output} 2> {log}"
@@ -58,13 +58,13 @@ rule events_picture:
             category="Events",
             subcategory="{scenario}",
         ),
-    params:
-        window_ms=config["events"]["window_ms"],
-        code=code("pictures"),
     log:
         "results/logs/{scenario}/{id}/events_picture.log",
     conda:
         ENV
+    params:
+        window_ms=config["events"]["window_ms"],
+        code=code("pictures"),
     shell:
         "traj2events picture events {input.events} --trajectory {input.trajectory} "
         "--window-ms {params.window_ms} --output {output} 2> {log}"
@@ -79,11 +79,11 @@ rule dataset_picture:
             caption="../report/trajectories.rst",
             category="Trajectories",
         ),
-    params:
-        code=code("pictures"),
     log:
         "results/logs/dataset_picture.log",
     conda:
         ENV
+    params:
+        code=code("pictures"),
     shell:
         "traj2events picture dataset {input} --output {output} 2> {log}"

@@ -10,14 +10,14 @@ rule render:
         frames=frames_output("results/{scenario}/{id}/frames.h5"),
         video="results/{scenario}/{id}/video.mkv",
         preview="results/{scenario}/{id}/preview.mp4",
-    params:
-        settings=render_settings,
-        code=code("render"),
-    threads: 1
     log:
         "results/logs/{scenario}/{id}/render.log",
     conda:
         "../../envs/render.yaml"
+    threads: 1
+    params:
+        settings=render_settings,
+        code=code("render"),
     shell:
         # llvmpipe would start a thread per core in every job; one job = one core.
         "LP_NUM_THREADS={threads} traj2events render {input.trajectory} --settings '{params.settings}' "

@@ -6,13 +6,13 @@
 rule base_solution:
     output:
         "results/{scenario}/base.h5",
-    params:
-        settings=scenario_settings,
-        code=code("base_solution"),
     log:
         "results/logs/{scenario}/base_solution.log",
     conda:
         ENV
+    params:
+        settings=scenario_settings,
+        code=code("base_solution"),
     shell:
         "traj2events base --settings {params.settings:q} --output {output} 2> {log}"
 
@@ -23,14 +23,14 @@ checkpoint sample_trajectories:
     output:
         solutions="results/{scenario}/solutions.h5",
         table="results/{scenario}/samples.csv",
-    params:
-        settings=scenario_settings,
-        code=code("sample_trajectories"),
-    threads: workflow.cores
     log:
         "results/logs/{scenario}/sample_trajectories.log",
     conda:
         ENV
+    threads: workflow.cores
+    params:
+        settings=scenario_settings,
+        code=code("sample_trajectories"),
     shell:
         "traj2events sample --settings {params.settings:q} --base {input.base} "
         "--output {output.solutions} --table {output.table} --jobs {threads} 2> {log}"
@@ -41,14 +41,14 @@ rule camera_poses:
         "results/{scenario}/solutions.h5",
     output:
         "results/{scenario}/{id}/trajectory.h5",
-    params:
-        fps=config["camera"]["fps"],
-        method=config["upsampling"]["method"],
-        code=code("camera_poses"),
     log:
         "results/logs/{scenario}/{id}/camera_poses.log",
     conda:
         ENV
+    params:
+        fps=config["camera"]["fps"],
+        method=config["upsampling"]["method"],
+        code=code("camera_poses"),
     shell:
         "traj2events upsample --solutions {input} --id {wildcards.id} --fps {params.fps} "
         "--method {params.method} --output {output} 2> {log}"
@@ -59,12 +59,12 @@ rule dataset_index:
         scenario_outputs,
     output:
         "results/{scenario}/index.csv",
-    params:
-        code=code("index"),
     log:
         "results/logs/{scenario}/dataset_index.log",
     conda:
         ENV
+    params:
+        code=code("index"),
     shell:
         "traj2events index {input} --output {output} 2> {log}"
 
@@ -79,11 +79,11 @@ rule trajectory_summary:
             caption="../report/summary.rst",
             category="Trajectories",
         ),
-    params:
-        code=code("summary"),
     log:
         "results/logs/trajectory_summary.log",
     conda:
         ENV
+    params:
+        code=code("summary"),
     shell:
         "traj2events summary --solutions {input.solutions} --tables {input.tables} --output {output} 2> {log}"

@@ -1,6 +1,7 @@
 """Atomic writes: every output goes to a hidden temporary name in its target folder and
 is renamed into place only when complete, so an interrupted or failed job never leaves a
 half-written file (or folder) where the workflow expects a finished one."""
+
 from __future__ import annotations
 
 import contextlib

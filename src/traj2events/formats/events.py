@@ -1,5 +1,6 @@
 """Events: the structured dtype (x, y, t, p) used everywhere in the package (tonic's
 convention) and events.h5 in the DSEC layout."""
+
 from __future__ import annotations
 
 import os
@@ -26,16 +27,20 @@ class EventsWriter:
     each millisecond), `t_offset` (int64, us). Event arrays are compressed with Blosc/zstd
     through hdf5plugin (what DSEC uses); attributes hold the emulator's parameters."""
 
-    def __init__(self, path: str | os.PathLike, width: int, height: int, attrs: dict, t_offset_us: int = 0,
-                 chunk: int = 1 << 18):
+    def __init__(
+        self, path: str | os.PathLike, width: int, height: int, attrs: dict, t_offset_us: int = 0, chunk: int = 1 << 18
+    ):
         compression = _blosc_zstd()
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
         group = self._file.create_group("events")
-        self._sets = {name: group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,),
-                                                 track_times=False, **compression)
-                      for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1"))}
+        self._sets = {
+            name: group.create_dataset(
+                name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), track_times=False, **compression
+            )
+            for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1"))
+        }
         self._file.create_dataset("t_offset", data=np.int64(t_offset_us), track_times=False)
         set_attrs(self._file, {"width": width, "height": height, **attrs})
         self.t_offset_us = t_offset_us
@@ -59,7 +64,7 @@ class EventsWriter:
         for name, values in (("x", events["x"]), ("y", events["y"]), ("t", t), ("p", events["p"])):
             ds = self._sets[name]
             ds.resize((self.n + len(t),))
-            ds[self.n:] = values
+            ds[self.n :] = values
         self.n += len(t)
         self._last_t = int(t[-1])
 
@@ -108,4 +113,3 @@ def read_events_window(path: str | os.PathLike, t_start_us: int, t_end_us: int) 
         out["x"], out["y"], out["p"] = g["x"][lo:hi], g["y"][lo:hi], g["p"][lo:hi]
         out["t"] = g["t"][lo:hi] + offset
     return out[(out["t"] >= t_start_us) & (out["t"] < t_end_us)]
-

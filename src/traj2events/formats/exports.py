@@ -1,5 +1,6 @@
 """Event exports beside events.h5: an ELOPE-style .npz, Prophesee EVT 3.0 (.raw) and
 AEDAT4, for the tools that read those."""
+
 from __future__ import annotations
 
 import os
@@ -10,8 +11,13 @@ import numpy as np
 from .atomic import atomic_output
 
 
-def write_elope_npz(path: str | os.PathLike, events: np.ndarray, timestamps_s: np.ndarray | None = None,
-                    traj: np.ndarray | None = None, range_meter: np.ndarray | None = None) -> None:
+def write_elope_npz(
+    path: str | os.PathLike,
+    events: np.ndarray,
+    timestamps_s: np.ndarray | None = None,
+    traj: np.ndarray | None = None,
+    range_meter: np.ndarray | None = None,
+) -> None:
     """An ELOPE-style .npz: `events` (structured x, y, p, t in us) and, when given,
     `timestamps` (s), `traj` (N x 12: position (z negative above the site, our z-down
     frame), velocity, roll/pitch/yaw, body rates) and `range_meter` (N x 2: t, distance

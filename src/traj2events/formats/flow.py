@@ -1,5 +1,6 @@
 """Motion-field files: motion_field.h5 (every field of a trajectory) and Middlebury .flo
 (one displacement field per file, which optical-flow tools read)."""
+
 from __future__ import annotations
 
 import os
@@ -32,8 +33,9 @@ def read_flo(path: str | os.PathLike) -> np.ndarray:
     return np.frombuffer(data[12:], dtype="<f4").reshape(height, width, 2).copy()
 
 
-def write_motion_field(path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, np.ndarray],
-                       attrs: dict) -> None:
+def write_motion_field(
+    path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, np.ndarray], attrs: dict
+) -> None:
     """motion_field.h5: t (K,), frame_index (K,), and each (K, H, W, ...) field, chunked
     one frame per chunk and compressed."""
     with atomic_output(path) as tmp, create(tmp) as f:
@@ -41,6 +43,7 @@ def write_motion_field(path: str | os.PathLike, t: np.ndarray, frame_index: np.n
         write_dataset(f, "frame_index", frame_index)
         for name, data in fields.items():
             chunks = (1, *data.shape[1:]) if len(data) else None
-            f.create_dataset(name, data=data, chunks=chunks, compression="gzip", compression_opts=4, shuffle=True,
-                             track_times=False)
+            f.create_dataset(
+                name, data=data, chunks=chunks, compression="gzip", compression_opts=4, shuffle=True, track_times=False
+            )
         set_attrs(f, attrs)

@@ -3,6 +3,7 @@
 `t` (n,) s, `frame_index` (n,), `radiance` (n, H, W) float32 W m^-2 sr^-1 and `depth_m`
 (n, H, W) float32 along the boresight (0 = sky), both rounded to 16 significant bits and
 compressed one frame per chunk; attributes: camera, Sun, terrain, reflectance, display."""
+
 from __future__ import annotations
 
 import os
@@ -30,18 +31,28 @@ def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
 class FramesWriter:
     """frames.h5, one frame at a time (see the module docstring)."""
 
-    def __init__(self, path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, height: int, width: int,
-                 attrs: dict):
+    def __init__(
+        self, path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, height: int, width: int, attrs: dict
+    ):
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
         write_dataset(self._file, "t", np.asarray(t, float))
         write_dataset(self._file, "frame_index", np.asarray(frame_index, np.int64))
         n = len(t)
-        self._sets = {name: self._file.create_dataset(name, shape=(n, height, width), dtype=np.float32,
-                                                      chunks=(1, height, width), compression="gzip",
-                                                      compression_opts=1, shuffle=True, track_times=False)
-                      for name in ("radiance", "depth_m")}
+        self._sets = {
+            name: self._file.create_dataset(
+                name,
+                shape=(n, height, width),
+                dtype=np.float32,
+                chunks=(1, height, width),
+                compression="gzip",
+                compression_opts=1,
+                shuffle=True,
+                track_times=False,
+            )
+            for name in ("radiance", "depth_m")
+        }
         set_attrs(self._file, attrs)
 
     def write(self, i: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
@@ -83,7 +94,7 @@ class FramesFile:
     def radiance_chunks(self, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames."""
         for start in range(0, self.shape[0], chunk):
-            yield self._file["radiance"][start:start + chunk], self.t[start:start + chunk]
+            yield self._file["radiance"][start : start + chunk], self.t[start : start + chunk]
 
     def close(self) -> None:
         self._file.close()

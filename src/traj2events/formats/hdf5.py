@@ -1,5 +1,6 @@
 """Byte-reproducible HDF5: fixed library version bounds, no object timestamps, attributes
 in insertion order; the same content gives the same bytes."""
+
 from __future__ import annotations
 
 import json

@@ -5,6 +5,7 @@ trajectory's collocation nodes and its camera poses at the frame rate).
 Groups `nodes` and `poses` hold `t` (s), `state` (n x 13, order and units in
 `state_names`: m, m/s, rad, rad/s, kg) and `control` (n x 4, dimensionless); the root
 attributes hold the vehicle constants, so anyone can re-integrate the dynamics."""
+
 from __future__ import annotations
 
 import os
@@ -35,8 +36,9 @@ def vehicle_attrs(vehicle: Vehicle) -> dict:
 
 
 def vehicle_from_attrs(attrs: h5py.AttributeManager) -> Vehicle:
-    return Vehicle(**{k: (tuple(attrs[k]) if k == "inertia_kgm2" else float(attrs[k]))
-                      for k in Vehicle.__dataclass_fields__})
+    return Vehicle(
+        **{k: (tuple(attrs[k]) if k == "inertia_kgm2" else float(attrs[k])) for k in Vehicle.__dataclass_fields__}
+    )
 
 
 def solution_attrs(solution, bc) -> dict:
@@ -93,8 +95,12 @@ def read_trajectory(path: str | os.PathLike) -> Trajectory:
     with h5py.File(path, "r") as f:
         poses = [f[f"poses/{k}"][()] for k in ("t", "state", "control")] if "poses" in f else [None] * 3
         return Trajectory(
-            f["nodes/t"][()], f["nodes/state"][()], f["nodes/control"][()], *poses,
-            attrs=dict(f.attrs), vehicle=vehicle_from_attrs(f.attrs),
+            f["nodes/t"][()],
+            f["nodes/state"][()],
+            f["nodes/control"][()],
+            *poses,
+            attrs=dict(f.attrs),
+            vehicle=vehicle_from_attrs(f.attrs),
         )
 
 
@@ -115,6 +121,10 @@ def read_solution_set(path: str | os.PathLike) -> dict:
     with h5py.File(path, "r") as f:
         samples = {}
         for name, g in f["samples"].items():
-            samples[int(name)] = {"t": g["t"][()], "state": g["state"][()], "control": g["control"][()],
-                                  **{k: plain(v) for k, v in g.attrs.items()}}
+            samples[int(name)] = {
+                "t": g["t"][()],
+                "state": g["state"][()],
+                "control": g["control"][()],
+                **{k: plain(v) for k, v in g.attrs.items()},
+            }
         return {"attrs": dict(f.attrs), "samples": samples}

@@ -1,5 +1,6 @@
 """Stage 1: a scenario's base solution (every sampled range at its midpoint), which the
 continuation sampling starts from."""
+
 from __future__ import annotations
 
 import os
@@ -31,15 +32,22 @@ def solve_base(settings: ScenarioSettings) -> tuple[Solution, object]:
         log(f"{s.scenario.name}: {sol.status} after {sol.iterations} iterations, {sol.solve_time_s:.2f} s")
         if sol.success:
             return sol, bc
-    raise BaseSolveError(f"scenario '{s.scenario.name}': the base problem (midpoint of every range) did not "
-                         f"solve: {sol.status}. Check the ranges and vehicle in the config.")
+    raise BaseSolveError(
+        f"scenario '{s.scenario.name}': the base problem (midpoint of every range) did not "
+        f"solve: {sol.status}. Check the ranges and vehicle in the config."
+    )
 
 
 def base_solution(settings: ScenarioSettings, output: str | os.PathLike) -> Solution:
     """Solve the base problem and write base.h5 (nodes only)."""
     sol, bc = solve_base(settings)
-    attrs = {**vehicle_attrs(settings.vehicle), **solution_attrs(sol, bc), "scenario": settings.scenario.name,
-             "epsilon": settings.ocp.epsilon, "mesh_clustering": settings.ocp.mesh_clustering,
-             "traj2events_version": __version__}
+    attrs = {
+        **vehicle_attrs(settings.vehicle),
+        **solution_attrs(sol, bc),
+        "scenario": settings.scenario.name,
+        "epsilon": settings.ocp.epsilon,
+        "mesh_clustering": settings.ocp.mesh_clustering,
+        "traj2events_version": __version__,
+    }
     write_trajectory(output, (sol.t, sol.state, sol.control), None, attrs)
     return sol

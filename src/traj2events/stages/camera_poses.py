@@ -1,5 +1,6 @@
 """Stage 3: one solved sample's camera poses at the frame rate, from the dynamics
 re-integrated with its optimal controls (or the paper's cubic spline, to compare)."""
+
 from __future__ import annotations
 
 import os
@@ -12,12 +13,24 @@ from ..scenarios import ScenarioSettings
 from ..upsample import upsample
 
 # Solve facts copied from solutions.h5 into each trajectory.h5 (so it stands alone).
-SOLVE_ATTRS = ("initial_state", "final_state", "transcription", "N", "solver_status", "iterations", "solve_time_s",
-               "cost", "tf_s", "error_position_m", "error_velocity_m_s")
+SOLVE_ATTRS = (
+    "initial_state",
+    "final_state",
+    "transcription",
+    "N",
+    "solver_status",
+    "iterations",
+    "solve_time_s",
+    "cost",
+    "tf_s",
+    "error_position_m",
+    "error_velocity_m_s",
+)
 
 
-def camera_poses(solutions: str | os.PathLike, sample_id: int, fps: float, method: str,
-                 output: str | os.PathLike) -> None:
+def camera_poses(
+    solutions: str | os.PathLike, sample_id: int, fps: float, method: str, output: str | os.PathLike
+) -> None:
     """Write trajectory.h5 (nodes and poses) of sample `sample_id` of solutions.h5."""
     data = read_solution_set(solutions)
     s = ScenarioSettings.from_json(data["attrs"]["settings"])
@@ -27,8 +40,17 @@ def camera_poses(solutions: str | os.PathLike, sample_id: int, fps: float, metho
     t, state, control = sample["t"], sample["state"], sample["control"]
     poses = upsample(Dynamics(s.vehicle), t, state, control, fps, method)
     log(f"{s.scenario.name}/{sample_id:04d}: {len(poses[0])} poses at {fps:g} fps ({method})")
-    attrs = {**vehicle_attrs(s.vehicle), **{k: sample[k] for k in SOLVE_ATTRS}, "fps": fps, "upsampling": method,
-             "scenario": s.scenario.name, "id": sample_id, "seed": s.seed, "epsilon": s.ocp.epsilon,
-             "mesh_clustering": s.ocp.mesh_clustering, "continuation": sample["method"],
-             "traj2events_version": __version__}
+    attrs = {
+        **vehicle_attrs(s.vehicle),
+        **{k: sample[k] for k in SOLVE_ATTRS},
+        "fps": fps,
+        "upsampling": method,
+        "scenario": s.scenario.name,
+        "id": sample_id,
+        "seed": s.seed,
+        "epsilon": s.ocp.epsilon,
+        "mesh_clustering": s.ocp.mesh_clustering,
+        "continuation": sample["method"],
+        "traj2events_version": __version__,
+    }
     write_trajectory(output, (t, state, control), poses, attrs)

@@ -6,6 +6,7 @@ Inputs, each read in chunks so memory stays bounded:
     a video          8-bit grey, as v2e reads it
     a folder         8-bit grey images, sorted by name (needs the frame rate)
 """
+
 from __future__ import annotations
 
 import os
@@ -52,10 +53,10 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
 
     def images():
         for start in range(0, len(files), chunk):
-            batch = [np.asarray(Image.open(f).convert("L")) for f in files[start:start + chunk]]
+            batch = [np.asarray(Image.open(f).convert("L")) for f in files[start : start + chunk]]
             if any(b.shape != (height, width) for b in batch):
                 raise ValueError(f"events INPUT: images in {path} differ in size (expected {width} x {height})")
-            yield np.stack(batch), times[start:start + chunk]
+            yield np.stack(batch), times[start : start + chunk]
 
     return FrameSource(width, height, "images (8-bit)", images())
 
@@ -91,8 +92,9 @@ def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
     return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video())
 
 
-def frame_source(path: str | os.PathLike, chunk: int = 64, fps: float | None = None,
-                 white: float | None = None) -> FrameSource:
+def frame_source(
+    path: str | os.PathLike, chunk: int = 64, fps: float | None = None, white: float | None = None
+) -> FrameSource:
     """The frames of frames.h5, a video or a folder of images (by what `path` is)."""
     path = Path(path)
     if not path.exists():
@@ -115,14 +117,27 @@ def emulator_params(preset: str, **overrides) -> EmulatorParams:
     return replace(PRESETS[preset], **{k: v for k, v in overrides.items() if v is not None})
 
 
-def emulate(source: FrameSource, params: EmulatorParams, seed: int, output: str | os.PathLike, preset: str,
-            input_name: str, progress_every: int = 640) -> tuple[int, int, float]:
+def emulate(
+    source: FrameSource,
+    params: EmulatorParams,
+    seed: int,
+    output: str | os.PathLike,
+    preset: str,
+    input_name: str,
+    progress_every: int = 640,
+) -> tuple[int, int, float]:
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
     `input_name` are recorded in its attributes). Returns (frames, events, time of the
     last frame in s)."""
     emulator = EventEmulator(source.width, source.height, params, seed=seed)
-    attrs = {"preset": preset, "seed": seed, "input": input_name, "input_kind": source.kind,
-             **{f"emulator_{k}": v for k, v in asdict(params).items()}, "traj2events_version": __version__}
+    attrs = {
+        "preset": preset,
+        "seed": seed,
+        "input": input_name,
+        "input_kind": source.kind,
+        **{f"emulator_{k}": v for k, v in asdict(params).items()},
+        "traj2events_version": __version__,
+    }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
     writer = EventsWriter(output, source.width, source.height, attrs)
     try:
@@ -139,8 +154,10 @@ def emulate(source: FrameSource, params: EmulatorParams, seed: int, output: str 
         raise
     writer.close(int(round(t_last * 1e6)))
     elapsed = time.perf_counter() - start
-    log(f"{n_frames} frames, {n_events} events in {elapsed:.1f} s ({n_frames / elapsed:.0f} frames/s, "
-        f"{n_events / elapsed:.3g} events/s)")
+    log(
+        f"{n_frames} frames, {n_events} events in {elapsed:.1f} s ({n_frames / elapsed:.0f} frames/s, "
+        f"{n_events / elapsed:.3g} events/s)"
+    )
     return n_frames, n_events, t_last
 
 
@@ -155,8 +172,14 @@ def central_range(frames: str | os.PathLike) -> np.ndarray:
         return np.stack([f.t, f.depth_at(i, j) * ray], axis=1)
 
 
-def export_events(events: str | os.PathLike, npz: str | None = None, evt3: str | None = None,
-                  aedat4: str | None = None, trajectory: str | None = None, frames: str | None = None) -> None:
+def export_events(
+    events: str | os.PathLike,
+    npz: str | None = None,
+    evt3: str | None = None,
+    aedat4: str | None = None,
+    trajectory: str | None = None,
+    frames: str | None = None,
+) -> None:
     """Write the asked-for exports of events.h5: ELOPE-style .npz (with trajectory.h5: its
     timestamps and states; with frames.h5: the range meter), EVT 3.0, AEDAT4."""
     if not (npz or evt3 or aedat4):
@@ -166,7 +189,7 @@ def export_events(events: str | os.PathLike, npz: str | None = None, evt3: str |
         timestamps = traj = None
         if trajectory is not None:
             tr = read_trajectory(trajectory)
-            timestamps, traj = tr.t, tr.state[:, :BODY_RATES.stop]
+            timestamps, traj = tr.t, tr.state[:, : BODY_RATES.stop]
         write_elope_npz(npz, stream, timestamps, traj, central_range(frames) if frames else None)
     for path in (evt3, aedat4):
         if path:

@@ -1,4 +1,5 @@
 """The dataset index: one row per trajectory of a scenario."""
+
 from __future__ import annotations
 
 import os
@@ -15,10 +16,18 @@ from ..state import MASS
 def index_row(path: str | os.PathLike) -> dict:
     tr = read_trajectory(path)
     a = tr.attrs
-    return {"scenario": a["scenario"], "id": int(a["id"]), "path": str(path), "tf_s": float(a["tf_s"]),
-            "n_poses": len(tr.t), "fps": float(a["fps"]), "N": int(a["N"]),
-            "final_mass_kg": float(tr.state_nodes[-1, MASS]), "continuation": a["continuation"],
-            "error_position_m": float(a["error_position_m"])}
+    return {
+        "scenario": a["scenario"],
+        "id": int(a["id"]),
+        "path": str(path),
+        "tf_s": float(a["tf_s"]),
+        "n_poses": len(tr.t),
+        "fps": float(a["fps"]),
+        "N": int(a["N"]),
+        "final_mass_kg": float(tr.state_nodes[-1, MASS]),
+        "continuation": a["continuation"],
+        "error_position_m": float(a["error_position_m"]),
+    }
 
 
 def dataset_index(paths: list[str | os.PathLike], output: str | os.PathLike) -> pd.DataFrame:

@@ -1,6 +1,7 @@
 """Stage 6: the ground-truth motion field of every n-th frame of a trajectory, over the
 Moon's sphere (analytic) and, given frames.h5, of the rendered terrain from its depth:
 instantaneous flow (px/s) and the exact displacement to the next frame (px)."""
+
 from __future__ import annotations
 
 import os
@@ -19,19 +20,33 @@ from ..progress import log
 
 
 def _empty_fields(n: int, h: int, w: int, terrain: bool) -> dict[str, np.ndarray]:
-    fields = {"flow_sphere": np.empty((n, h, w, 2), np.float32), "displacement_sphere": np.empty((n, h, w, 2), np.float32),
-              "valid": np.empty((n, h, w), bool)}
+    fields = {
+        "flow_sphere": np.empty((n, h, w, 2), np.float32),
+        "displacement_sphere": np.empty((n, h, w, 2), np.float32),
+        "valid": np.empty((n, h, w), bool),
+    }
     if terrain:
-        fields.update({"flow_terrain": np.empty((n, h, w, 2), np.float32),
-                       "displacement_terrain": np.empty((n, h, w, 2), np.float32),
-                       "valid_terrain": np.empty((n, h, w), bool),
-                       "sphere_minus_terrain_mean_px_s": np.full((n, 2), np.nan, np.float32),
-                       "sphere_minus_terrain_rms_px_s": np.full(n, np.nan, np.float32)})
+        fields.update(
+            {
+                "flow_terrain": np.empty((n, h, w, 2), np.float32),
+                "displacement_terrain": np.empty((n, h, w, 2), np.float32),
+                "valid_terrain": np.empty((n, h, w), bool),
+                "sphere_minus_terrain_mean_px_s": np.full((n, 2), np.nan, np.float32),
+                "sphere_minus_terrain_rms_px_s": np.full(n, np.nan, np.float32),
+            }
+        )
     return fields
 
 
-def motion_field(trajectory: str | os.PathLike, camera: Camera, moon_radius_m: float, every_n_frames: int,
-                 output: str | os.PathLike, flo_dir: str | os.PathLike, frames: str | os.PathLike | None = None) -> None:
+def motion_field(
+    trajectory: str | os.PathLike,
+    camera: Camera,
+    moon_radius_m: float,
+    every_n_frames: int,
+    output: str | os.PathLike,
+    flo_dir: str | os.PathLike,
+    frames: str | os.PathLike | None = None,
+) -> None:
     """Write motion_field.h5 and one .flo per field (the sphere displacement) into flo_dir."""
     if every_n_frames < 1:
         raise ValueError(f"motion field: every_n_frames: expected >= 1, got {every_n_frames}")
@@ -41,13 +56,17 @@ def motion_field(trajectory: str | os.PathLike, camera: Camera, moon_radius_m: f
     rendered = FramesFile(frames) if frames else None
     try:
         if rendered is not None and rendered.shape != (len(tr.t), camera.height, camera.width):
-            raise ValueError(f"{frames}: depth_m has shape {rendered.shape}, expected "
-                             f"({len(tr.t)}, {camera.height}, {camera.width}) to match {trajectory}")
+            raise ValueError(
+                f"{frames}: depth_m has shape {rendered.shape}, expected "
+                f"({len(tr.t)}, {camera.height}, {camera.width}) to match {trajectory}"
+            )
         picked = np.arange(0, len(tr.t) - 1, every_n_frames)  # each needs its next frame
         n, h, w = len(picked), camera.height, camera.width
         fields = _empty_fields(n, h, w, rendered is not None)
-        log(f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"
-            + (f", terrain-true from {frames}" if rendered is not None else ""))
+        log(
+            f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"
+            + (f", terrain-true from {frames}" if rendered is not None else "")
+        )
         with atomic_directory(flo_dir) as tmp_dir:
             for i, k in enumerate(picked):
                 flow, on_sphere = sphere_flow(camera, tr.state[k], moon_radius_m, np.float32)
@@ -68,15 +87,26 @@ def motion_field(trajectory: str | os.PathLike, camera: Camera, moon_radius_m: f
                         fields["sphere_minus_terrain_rms_px_s"][i] = np.sqrt(np.mean(np.sum(diff**2, axis=1)))
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
-            attrs = {"width": w, "height": h, "fov_deg": camera.fov_deg, "focal_px": camera.focal_px,
-                     "moon_radius_m": moon_radius_m, "fps": float(tr.attrs["fps"]), "every_n_frames": every_n_frames,
-                     "scenario": tr.attrs["scenario"], "id": int(tr.attrs["id"]), "traj2events_version": __version__}
+            attrs = {
+                "width": w,
+                "height": h,
+                "fov_deg": camera.fov_deg,
+                "focal_px": camera.focal_px,
+                "moon_radius_m": moon_radius_m,
+                "fps": float(tr.attrs["fps"]),
+                "every_n_frames": every_n_frames,
+                "scenario": tr.attrs["scenario"],
+                "id": int(tr.attrs["id"]),
+                "traj2events_version": __version__,
+            }
             if rendered is not None:
                 rms = fields["sphere_minus_terrain_rms_px_s"]
                 median = float(np.nanmedian(rms)) if np.isfinite(rms).any() else np.nan
                 attrs["sphere_minus_terrain_rms_px_s_median"] = median
-                log(f"sphere minus terrain-true field: median RMS {median:.3g} px/s, "
-                    f"mean offset {np.nanmean(fields['sphere_minus_terrain_mean_px_s'], axis=0)} px/s")
+                log(
+                    f"sphere minus terrain-true field: median RMS {median:.3g} px/s, "
+                    f"mean offset {np.nanmean(fields['sphere_minus_terrain_mean_px_s'], axis=0)} px/s"
+                )
             write_motion_field(output, tr.t[picked], picked, fields, attrs)
     finally:
         if rendered is not None:

@@ -1,6 +1,7 @@
 """Pictures: the mosaics of frames, motion field and event frames at the paper's five
 times, and the dataset figure. Each is its own rule, so restyling a picture or changing a
 picture setting (the event-frame window) reruns only pictures."""
+
 from __future__ import annotations
 
 import os
@@ -47,8 +48,13 @@ def frames_picture(trajectory: str | os.PathLike, video: str | os.PathLike, outp
     save_png(fig, output, dpi=100)
 
 
-def motion_field_picture(trajectory: str | os.PathLike, camera: Camera, moon_radius_m: float,
-                         output: str | os.PathLike, video: str | os.PathLike | None = None) -> None:
+def motion_field_picture(
+    trajectory: str | os.PathLike,
+    camera: Camera,
+    moon_radius_m: float,
+    output: str | os.PathLike,
+    video: str | os.PathLike | None = None,
+) -> None:
     """motion_field.png: colour wheel and quiver of the sphere's field at the paper's five
     times, over the display frames of video.mkv when given."""
     tr = read_trajectory(trajectory)
@@ -59,9 +65,14 @@ def motion_field_picture(trajectory: str | os.PathLike, camera: Camera, moon_rad
         unique = sorted(set(picks))
         by_index = dict(zip(unique, read_video(video, unique)))
         backgrounds = [by_index[k] for k in picks]
-    fig = motion_field_mosaic([float(tr.t[k]) for k in picks], [f for f, _ in fields], [m for _, m in fields],
-                              list(PAPER_LABELS), f"{_title(tr)}: motion field over the sphere (px/s)",
-                              backgrounds=backgrounds)
+    fig = motion_field_mosaic(
+        [float(tr.t[k]) for k in picks],
+        [f for f, _ in fields],
+        [m for _, m in fields],
+        list(PAPER_LABELS),
+        f"{_title(tr)}: motion field over the sphere (px/s)",
+        backgrounds=backgrounds,
+    )
     save_png(fig, output, dpi=100)
 
 
@@ -71,8 +82,15 @@ def centred_window(centre_us: int, window_us: int, end_us: int) -> tuple[int, in
     return start, start + window_us
 
 
-def events_picture(events: str | os.PathLike, end_s: float, width: int, height: int, window_ms: float,
-                   title: str, output: str | os.PathLike) -> None:
+def events_picture(
+    events: str | os.PathLike,
+    end_s: float,
+    width: int,
+    height: int,
+    window_ms: float,
+    title: str,
+    output: str | os.PathLike,
+) -> None:
     """events.png: event frames (ON blue, OFF red) of `window_ms` windows at the paper's
     five times of a recording that ends at `end_s`."""
     window_us = int(round(window_ms * 1000))
@@ -87,8 +105,9 @@ def events_picture(events: str | os.PathLike, end_s: float, width: int, height: 
     save_png(event_mosaic(centres, images, counts, list(PAPER_LABELS), title, window_ms), output, dpi=100)
 
 
-def trajectory_events_picture(events: str | os.PathLike, trajectory: str | os.PathLike, window_ms: float,
-                              output: str | os.PathLike) -> None:
+def trajectory_events_picture(
+    events: str | os.PathLike, trajectory: str | os.PathLike, window_ms: float, output: str | os.PathLike
+) -> None:
     """events.png of one trajectory (its size from its events.h5, its end from its poses)."""
     tr = read_trajectory(trajectory)
     attrs = read_events_attrs(events)

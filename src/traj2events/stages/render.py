@@ -1,6 +1,7 @@
 """Stages 4-5: render the lunar surface from every pose of a trajectory (linear radiance
 and depth, frames.h5) and the videos made from the same frames (lossless FFV1 of the 8-bit
 display frames, and an H.264 preview)."""
+
 from __future__ import annotations
 
 import json
@@ -51,10 +52,20 @@ class RenderSettings:
         reach = max(abs(v) for v in sc["downrange_m"]) + max(abs(v) for v in sc["crossrange_m"])
         horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
         r = config["render"]
-        return cls(name, int(config["camera"]["width"]), int(config["camera"]["height"]),
-                   float(config["camera"]["fov_deg"]), radius, dict(config["terrain"]), dict(sc["sun"]),
-                   dict(r["reflectance"]), dict(r["lod"]), float(reach + horizon),
-                   float(r["display_white_w_m2_sr"]), float(r["display_gamma"]))
+        return cls(
+            name,
+            int(config["camera"]["width"]),
+            int(config["camera"]["height"]),
+            float(config["camera"]["fov_deg"]),
+            radius,
+            dict(config["terrain"]),
+            dict(sc["sun"]),
+            dict(r["reflectance"]),
+            dict(r["lod"]),
+            float(reach + horizon),
+            float(r["display_white_w_m2_sr"]),
+            float(r["display_gamma"]),
+        )
 
     def to_json(self) -> str:
         return json.dumps(self.__dict__, sort_keys=True)
@@ -74,16 +85,32 @@ class RenderSettings:
 
     def frame_attrs(self, camera: Camera, sun: Sun) -> dict:
         """The scene's description, stored with the frames."""
-        return {"width": self.width, "height": self.height, "fov_deg": self.fov_deg, "focal_px": camera.focal_px,
-                "moon_radius_m": self.moon_radius_m, "sun_range_m": sun.range_m, "sun_azimuth_deg": sun.azimuth_deg,
-                "sun_elevation_deg": sun.elevation_deg, "sun_irradiance_w_m2": sun.irradiance_w_m2,
-                "reflectance": self.reflectance, "terrain": self.terrain, "lod": self.lod,
-                "terrain_half_extent_m": self.half_extent_m, "display_white_w_m2_sr": self.display_white_w_m2_sr,
-                "display_gamma": self.display_gamma}
+        return {
+            "width": self.width,
+            "height": self.height,
+            "fov_deg": self.fov_deg,
+            "focal_px": camera.focal_px,
+            "moon_radius_m": self.moon_radius_m,
+            "sun_range_m": sun.range_m,
+            "sun_azimuth_deg": sun.azimuth_deg,
+            "sun_elevation_deg": sun.elevation_deg,
+            "sun_irradiance_w_m2": sun.irradiance_w_m2,
+            "reflectance": self.reflectance,
+            "terrain": self.terrain,
+            "lod": self.lod,
+            "terrain_half_extent_m": self.half_extent_m,
+            "display_white_w_m2_sr": self.display_white_w_m2_sr,
+            "display_gamma": self.display_gamma,
+        }
 
 
-def render_trajectory(trajectory: str | os.PathLike, settings: RenderSettings, frames: str | os.PathLike,
-                      video: str | os.PathLike, preview: str | os.PathLike) -> None:
+def render_trajectory(
+    trajectory: str | os.PathLike,
+    settings: RenderSettings,
+    frames: str | os.PathLike,
+    video: str | os.PathLike,
+    preview: str | os.PathLike,
+) -> None:
     """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv, preview.mp4."""
     s = settings
     tr = read_trajectory(trajectory)
@@ -92,17 +119,26 @@ def render_trajectory(trajectory: str | os.PathLike, settings: RenderSettings, f
     camera, tiles, sun, reflectance = s.build()
     fps = float(tr.attrs["fps"])
     n = len(tr.t)
-    attrs = {**s.frame_attrs(camera, sun), "fps": fps, "scenario": tr.attrs["scenario"], "id": int(tr.attrs["id"]),
-             "traj2events_version": __version__}
+    attrs = {
+        **s.frame_attrs(camera, sun),
+        "fps": fps,
+        "scenario": tr.attrs["scenario"],
+        "id": int(tr.attrs["id"]),
+        "traj2events_version": __version__,
+    }
     attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
-    log(f"{trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {sun.azimuth_deg} deg, "
-        f"el {sun.elevation_deg} deg, {s.reflectance['model']})")
+    log(
+        f"{trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {sun.azimuth_deg} deg, "
+        f"el {sun.elevation_deg} deg, {s.reflectance['model']})"
+    )
     start = time.perf_counter()
     triangles = reused = 0
-    with TerrainRenderer(tiles, camera, sun, reflectance) as renderer, \
-            FramesWriter(frames, tr.t, np.arange(n), s.height, s.width, attrs) as out, \
-            VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless, \
-            VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview:
+    with (
+        TerrainRenderer(tiles, camera, sun, reflectance) as renderer,
+        FramesWriter(frames, tr.t, np.arange(n), s.height, s.width, attrs) as out,
+        VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
+        VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview,
+    ):
         frame = None
         for k in range(n):
             # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
@@ -117,13 +153,32 @@ def render_trajectory(trajectory: str | os.PathLike, settings: RenderSettings, f
             shown_preview.write(shown)
             if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
                 elapsed = time.perf_counter() - start
-                log(f"  {k + 1}/{n} frames, {elapsed / (k + 1) * 1e3:.1f} ms/frame, "
-                    f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 - reused, 1):.0f} triangles/frame")
+                log(
+                    f"  {k + 1}/{n} frames, {elapsed / (k + 1) * 1e3:.1f} ms/frame, "
+                    f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 - reused, 1):.0f} triangles/frame"
+                )
     log(f"{n} frames in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
 
 
 # frames.h5's attribute order (kept, so the same scene gives the same bytes).
-FRAME_ATTR_ORDER = ("width", "height", "fov_deg", "focal_px", "fps", "moon_radius_m", "sun_range_m", "sun_azimuth_deg",
-                    "sun_elevation_deg", "sun_irradiance_w_m2", "reflectance", "terrain", "lod",
-                    "terrain_half_extent_m", "display_white_w_m2_sr", "display_gamma", "scenario", "id",
-                    "traj2events_version")
+FRAME_ATTR_ORDER = (
+    "width",
+    "height",
+    "fov_deg",
+    "focal_px",
+    "fps",
+    "moon_radius_m",
+    "sun_range_m",
+    "sun_azimuth_deg",
+    "sun_elevation_deg",
+    "sun_irradiance_w_m2",
+    "reflectance",
+    "terrain",
+    "lod",
+    "terrain_half_extent_m",
+    "display_white_w_m2_sr",
+    "display_gamma",
+    "scenario",
+    "id",
+    "traj2events_version",
+)

@@ -1,5 +1,6 @@
 """The dataset summary: one row per scenario (counts, failures, final mass and t_f
 ranges, worst re-integration error)."""
+
 from __future__ import annotations
 
 import os
@@ -16,26 +17,29 @@ def summary_table(scenarios: list[str], sample_tables: list[pd.DataFrame]) -> pd
     rows = []
     for name, table in zip(scenarios, sample_tables):
         ok = table[table["success"]]
-        rows.append({
-            "scenario": name,
-            "count": len(table),
-            "solved": len(ok),
-            "failed": int((~table["success"]).sum()),
-            "solved_first_try": int((table["method"] == "warm").sum()),
-            "refined": int(table["method"].str.endswith("+refined").sum()),
-            "final_mass_min_kg": ok["final_mass_kg"].min(),
-            "final_mass_mean_kg": ok["final_mass_kg"].mean(),
-            "final_mass_max_kg": ok["final_mass_kg"].max(),
-            "tf_min_s": ok["tf_s"].min(),
-            "tf_max_s": ok["tf_s"].max(),
-            "max_error_position_m": ok["error_position_m"].max(),
-            "max_error_velocity_m_s": ok["error_velocity_m_s"].max(),
-        })
+        rows.append(
+            {
+                "scenario": name,
+                "count": len(table),
+                "solved": len(ok),
+                "failed": int((~table["success"]).sum()),
+                "solved_first_try": int((table["method"] == "warm").sum()),
+                "refined": int(table["method"].str.endswith("+refined").sum()),
+                "final_mass_min_kg": ok["final_mass_kg"].min(),
+                "final_mass_mean_kg": ok["final_mass_kg"].mean(),
+                "final_mass_max_kg": ok["final_mass_kg"].max(),
+                "tf_min_s": ok["tf_s"].min(),
+                "tf_max_s": ok["tf_s"].max(),
+                "max_error_position_m": ok["error_position_m"].max(),
+                "max_error_velocity_m_s": ok["error_velocity_m_s"].max(),
+            }
+        )
     return pd.DataFrame(rows)
 
 
-def dataset_summary(solutions: list[str | os.PathLike], tables: list[str | os.PathLike],
-                    output: str | os.PathLike) -> pd.DataFrame:
+def dataset_summary(
+    solutions: list[str | os.PathLike], tables: list[str | os.PathLike], output: str | os.PathLike
+) -> pd.DataFrame:
     """summary.csv from each scenario's solutions.h5 (for its name) and samples.csv."""
     if len(solutions) != len(tables):
         raise ValueError(f"summary: expected one samples.csv per solutions.h5, got {len(tables)} and {len(solutions)}")
