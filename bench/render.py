@@ -91,7 +91,7 @@ def run_case(name, state, sun, extent, size, n_frames, budgets, reference):
             tiles=frame.n_tiles,
             uniform=uniform,
             build_s=build_s,
-            n_built=len(tiles._cache),
+            n_built=tiles.n_cached,
             frame=frame,
         )
     ref = results[reference]["frame"]

@@ -9,6 +9,7 @@ from conftest import ROOT, landing_bc
 from traj2events.config import load_config
 from traj2events.ocp import Solution
 from traj2events.scenarios import (
+    RANGE_KEYS,
     Acceptance,
     Scenario,
     ScenarioSettings,
@@ -54,20 +55,7 @@ def test_base_is_the_midpoint_and_the_lander_approaches_along_plus_x(braking):
 
 
 def test_scenario_rejects_reversed_range():
-    ranges = {
-        k: (0.0, 1.0)
-        for k in (
-            "downrange_m",
-            "crossrange_m",
-            "altitude_m",
-            "speed_forward_m_s",
-            "speed_cross_m_s",
-            "speed_down_m_s",
-            "roll_deg",
-            "pitch_deg",
-            "yaw_deg",
-        )
-    }
+    ranges = {k: (0.0, 1.0) for k in RANGE_KEYS}
     ranges["pitch_deg"] = (60.0, 45.0)
     with pytest.raises(ValueError, match="pitch_deg"):
         Scenario("x", 1, 10.0, ranges)

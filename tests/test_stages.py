@@ -1,0 +1,156 @@
+"""Every stage function on a tiny scenario, chained as the workflow chains them, without
+the command line: each output exists, reads back, and agrees with its inputs."""
+
+import h5py
+import numpy as np
+import pandas as pd
+import pytest
+
+from traj2events.camera import Camera
+from traj2events.config import resolve_config
+from traj2events.formats.events import read_events
+from traj2events.formats.trajectory import read_solution_set, read_trajectory
+from traj2events.scenarios import ScenarioSettings
+from traj2events.stages import pictures
+from traj2events.stages.base_solution import BaseSolveError, base_solution
+from traj2events.stages.camera_poses import camera_poses
+from traj2events.stages.events import emulate, emulator_params, export_events, frame_source
+from traj2events.stages.index import dataset_index
+from traj2events.stages.motion_field import motion_field
+from traj2events.stages.render import RenderSettings, render_trajectory
+from traj2events.stages.sample_trajectories import initial_values, sample_trajectories
+from traj2events.stages.summary import dataset_summary
+from traj2events.state import MASS
+
+SIZE = 16
+
+
+@pytest.fixture(scope="module")
+def config():
+    return resolve_config(
+        {
+            "ocp": {"n_nodes": 30, "refine_n_nodes": 60},
+            "camera": {"fps": 5.0, "width": SIZE, "height": SIZE},
+            "motion_field": {"every_n_frames": 7},
+            "scenarios": {"braking": None, "approach": None, "descent": {"n_trajectories": 2}},
+        }
+    )
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory, config):
+    """The chain of stages for the descent scenario's trajectory 0000."""
+    d = tmp_path_factory.mktemp("stages")
+    s = ScenarioSettings.from_config(config, "descent")
+    base_solution(s, d / "base.h5")
+    results = sample_trajectories(s, d / "base.h5", d / "solutions.h5", d / "samples.csv", jobs=1)
+    assert all(r.success for r in results)
+    camera_poses(d / "solutions.h5", 0, config["camera"]["fps"], "reintegrate", d / "trajectory.h5")
+    render_trajectory(
+        d / "trajectory.h5",
+        RenderSettings.from_config(config, "descent"),
+        d / "frames.h5",
+        d / "video.mkv",
+        d / "p.mp4",
+    )
+    return d
+
+
+def test_base_and_samples_are_solved_and_tabled(built, config):
+    base = read_trajectory(built / "base.h5")
+    assert base.t is None and base.attrs["solver_success"] and base.attrs["scenario"] == "descent"
+    table = pd.read_csv(built / "samples.csv")
+    assert list(table["id"]) == [0, 1] and table["success"].all()
+    solutions = read_solution_set(built / "solutions.h5")
+    for i, row in table.iterrows():
+        sample = solutions["samples"][i]
+        assert row["final_mass_kg"] == pytest.approx(sample["state"][-1, MASS])
+        drawn = initial_values(sample["initial_state"])
+        lo, hi = config["scenarios"]["descent"]["altitude_m"]
+        assert lo <= drawn["altitude_m"] <= hi and drawn["altitude_m"] == pytest.approx(row["altitude_m"])
+
+
+def test_camera_poses_run_at_the_frame_rate_and_land(built):
+    tr = read_trajectory(built / "trajectory.h5")
+    np.testing.assert_allclose(np.diff(tr.t), 0.2, atol=1e-12)
+    assert abs(tr.state[-1, 2]) < 0.5 and tr.attrs["id"] == 0 and tr.attrs["fps"] == 5.0
+
+
+def test_a_failed_sample_is_refused_by_camera_poses(built, tmp_path):
+    with pytest.raises(ValueError, match="sample 7 is not a solved sample"):
+        camera_poses(built / "solutions.h5", 7, 5.0, "reintegrate", tmp_path / "t.h5")
+    assert not list(tmp_path.iterdir())
+
+
+def test_an_unsolvable_base_problem_is_named(config, tmp_path):
+    bad = dict(config["scenarios"]["descent"], altitude_m=[90000.0, 90000.0])  # far beyond the fuel
+    s = ScenarioSettings.from_config(
+        resolve_config({"ocp": {"max_iter": 15}, "scenarios": {"braking": None, "approach": None, "descent": bad}}),
+        "descent",
+    )
+    with pytest.raises(BaseSolveError, match="scenario 'descent'"):
+        base_solution(s, tmp_path / "base.h5")
+    assert not list(tmp_path.iterdir())
+
+
+def test_render_writes_frames_and_a_lossless_video_of_them(built):
+    from traj2events.video import display_frame, read_video
+
+    tr = read_trajectory(built / "trajectory.h5")
+    with h5py.File(built / "frames.h5") as f:
+        radiance = f["radiance"][()]
+        assert radiance.shape == (len(tr.t), SIZE, SIZE) and (f["depth_m"][len(tr.t) // 2] > 0).all()
+        white, gamma = f.attrs["display_white_w_m2_sr"], f.attrs["display_gamma"]
+    video = read_video(built / "video.mkv")
+    assert video.shape == radiance.shape
+    # The video holds the display frames of the unrounded radiance: within 1 DN of frames.h5's.
+    assert np.abs(video.astype(int) - display_frame(radiance, white, gamma).astype(int)).max() <= 1
+
+
+def test_motion_field_with_the_terrain_field(built, config):
+    camera = Camera(SIZE, SIZE, config["camera"]["fov_deg"])
+    motion_field(built / "trajectory.h5", camera, 1_737_400.0, 7, built / "mf.h5", built / "flow", built / "frames.h5")
+    with h5py.File(built / "mf.h5") as f:
+        frames = f["frame_index"][()]
+        assert frames[0] == 0 and np.all(np.diff(frames) == 7)
+        assert f["displacement_terrain"].shape == (len(frames), SIZE, SIZE, 2)
+        assert np.nanmedian(f["sphere_minus_terrain_rms_px_s"][()]) < np.abs(f["flow_sphere"][()]).max()
+    assert sorted(p.name for p in (built / "flow").iterdir()) == [f"{k:06d}.flo" for k in frames]
+    with pytest.raises(ValueError, match="every_n_frames"):
+        motion_field(built / "trajectory.h5", camera, 1_737_400.0, 0, built / "x.h5", built / "x")
+
+
+def test_events_exports_and_pictures(built, config):
+    source = frame_source(built / "frames.h5", chunk=4)
+    params = emulator_params("paper", refractory_s=None)
+    n_frames, n_events, t_last = emulate(source, params, 3, built / "events.h5", "paper", "frames.h5")
+    events, attrs = read_events(built / "events.h5")
+    assert len(events) == n_events > 0 and attrs["seed"] == 3 and attrs["input"] == "frames.h5"
+    assert t_last == pytest.approx(read_trajectory(built / "trajectory.h5").t[-1])
+    export_events(built / "events.h5", npz=str(built / "e.npz"), trajectory=built / "trajectory.h5",
+                  frames=built / "frames.h5")  # fmt: skip
+    npz = np.load(built / "e.npz")
+    assert len(npz["events"]) == n_events and npz["traj"].shape[1] == 12 and npz["range_meter"][0, 1] > 0
+    camera = Camera(SIZE, SIZE, config["camera"]["fov_deg"])
+    pictures.frames_picture(built / "trajectory.h5", built / "video.mkv", built / "frames.png")
+    pictures.motion_field_picture(built / "trajectory.h5", camera, 1_737_400.0, built / "mf.png", built / "video.mkv")
+    pictures.trajectory_events_picture(built / "events.h5", built / "trajectory.h5", 10.0, built / "events.png")
+    pictures.dataset_picture([built / "solutions.h5"], built / "trajectories.png")
+    for name in ("frames.png", "mf.png", "events.png", "trajectories.png"):
+        assert (built / name).read_bytes()[:4] == b"\x89PNG"
+
+
+def test_index_and_summary(built):
+    index = dataset_index([built / "trajectory.h5", built / "video.mkv"], built / "index.csv")
+    assert list(index["id"]) == [0] and index["n_poses"][0] == len(read_trajectory(built / "trajectory.h5").t)
+    summary = dataset_summary([built / "solutions.h5"], [built / "samples.csv"], built / "summary.csv")
+    assert summary.loc[0, "scenario"] == "descent" and summary.loc[0, "solved"] == 2
+    with pytest.raises(ValueError, match="one samples.csv per solutions.h5"):
+        dataset_summary([built / "solutions.h5"], [], built / "s.csv")
+
+
+def test_centred_windows_stay_inside_the_recording():
+    assert pictures.centred_window(0, 10_000, 1_000_000) == (0, 10_000)
+    assert pictures.centred_window(500_000, 10_000, 1_000_000) == (495_000, 505_000)
+    assert pictures.centred_window(1_000_000, 10_000, 1_000_000) == (990_000, 1_000_000)
+    assert pictures.centred_window(3_000, 10_000, 4_000) == (0, 10_000)  # a recording shorter than the window
