@@ -158,7 +158,7 @@ def test_motion_field_cli_names_a_missing_trajectory(tmp_path):
 def test_overlays_hold_only_what_differs_from_the_defaults():
     smoke = load_yaml(ROOT / "config" / "smoke.yaml")
     config = load_config(ROOT / "config" / "smoke.yaml")
-    assert list(config["scenarios"]) == ["descent"]  # the others are set to null
+    assert list(config["scenarios"]) == ["descent"]  # the scenarios it names, and no others
     assert config["camera"]["width"] == 32 and config["camera"]["fov_deg"] == default_config()["camera"]["fov_deg"]
     assert config["ocp"]["n_nodes"] == 30 and config["ocp"]["tol"] == default_config()["ocp"]["tol"]
     assert len(yaml.safe_dump(smoke)) < len(yaml.safe_dump(config)) / 5
@@ -167,9 +167,16 @@ def test_overlays_hold_only_what_differs_from_the_defaults():
 
 def test_merge_replaces_values_and_merges_mappings():
     base = {"a": {"b": 1, "c": [1, 2]}, "scenarios": {"x": {"n": 1, "sun": {"az": 1, "el": 2}}, "y": {"n": 2}}}
-    merged = merge_config(base, {"a": {"c": [3]}, "scenarios": {"x": {"sun": {"el": 5}}, "y": None, "z": {"n": 3}}})
+    merged = merge_config(base, {"a": {"c": [3]}, "scenarios": {"x": {"sun": {"el": 5}}, "z": {"n": 3}}})
     assert merged == {"a": {"b": 1, "c": [3]}, "scenarios": {"x": {"n": 1, "sun": {"az": 1, "el": 5}}, "z": {"n": 3}}}
     assert base["scenarios"]["x"]["sun"]["el"] == 2  # the base is not modified
+    assert merge_config(base, {"a": {"b": 2}})["scenarios"] == base["scenarios"]  # no `scenarios`: the defaults
+
+
+def test_a_complete_config_builds_its_own_scenarios_only():
+    config = default_config()
+    config["scenarios"] = {"mysite": dict(config["scenarios"]["descent"], n_trajectories=3)}
+    assert list(resolve_config(config)["scenarios"]) == ["mysite"]
 
 
 def test_a_new_scenario_must_be_complete():

@@ -28,19 +28,18 @@ def section(name: str) -> dict:
 
 
 def merge_config(base: dict, overlay: dict | None) -> dict:
-    """`overlay` on top of `base`: mappings merge key by key, other values replace; a
-    scenario set to null in the overlay is left out (so an overlay can drop one)."""
+    """`overlay` on top of `base`: mappings merge key by key, other values replace.
+    `scenarios` is the exception: an overlay that gives it names the scenarios to build
+    (the others are left out), each merged onto the base's scenario of that name if there
+    is one. So `{scenarios: {descent: {n_trajectories: 5}}}` builds descent alone."""
     out = copy.deepcopy(base)
     for key, value in (overlay or {}).items():
-        if key == "scenarios" and isinstance(value, dict) and isinstance(out.get(key), dict):
-            scenarios = out[key]
-            for name, scenario in value.items():
-                if scenario is None:
-                    scenarios.pop(name, None)
-                elif isinstance(scenario, dict) and isinstance(scenarios.get(name), dict):
-                    scenarios[name] = merge_config(scenarios[name], scenario)
-                else:
-                    scenarios[name] = copy.deepcopy(scenario)
+        if key == "scenarios" and isinstance(value, dict):
+            known = out.get(key) if isinstance(out.get(key), dict) else {}
+            out[key] = {
+                name: merge_config(known.get(name) or {}, scenario) if isinstance(scenario, dict) else scenario
+                for name, scenario in value.items()
+            }
         elif isinstance(value, dict) and isinstance(out.get(key), dict):
             out[key] = merge_config(out[key], value)
         else:
