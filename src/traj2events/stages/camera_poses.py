@@ -13,19 +13,8 @@ from ..scenarios import ScenarioSettings
 from ..upsample import upsample
 
 # Solve facts copied from solutions.h5 into each trajectory.h5 (so it stands alone).
-SOLVE_ATTRS = (
-    "initial_state",
-    "final_state",
-    "transcription",
-    "N",
-    "solver_status",
-    "iterations",
-    "solve_time_s",
-    "cost",
-    "tf_s",
-    "error_position_m",
-    "error_velocity_m_s",
-)
+SOLVE_ATTRS = ("initial_state", "final_state", "transcription", "N", "solver_status", "iterations", "solve_time_s",
+               "cost", "tf_s", "error_position_m", "error_velocity_m_s")  # fmt: skip
 
 
 def camera_poses(
