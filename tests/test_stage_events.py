@@ -1,0 +1,68 @@
+"""The events stage: its three inputs (video, folder of images, frames.h5) give the same
+events for the same frames, the same seed gives the same bytes, bad inputs are named."""
+
+import h5py
+import numpy as np
+import pytest
+from PIL import Image
+
+from traj2events.formats.events import read_events
+from traj2events.stages.events import emulate, emulator_params, frame_source
+from traj2events.stages.pictures import events_picture
+from traj2events.video import VideoWriter
+
+
+def emulate_file(path, output, preset="clean", fps=None, chunk=64, seed=0):
+    """(frames, events, t_last) of emulating `path` into `output`."""
+    return emulate(frame_source(path, chunk, fps), emulator_params(preset), seed, output, preset, str(path))
+
+
+def ramp_frames(n=30, h=12, w=16):
+    t = np.arange(n)[:, None, None]
+    x = np.arange(w)[None, None, :]
+    return np.clip(40 + 6 * t + 3 * x, 0, 255).astype(np.uint8) * np.ones((1, h, 1), np.uint8)
+
+
+def test_events_command_on_a_video_a_folder_and_frames_h5(tmp_path):
+    frames = ramp_frames()
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in frames:
+            video.write(f)
+    folder = tmp_path / "images"
+    folder.mkdir()
+    for k, f in enumerate(frames):
+        Image.fromarray(f).save(folder / f"{k:04d}.png")
+    emulate_file(tmp_path / "in.mkv", tmp_path / "v.h5")
+    emulate_file(folder, tmp_path / "i.h5", fps=50.0, chunk=7)
+    from_video, attrs = read_events(tmp_path / "v.h5")
+    from_images, _ = read_events(tmp_path / "i.h5")
+    assert len(from_video) > 100 and from_video.tobytes() == from_images.tobytes()  # same frames, same events
+    assert (from_video["p"] == 1).all()  # brightening only
+    assert attrs["emulator_theta_on"] == 0.25 and attrs["preset"] == "clean"
+    # The HDR path: frames.h5 with linear radiance and its timestamps.
+    with h5py.File(tmp_path / "frames.h5", "w") as f:
+        f["t"] = np.arange(len(frames)) / 50.0
+        f["radiance"] = frames.astype(np.float32) / 255.0 * 40.0
+        f.attrs["display_white_w_m2_sr"] = 40.0
+    _, _, t_last = emulate_file(tmp_path / "frames.h5", tmp_path / "r.h5")
+    events_picture(tmp_path / "r.h5", t_last, 16, 12, 10.0, "ramp", tmp_path / "r.png")
+    from_radiance, _ = read_events(tmp_path / "r.h5")
+    assert abs(len(from_radiance) - len(from_video)) <= 0.05 * len(from_video)
+    assert (tmp_path / "r.png").stat().st_size > 5000
+
+
+def test_same_seed_same_bytes_and_clear_errors(tmp_path):
+    frames = ramp_frames()
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in frames:
+            video.write(f)
+    for name in ("a", "b"):
+        emulate_file(tmp_path / "in.mkv", tmp_path / f"{name}.h5", preset="paper", seed=5)
+    assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match="holds no .png"):
+        emulate_file(tmp_path / "empty", tmp_path / "x.h5", fps=10.0)
+    with pytest.raises(FileNotFoundError, match="missing.mkv does not exist"):
+        emulate_file(tmp_path / "missing.mkv", tmp_path / "x.h5")
+    assert not (tmp_path / "x.h5").exists()
+    assert not (tmp_path / "x.h5").exists()
