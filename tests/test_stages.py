@@ -32,7 +32,7 @@ def config():
             "ocp": {"n_nodes": 30, "refine_n_nodes": 60},
             "camera": {"fps": 5.0, "width": SIZE, "height": SIZE},
             "motion_field": {"every_n_frames": 7},
-            "scenarios": {"braking": None, "approach": None, "descent": {"n_trajectories": 2}},
+            "scenarios": {"descent": {"n_trajectories": 2}},
         }
     )
 
@@ -85,7 +85,7 @@ def test_a_failed_sample_is_refused_by_camera_poses(built, tmp_path):
 def test_an_unsolvable_base_problem_is_named(config, tmp_path):
     bad = dict(config["scenarios"]["descent"], altitude_m=[90000.0, 90000.0])  # far beyond the fuel
     s = ScenarioSettings.from_config(
-        resolve_config({"ocp": {"max_iter": 15}, "scenarios": {"braking": None, "approach": None, "descent": bad}}),
+        resolve_config({"ocp": {"max_iter": 15}, "scenarios": {"descent": bad}}),
         "descent",
     )
     with pytest.raises(BaseSolveError, match="scenario 'descent'"):
