@@ -197,9 +197,9 @@ def test_dataclass_defaults_come_from_the_defaults_file():
 
     from traj2events.ocp import OcpSettings
     from traj2events.reflectance import ReflectanceParams
-    from traj2events.state import Vehicle
     from traj2events.terrain import TerrainParams
     from traj2events.tiles import LodSettings
+    from traj2events.vehicle import Vehicle
 
     d = default_config()
     for cls, values in (

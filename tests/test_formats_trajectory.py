@@ -117,14 +117,18 @@ def test_atomic_directory_replaces_the_folder_only_when_complete(tmp_path):
     assert target.stat().st_mode & 0o055  # readable by others, unlike mkdtemp's 0700
 
 
-def test_reading_outputs_needs_neither_solver_nor_renderer():
+def test_reading_outputs_needs_only_numpy_and_h5py(tmp_path, solved30, vehicle):
     import subprocess
     import sys
 
+    write_trajectory(tmp_path / "t.h5", (solved30.t, solved30.state, solved30.control), None, vehicle_attrs(vehicle))
+    heavy = ("casadi", "numba", "pyrender", "OpenGL", "scipy", "matplotlib", "yaml", "pandas")
     code = (
-        "import sys, traj2events.formats.trajectory, traj2events.formats.events, traj2events.formats.flow, "
-        "traj2events.formats.frames, traj2events.formats.exports; "
-        "print(sorted(m for m in ('casadi', 'numba', 'pyrender', 'OpenGL', 'scipy', 'matplotlib') if m in sys.modules))"
+        "import sys, traj2events.formats.events, traj2events.formats.flow, traj2events.formats.frames, "
+        "traj2events.formats.exports\n"
+        "from traj2events.formats.trajectory import read_trajectory\n"
+        f"read_trajectory({str(tmp_path / 't.h5')!r})\n"
+        f"print(sorted(m for m in {heavy!r} if m in sys.modules))"
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert run.stdout.strip() == "[]"

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from .state import CONTROL_NAMES, N_CONTROL, N_STATE, STATE_NAMES, Vehicle, rotation_body_to_inertial, rotation_matrix
+from .state import CONTROL_NAMES, N_CONTROL, N_STATE, STATE_NAMES, rotation_body_to_inertial, rotation_matrix
+from .vehicle import Vehicle
 
 __all__ = [
     "CONTROL_NAMES",

@@ -14,31 +14,18 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from ..state import CONTROL_NAMES, STATE_NAMES, Vehicle
+from ..state import CONTROL_NAMES, STATE_NAMES
 from .atomic import atomic_output
 from .hdf5 import create, plain, set_attrs, write_dataset
 
-
-def vehicle_attrs(vehicle: Vehicle) -> dict:
-    """The root attributes that let anyone re-integrate the dynamics from the file."""
-    return {
-        "mass_kg": vehicle.mass_kg,
-        "dry_mass_kg": vehicle.dry_mass_kg,
-        "thrust_main_N": vehicle.thrust_main_N,
-        "thrust_rcs_N": vehicle.thrust_rcs_N,
-        "lever_arm_m": vehicle.lever_arm_m,
-        "inertia_kgm2": np.array(vehicle.inertia_kgm2),
-        "isp_s": vehicle.isp_s,
-        "g_m_s2": vehicle.g_m_s2,
-        "g0_m_s2": vehicle.g0_m_s2,
-        "tilt_max_deg": vehicle.tilt_max_deg,
-    }
+VEHICLE_KEYS = ("mass_kg", "dry_mass_kg", "thrust_main_N", "thrust_rcs_N", "lever_arm_m", "inertia_kgm2", "isp_s",
+                "g_m_s2", "g0_m_s2", "tilt_max_deg")  # fmt: skip
 
 
-def vehicle_from_attrs(attrs: h5py.AttributeManager) -> Vehicle:
-    return Vehicle(
-        **{k: (tuple(attrs[k]) if k == "inertia_kgm2" else float(attrs[k])) for k in Vehicle.__dataclass_fields__}
-    )
+def vehicle_attrs(vehicle) -> dict:
+    """The root attributes (from a vehicle.Vehicle) that let anyone re-integrate the
+    dynamics from the file."""
+    return {k: (np.array(vehicle.inertia_kgm2) if k == "inertia_kgm2" else getattr(vehicle, k)) for k in VEHICLE_KEYS}
 
 
 def solution_attrs(solution, bc) -> dict:
@@ -88,7 +75,15 @@ class Trajectory:
     state: np.ndarray | None
     control: np.ndarray | None
     attrs: dict
-    vehicle: Vehicle
+
+    @property
+    def vehicle(self):
+        """The vehicle.Vehicle of the root attributes (to re-integrate the dynamics)."""
+        from ..vehicle import Vehicle
+
+        return Vehicle(
+            **{k: (tuple(self.attrs[k]) if k == "inertia_kgm2" else float(self.attrs[k])) for k in VEHICLE_KEYS}
+        )
 
 
 def read_trajectory(path: str | os.PathLike) -> Trajectory:
@@ -100,7 +95,6 @@ def read_trajectory(path: str | os.PathLike) -> Trajectory:
             f["nodes/control"][()],
             *poses,
             attrs=dict(f.attrs),
-            vehicle=vehicle_from_attrs(f.attrs),
         )
 
 
