@@ -241,3 +241,61 @@ def test_non_utf8_and_non_mapping_configs_are_named(tmp_path):
     listing.write_text("- 1\n- 2\n")
     with pytest.raises(ConfigError, match="list.yaml.*mapping"):
         load_config(listing)
+
+
+NAN, INF = float("nan"), float("inf")
+BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
+    ({"vehicle": {"mass_kg": NAN}}, ["vehicle.mass_kg", "finite"]),
+    ({"scenarios": {"descent": {"sun": {"elevation_deg": NAN}}}}, ["scenarios.descent.sun.elevation_deg", "finite"]),
+    ({"scenarios": {"descent": {"altitude_m": [200.0, INF]}}}, ["scenarios.descent.altitude_m.1", "finite"]),
+    ({"render": {"display_white_w_m2_sr": INF}}, ["render.display_white_w_m2_sr", "finite"]),
+    ({"scenarios": {"descent": {"sun": {"elevation_deg": -30.0}}}}, ["scenarios.descent.sun.elevation_deg", "> 0"]),
+    ({"scenarios": {"descent": {"sun": {"elevation_deg": 0.0}}}}, ["scenarios.descent.sun.elevation_deg", "> 0"]),
+    ({"scenarios": {"descent": {"sun": {"range_m": 1.0}}}}, ["scenarios.descent.sun.range_m", ">= 1.46e+11"]),
+    ({"scenarios": {"descent": {"sun": {"range_m": 1e15}}}}, ["scenarios.descent.sun.range_m", "<= 1.53e+11"]),
+    ({"ocp": {"tf_min_s": 500.0, "tf_max_s": 100.0}}, ["ocp.tf_min_s", "less than ocp.tf_max_s"]),
+    ({"scenarios": {"descent": {"tf_guess_s": 5000.0}}}, ["scenarios.descent.tf_guess_s", "[ocp.tf_min_s"]),
+    ({"ocp": {"refine_n_nodes": 40}}, ["ocp.refine_n_nodes", "more than ocp.n_nodes"]),
+    ({"terrain": {"crater_diameter_min_m": 50.0, "crater_diameter_max_m": 10.0}}, ["terrain.crater_diameter_min_m"]),
+    ({"events": {"hot_pixel_fraction": 0.01}}, ["events.hot_pixel_hz", "> 0"]),
+    ({"scenarios": {"descent": {"altitude_m": [-10.0, 100.0]}}}, ["scenarios.descent.altitude_m", "above the ground"]),
+    ({"scenarios": {"descent": None}}, ["scenarios.descent", "expected object"]),
+    ({"terrain": {"elevation_grid": "no/such/dem.npy", "grid_spacing_m": 1.0}}, ["terrain.elevation_grid", "dem.npy"]),
+]
+
+
+@pytest.mark.parametrize("overlay, fragments", BAD_OVERLAYS, ids=[str(f[0]) for _, f in BAD_OVERLAYS])
+def test_bad_values_are_refused_naming_the_key(overlay, fragments):
+    with pytest.raises(ConfigError) as info:
+        resolve_config(overlay)
+    for fragment in fragments:
+        assert fragment in str(info.value), str(info.value)
+
+
+def write_dem(path, kind):
+    import numpy as np
+
+    if kind == "1-D":
+        np.save(path, np.zeros(10))
+    elif kind == "NaN":
+        np.save(path, np.full((4, 4), np.nan))
+    elif kind == "garbage":
+        path.write_bytes(b"not a numpy file at all")
+    else:
+        np.save(path, np.zeros((8, 8)))
+
+
+@pytest.mark.parametrize(
+    "kind, spacing, fragment",
+    [("1-D", 1.0, "finite 2-D"), ("NaN", 1.0, "finite 2-D"), ("garbage", 1.0, "dem.npy"), ("ok", None, "spacing")],
+)
+def test_a_bad_elevation_grid_is_refused_before_any_job(tmp_path, kind, spacing, fragment):
+    write_dem(tmp_path / "dem.npy", kind)
+    with pytest.raises(ConfigError, match="terrain.elevation_grid") as info:
+        resolve_config({"terrain": {"elevation_grid": str(tmp_path / "dem.npy"), "grid_spacing_m": spacing}})
+    assert fragment in str(info.value)
+
+
+def test_a_good_elevation_grid_passes(tmp_path):
+    write_dem(tmp_path / "dem.npy", "ok")
+    resolve_config({"terrain": {"elevation_grid": str(tmp_path / "dem.npy"), "grid_spacing_m": 2.0}})

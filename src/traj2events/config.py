@@ -9,6 +9,7 @@ job runs; `validate_config` turns the first problem into one line such as
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +48,8 @@ def _describe(error: jsonschema.ValidationError) -> str:
         return f"config key '{where}': expected {schema_value}, got {type(got).__name__} {got!r}"
     if v in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         op = {"minimum": ">=", "maximum": "<=", "exclusiveMinimum": ">", "exclusiveMaximum": "<"}[v]
-        return f"config key '{where}': expected a value {op} {schema_value}, got {got!r}"
+        bound = f"{schema_value:g}" if isinstance(schema_value, float) else schema_value
+        return f"config key '{where}': expected a value {op} {bound}, got {got!r}"
     if v == "enum":
         return f"config key '{where}': expected one of {schema_value}, got {got!r}"
     if v in ("minItems", "maxItems"):
@@ -57,37 +59,86 @@ def _describe(error: jsonschema.ValidationError) -> str:
     return f"config key '{where}': {error.message}"
 
 
-def _semantic_errors(config: dict) -> list[str]:
-    """What a schema cannot say: ordered ranges and initial attitudes within the tilt limit."""
-    import math
+def _non_finite(value: Any, path: tuple = ()) -> list[str]:
+    """Keys whose number is NaN or infinite (JSON Schema's bounds let NaN through)."""
+    if isinstance(value, dict):
+        return [e for k, v in value.items() for e in _non_finite(v, (*path, k))]
+    if isinstance(value, list):
+        return [e for i, v in enumerate(value) for e in _non_finite(v, (*path, i))]
+    if isinstance(value, float) and not math.isfinite(value):
+        return [f"config key '{_key(path)}': expected a finite number, got {value}"]
+    return []
 
+
+def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
     from .scenarios import RANGE_KEYS
 
     errors = []
-    tilt = config["vehicle"]["tilt_max_deg"]
-    for name, sc in config["scenarios"].items():
-        if name in RESERVED_SCENARIO_NAMES:
-            errors.append(
-                f"config key 'scenarios.{name}': the name '{name}' is reserved for results/{name}/ "
-                f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
-            )
-        for key in RANGE_KEYS:
-            lo, hi = sc[key]
-            if lo > hi:
-                errors.append(
-                    f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}"
-                )
-        worst = math.cos(math.radians(max(map(abs, sc["roll_deg"])))) * math.cos(
-            math.radians(max(map(abs, sc["pitch_deg"])))
+    if name in RESERVED_SCENARIO_NAMES:
+        errors.append(
+            f"config key 'scenarios.{name}': the name '{name}' is reserved for results/{name}/ "
+            f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
         )
-        if worst < math.cos(math.radians(tilt)):
-            errors.append(
-                f"config keys 'scenarios.{name}.pitch_deg'/'roll_deg': initial tilt exceeds "
-                f"vehicle.tilt_max_deg = {tilt} (cos(roll) cos(pitch) must stay >= cos(tilt_max))"
-            )
-    if config["vehicle"]["dry_mass_kg"] >= config["vehicle"]["mass_kg"]:
-        errors.append("config key 'vehicle.dry_mass_kg': expected less than vehicle.mass_kg")
+    for key in RANGE_KEYS:
+        lo, hi = sc[key]
+        if lo > hi:
+            errors.append(f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}")
+    tilt = config["vehicle"]["tilt_max_deg"]
+    roll, pitch = (math.radians(max(map(abs, sc[k]))) for k in ("roll_deg", "pitch_deg"))
+    if math.cos(roll) * math.cos(pitch) < math.cos(math.radians(tilt)):
+        errors.append(
+            f"config keys 'scenarios.{name}.pitch_deg'/'roll_deg': initial tilt exceeds "
+            f"vehicle.tilt_max_deg = {tilt} (cos(roll) cos(pitch) must stay >= cos(tilt_max))"
+        )
+    ocp = config["ocp"]
+    if not ocp["tf_min_s"] <= sc["tf_guess_s"] <= ocp["tf_max_s"]:
+        errors.append(
+            f"config key 'scenarios.{name}.tf_guess_s': expected a value within [ocp.tf_min_s, ocp.tf_max_s] = "
+            f"[{ocp['tf_min_s']}, {ocp['tf_max_s']}], got {sc['tf_guess_s']}"
+        )
+    if sc["altitude_m"][0] <= 0:
+        errors.append(f"config key 'scenarios.{name}.altitude_m': expected a start above the ground (> 0 m), "
+                      f"got {sc['altitude_m']}")  # fmt: skip
     return errors
+
+
+def _elevation_grid_error(terrain: dict) -> list[str]:
+    """The user's DEM, loaded once here so that a bad file stops the run before any job."""
+    if not terrain.get("elevation_grid"):
+        return []
+    from .terrain import load_elevation_grid
+
+    try:
+        load_elevation_grid(terrain["elevation_grid"], terrain.get("grid_spacing_m"))
+    except Exception as exc:  # a malformed file fails in many ways (pickle, TIFF, zip): all name the file
+        path, message = str(terrain["elevation_grid"]), str(exc).removeprefix("terrain.elevation_grid: ")
+        message = message if path in message else f"{path}: {message or type(exc).__name__}"
+        return [f"config key 'terrain.elevation_grid': {message}"]
+    return []
+
+
+def _semantic_errors(config: dict) -> list[str]:
+    """What a schema cannot say: finite numbers, ordered ranges and bounds, initial
+    attitudes within the tilt limit, start times within the time bounds, a usable DEM."""
+    errors = _non_finite(config)
+    if errors:
+        return errors
+    vehicle, ocp, terrain = config["vehicle"], config["ocp"], config["terrain"]
+    if vehicle["dry_mass_kg"] >= vehicle["mass_kg"]:
+        errors.append("config key 'vehicle.dry_mass_kg': expected less than vehicle.mass_kg")
+    if ocp["tf_min_s"] >= ocp["tf_max_s"]:
+        errors.append(f"config key 'ocp.tf_min_s': expected less than ocp.tf_max_s = {ocp['tf_max_s']}, "
+                      f"got {ocp['tf_min_s']}")  # fmt: skip
+    if ocp["refine_n_nodes"] and ocp["refine_n_nodes"] <= ocp["n_nodes"]:
+        errors.append(f"config key 'ocp.refine_n_nodes': expected 0 or more than ocp.n_nodes = {ocp['n_nodes']}, "
+                      f"got {ocp['refine_n_nodes']}")  # fmt: skip
+    if terrain["crater_diameter_min_m"] > terrain["crater_diameter_max_m"]:
+        errors.append("config key 'terrain.crater_diameter_min_m': expected at most terrain.crater_diameter_max_m")
+    if config["events"]["hot_pixel_fraction"] > 0 and not config["events"]["hot_pixel_hz"] > 0:
+        errors.append("config key 'events.hot_pixel_hz': expected > 0 when events.hot_pixel_fraction > 0")
+    for name, sc in config["scenarios"].items():
+        errors += _scenario_errors(config, name, sc)
+    return errors or _elevation_grid_error(terrain)
 
 
 def validate_config(config: Any, schema: dict | None = None) -> None:
