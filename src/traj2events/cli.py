@@ -23,10 +23,12 @@ def _settings_text(value: str) -> str:
 
 def cmd_check_config(args) -> int:
     from .config import load_config
+    from .plan import dataset_plan
 
     config = load_config(*args.config)
     n = sum(sc["n_trajectories"] for sc in config["scenarios"].values())
     print(f"{', '.join(args.config)}: valid ({len(config['scenarios'])} scenarios, {n} trajectories)")
+    print(dataset_plan(config).summary())
     return 0
 
 
@@ -179,7 +181,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"traj2events {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("check-config", help="validate config files (overlays on the defaults) against the schema")
+    p = sub.add_parser(
+        "check-config", help="validate config files (overlays on the defaults) and print the planned size"
+    )
     p.add_argument(
         "config", nargs="+", help="config YAML files, merged in order on the defaults, e.g. config/smoke.yaml"
     )

@@ -172,6 +172,14 @@ def resolve_config(overlay: Any) -> dict:
         raise ConfigError(f"config: expected a mapping of keys to values, got {type(overlay).__name__}")
     config = merge_config(default_config(), overlay)
     validate_config(config)
+    from .plan import dataset_plan, too_large
+
+    reason = too_large(dataset_plan(config))
+    if reason and not config["allow_large_dataset"]:
+        raise ConfigError(
+            f"config: the dataset is planned at {reason}; if you mean it, set 'allow_large_dataset: true' "
+            f"(`traj2events check-config` prints the plan)"
+        )
     return config
 
 

@@ -11,6 +11,7 @@ import pandas as pd
 
 from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
+from traj2events.plan import dataset_plan
 from traj2events.scenarios import ScenarioSettings
 from traj2events.stages.render import RenderSettings
 
@@ -20,6 +21,7 @@ except ConfigError as error:
     raise WorkflowError(f"invalid configuration: {error}")
 config.clear()
 config.update(_resolved)
+print(f"traj2events: {dataset_plan(config).summary()}", file=sys.stderr)
 
 # Rules call the `traj2events` command that sits beside the Python running Snakemake
 # (e.g. .venv/bin), so that `.venv/bin/snakemake` works without activating the venv.

@@ -1,0 +1,104 @@
+"""The planned size of a dataset, before any job runs: frames, disk per output kind and
+CPU time, from the config alone. Solved final times are not known yet, so each
+trajectory is taken to last its scenario's `tf_guess_s`; the per-pixel costs below were
+measured on this project's 2-core VM (docs/benchmarks.md) and are estimates, not bounds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+# Bytes per pixel per frame (per field for the motion field), measured on the default
+# dataset (128 x 128) and bench/frames_store.py (1024 x 1024).
+BYTES_PER_PX = {
+    "frames.h5": 3.0,  # radiance + depth, 16 significant bits, gzip-1
+    "video.mkv": 0.43,  # FFV1 of the 8-bit display frames
+    "preview.mp4": 0.03,
+    "events.h5": 0.35,  # paper preset: ~0.04-0.1 events per pixel per frame, ~3 bytes per event
+    "motion_field.h5": 23.0,  # per field written: sphere and terrain flow, displacement, masks
+    "flow/*.flo": 8.0,  # per field written
+}
+EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # measured on the default dataset
+# Seconds of one core: per frame (a fixed part and a per-pixel part), per motion field.
+RENDER_S = (0.012, 1.9e-7)  # 128^2: 15 ms/frame, 1024^2: 0.17-0.21 s/frame
+EVENTS_S = (0.0005, 2.0e-8)  # the whole events command (decoding, emulation, writing)
+FIELD_S_PER_PX = 1.5e-6  # motion field with the terrain-true field
+# Beyond these, `allow_large_dataset: true` must say the user means it.
+MAX_CORE_HOURS = 10_000.0
+MAX_DISK_TB = 50.0
+
+
+@dataclass(frozen=True)
+class Plan:
+    trajectories: int
+    frames: int  # over all trajectories
+    frames_per_trajectory_max: int
+    fields: int
+    disk_bytes: dict[str, float]  # kept outputs by kind; frames.h5 only if kept
+    frames_h5_live_bytes_max: float  # one trajectory's frames.h5 (temporary or not)
+    core_hours: dict[str, float]
+
+    @property
+    def total_disk_bytes(self) -> float:
+        return sum(self.disk_bytes.values())
+
+    @property
+    def total_core_hours(self) -> float:
+        return sum(self.core_hours.values())
+
+    def summary(self) -> str:
+        disk = ", ".join(f"{k} {_size(v)}" for k, v in self.disk_bytes.items())
+        hours = ", ".join(f"{k} {v:.3g}" for k, v in self.core_hours.items())
+        return (
+            f"planned: {self.trajectories} trajectories, {self.frames:,} frames (at most "
+            f"{self.frames_per_trajectory_max:,} per trajectory), {self.fields:,} motion fields; "
+            f"disk ~{_size(self.total_disk_bytes)} ({disk}); CPU ~{self.total_core_hours:.3g} core-hours ({hours}); "
+            f"each frames.h5 up to {_size(self.frames_h5_live_bytes_max)}. Estimates (t_f = tf_guess_s)."
+        )
+
+
+def _size(n_bytes: float) -> str:
+    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if n_bytes >= scale:
+            return f"{n_bytes / scale:.3g} {unit}"
+    return f"{n_bytes / 1e3:.3g} kB"
+
+
+def dataset_plan(config: dict) -> Plan:
+    """The planned size of the (validated) config's dataset."""
+    camera, every = config["camera"], config["motion_field"]["every_n_frames"]
+    pixels = camera["width"] * camera["height"]
+    per_trajectory = {name: int(sc["tf_guess_s"] * camera["fps"]) + 1 for name, sc in config["scenarios"].items()}
+    trajectories = sum(sc["n_trajectories"] for sc in config["scenarios"].values())
+    frames = sum(n * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
+    fields = sum(
+        -(-(n - 1) // every) * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items()
+    )
+    px_frames, px_fields = float(pixels) * frames, float(pixels) * fields
+    disk = {
+        "video.mkv": BYTES_PER_PX["video.mkv"] * px_frames,
+        "preview.mp4": BYTES_PER_PX["preview.mp4"] * px_frames,
+        "events.h5": BYTES_PER_PX["events.h5"] * px_frames,
+        "motion_field.h5": BYTES_PER_PX["motion_field.h5"] * px_fields,
+        "flow/*.flo": BYTES_PER_PX["flow/*.flo"] * px_fields,
+    }
+    for name in config["events"]["exports"]:
+        disk[f"events {name}"] = EXPORT_BYTES_PER_EVENTS_BYTE[name] * disk["events.h5"]
+    if config["render"]["keep_frames"]:
+        disk["frames.h5"] = BYTES_PER_PX["frames.h5"] * px_frames
+    hours = {
+        "render": frames * (RENDER_S[0] + RENDER_S[1] * pixels) / 3600,
+        "events": frames * (EVENTS_S[0] + EVENTS_S[1] * pixels) / 3600,
+        "motion field": px_fields * FIELD_S_PER_PX / 3600,
+    }
+    return Plan(trajectories, frames, max(per_trajectory.values()), fields, disk,
+                BYTES_PER_PX["frames.h5"] * pixels * max(per_trajectory.values()), hours)  # fmt: skip
+
+
+def too_large(plan: Plan) -> str | None:
+    """Why the plan is beyond one machine (or a modest cluster), or None."""
+    if plan.total_core_hours > MAX_CORE_HOURS:
+        return f"~{plan.total_core_hours:,.0f} core-hours of work (more than {MAX_CORE_HOURS:,.0f})"
+    if plan.total_disk_bytes > MAX_DISK_TB * 1e12:
+        return f"~{_size(plan.total_disk_bytes)} of outputs (more than {MAX_DISK_TB:g} TB)"
+    return None

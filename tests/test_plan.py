@@ -1,0 +1,43 @@
+"""The planned size printed before a run, and the refusal of a dataset beyond reach."""
+
+import pytest
+
+from conftest import ROOT
+from traj2events.config import ConfigError, load_config, resolve_config
+from traj2events.plan import BYTES_PER_PX, dataset_plan
+
+ONE = {"scenarios": {"descent": {"n_trajectories": 3, "tf_guess_s": 10.0}}}
+
+
+def test_frames_and_fields_follow_the_final_time_and_rates():
+    config = resolve_config({**ONE, "camera": {"fps": 10.0, "width": 64, "height": 32},
+                             "motion_field": {"every_n_frames": 7}})  # fmt: skip
+    plan = dataset_plan(config)
+    assert plan.trajectories == 3 and plan.frames == 3 * 101 and plan.frames_per_trajectory_max == 101
+    assert plan.fields == 3 * 15  # frames 0, 7, ..., 98 (each needs its next frame)
+    assert plan.disk_bytes["video.mkv"] == pytest.approx(BYTES_PER_PX["video.mkv"] * 64 * 32 * 303)
+
+
+def test_kept_frames_count_and_temporary_ones_do_not():
+    kept = dataset_plan(resolve_config({**ONE, "render": {"keep_frames": True}}))
+    temporary = dataset_plan(resolve_config({**ONE, "render": {"keep_frames": False}}))
+    assert "frames.h5" in kept.disk_bytes and "frames.h5" not in temporary.disk_bytes
+    assert kept.frames_h5_live_bytes_max == temporary.frames_h5_live_bytes_max > 0
+
+
+def test_default_dataset_plan_is_near_what_it_measured():
+    # Measured 2026-11-23 (docs/benchmarks.md): 18 671 frames, 2.0 GB, ~5 min of rendering on one core.
+    plan = dataset_plan(load_config(ROOT / "config" / "config.yaml"))
+    assert 0.9 < plan.frames / 18_671 < 1.25
+    assert 0.8 < plan.total_disk_bytes / 2.0e9 < 1.3
+    assert 0.5 < plan.core_hours["render"] * 60 / 4.7 < 2.0
+
+
+def test_the_paper_config_is_allowed_and_a_far_larger_one_is_refused():
+    paper = load_config(ROOT / "config" / "paper.yaml")
+    assert 100 < dataset_plan(paper).total_core_hours < 1000
+    huge = {"camera": {"width": 8192, "height": 8192, "fps": 100.0},
+            "scenarios": {name: {"n_trajectories": 167} for name in ("braking", "approach", "descent")}}  # fmt: skip
+    with pytest.raises(ConfigError, match="allow_large_dataset: true"):
+        resolve_config(huge)
+    assert resolve_config({**huge, "allow_large_dataset": True})["allow_large_dataset"] is True
