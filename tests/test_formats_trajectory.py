@@ -132,3 +132,17 @@ def test_reading_outputs_needs_only_numpy_and_h5py(tmp_path, solved30, vehicle):
     )
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert run.stdout.strip() == "[]"
+
+
+def test_a_new_write_removes_what_a_killed_one_left(tmp_path):
+    target = tmp_path / "events.npz"
+    (tmp_path / ".events.npz.abc123.part").write_bytes(b"killed")
+    (tmp_path / ".events.npz.def456.part.raw").write_bytes(b"killed")
+    (tmp_path / ".flow.xyz.part").mkdir()
+    (tmp_path / ".flow.xyz.part" / "000000.flo").write_bytes(b"half")
+    (tmp_path / ".other.npz.abc.part").write_bytes(b"another output's")
+    with atomic_output(target) as tmp:
+        tmp.write_bytes(b"done")
+    with atomic_directory(tmp_path / "flow") as tmp:
+        (tmp / "000000.flo").write_bytes(b"done")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".other.npz.abc.part", "events.npz", "flow"]

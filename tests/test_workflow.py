@@ -2,8 +2,10 @@
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import h5py
@@ -122,29 +124,69 @@ def test_second_run_has_nothing_to_do(built):
     assert "Nothing to be done" in run.stdout + run.stderr
 
 
+WALL_CLOCK = {"solve_time_s", "total_solve_time_s"}  # the only values that differ between identical runs
+
+
+def same_h5(a, b, path=""):
+    """Datasets and attributes equal bit for bit (NaN included), wall-clock attributes aside."""
+    names = set(a.attrs) - WALL_CLOCK
+    assert names == set(b.attrs) - WALL_CLOCK, path
+    for k in names:
+        va, vb = np.asarray(a.attrs[k]), np.asarray(b.attrs[k])
+        same = list(va.ravel()) == list(vb.ravel()) if va.dtype == object else va.tobytes() == vb.tobytes()
+        assert same, f"{path}@{k}"
+    if isinstance(a, h5py.Group):
+        assert set(a) == set(b), path
+        for k in a:
+            same_h5(a[k], b[k], f"{path}/{k}")
+    else:
+        assert a[()].tobytes() == b[()].tobytes(), path
+
+
+def assert_same_dataset(a, b):
+    """Every file under results/ (logs aside) the same: bytes, or for the solver's files
+    everything but the wall-clock solve times."""
+    files = sorted(p.relative_to(a) for p in (a / "results").rglob("*") if p.is_file() and "logs" not in p.parts)
+    assert files == sorted(
+        p.relative_to(b) for p in (b / "results").rglob("*") if p.is_file() and "logs" not in p.parts
+    )
+    for rel in files:
+        if rel.name in ("base.h5", "solutions.h5", "trajectory.h5"):
+            with h5py.File(a / rel) as fa, h5py.File(b / rel) as fb:
+                same_h5(fa, fb, str(rel))
+        elif rel.name == "samples.csv":
+            ta, tb = (pd.read_csv(d / rel).drop(columns="solve_time_s") for d in (a, b))
+            pd.testing.assert_frame_equal(ta, tb)
+        else:
+            assert (a / rel).read_bytes() == (b / rel).read_bytes(), rel
+
+
 def test_same_config_same_bytes(built, tmp_path):
     shutil.copy(built / "config.yaml", tmp_path / "config.yaml")
     snakemake(tmp_path)
-    for rel in ("results/descent/0001/trajectory.h5", "results/hover/0000/trajectory.h5"):
-        with h5py.File(built / rel) as a, h5py.File(tmp_path / rel) as b:
-            for key in ("nodes/t", "nodes/state", "nodes/control", "poses/t", "poses/state", "poses/control"):
-                assert a[key][()].tobytes() == b[key][()].tobytes(), key
-            # Everything but the wall-clock solve time is identical.
-            assert {k for k in a.attrs if k != "solve_time_s"} == {k for k in b.attrs if k != "solve_time_s"}
-            for k in a.attrs:
-                if k != "solve_time_s":
-                    va, vb = np.asarray(a.attrs[k]), np.asarray(b.attrs[k])
-                    assert va.tobytes() == vb.tobytes(), k  # bitwise, NaN included
-    for rel in (
-        "results/figures/trajectories.png",
-        "results/descent/0001/video.mkv",
-        "results/descent/0001/preview.mp4",
-        "results/descent/0001/frames.png",
-        "results/descent/0001/motion_field.h5",
-        "results/descent/0001/events.h5",
-        "results/descent/0001/events.raw",
-    ):
-        assert (built / rel).read_bytes() == (tmp_path / rel).read_bytes(), rel
+    assert_same_dataset(built, tmp_path)
+
+
+def test_a_run_killed_mid_render_recovers_as_the_readme_says(built, tmp_path):
+    shutil.copy(built / "config.yaml", tmp_path / "config.yaml")
+    cmd = [str(SNAKEMAKE), "-s", str(ROOT / "Snakefile"), "--directory", str(tmp_path), "--cores", "2",
+           "--configfile", str(tmp_path / "config.yaml")]  # fmt: skip
+    run = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                           start_new_session=True)  # fmt: skip
+    deadline = time.monotonic() + 300
+    while run.poll() is None and time.monotonic() < deadline:
+        if list((tmp_path / "results").glob("*/*/.frames.h5.*.part")):  # a render job is writing
+            break
+        time.sleep(0.02)
+    os.killpg(run.pid, signal.SIGKILL)  # Snakemake and its jobs, as a killed session would
+    run.wait()
+    assert list((tmp_path / "results").rglob(".*.part*")), "killed before any render started writing"
+    locked = snakemake(tmp_path, check=False)
+    assert locked.returncode != 0 and "unlock" in locked.stdout + locked.stderr  # the README's first step
+    snakemake(tmp_path, "--unlock")
+    snakemake(tmp_path)
+    assert not [p for p in (tmp_path / "results").rglob("*") if ".part" in p.name]  # no debris
+    assert_same_dataset(built, tmp_path)
 
 
 def test_editing_one_scenario_reruns_only_its_jobs(built, tmp_path):

@@ -1,10 +1,13 @@
 """Atomic writes: every output goes to a hidden temporary name in its target folder and
 is renamed into place only when complete, so an interrupted or failed job never leaves a
-half-written file (or folder) where the workflow expects a finished one."""
+half-written file (or folder) where the workflow expects a finished one. A killed job
+(SIGKILL) cannot clean up after itself: the next write of the same output removes what
+it left."""
 
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import shutil
 import tempfile
@@ -19,12 +22,23 @@ def _usual_mode(path: str, directory: bool) -> None:
     os.chmod(path, (0o777 if directory else 0o666) & ~umask)
 
 
+def remove_stale_temporaries(path: Path) -> None:
+    """Remove what an earlier, killed write of `path` left: `.{name}.*.part*` beside it."""
+    for stale in path.parent.glob(f".{glob.escape(path.name)}.*.part*"):
+        if stale.is_dir() and not stale.is_symlink():
+            shutil.rmtree(stale, ignore_errors=True)
+        else:
+            with contextlib.suppress(FileNotFoundError):
+                stale.unlink()
+
+
 @contextlib.contextmanager
 def atomic_output(path: str | os.PathLike, suffix: str = ".part") -> Iterator[Path]:
     """Yield a temporary path beside `path`; rename it to `path` if the block succeeds.
     `suffix` ends the temporary name (for writers that pick the format from it)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
     os.close(fd)
     _usual_mode(tmp, directory=False)
@@ -42,6 +56,7 @@ def atomic_directory(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary folder beside `path`; it replaces `path` if the block succeeds."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    remove_stale_temporaries(path)
     tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent))
     _usual_mode(str(tmp), directory=True)
     try:
