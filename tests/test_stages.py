@@ -154,3 +154,14 @@ def test_centred_windows_stay_inside_the_recording():
     assert pictures.centred_window(500_000, 10_000, 1_000_000) == (495_000, 505_000)
     assert pictures.centred_window(1_000_000, 10_000, 1_000_000) == (990_000, 1_000_000)
     assert pictures.centred_window(3_000, 10_000, 4_000) == (0, 10_000)  # a recording shorter than the window
+
+
+def test_a_scenario_without_a_solved_sample_is_an_error_not_an_empty_index(tmp_path):
+    from traj2events.stages.index import NoSolvedSampleError
+
+    samples = tmp_path / "samples.csv"
+    pd.DataFrame({"id": [0, 1, 2], "success": [False] * 3,
+                  "reason": ["infeasible", "infeasible", "iteration limit"]}).to_csv(samples, index=False)  # fmt: skip
+    with pytest.raises(NoSolvedSampleError, match=r"none of the 3 samples solved \(infeasible \(2\), iteration limit"):
+        dataset_index([], tmp_path / "index.csv", samples)
+    assert not (tmp_path / "index.csv").exists()

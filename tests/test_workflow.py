@@ -292,6 +292,22 @@ def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_
     }
 
 
+def test_a_failing_scenario_does_not_stop_the_others(tmp_path):
+    config = two_scenario_smoke()
+    # 90 km up: the base problem solves, but no sample meets the accuracy (measured: 8.8 m off).
+    config["scenarios"]["hover"].update(altitude_m=[90000.0, 90000.0], n_trajectories=1)
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    run = snakemake(tmp_path, check=False)
+    assert run.returncode != 0  # the run ends non-zero, naming what failed and why
+    out = run.stdout + run.stderr
+    assert "Error in rule dataset_index" in out and "scenario=hover" in out and "none of the 1 samples solved" in out
+    assert not (tmp_path / "results" / "hover" / "index.csv").exists()  # not an empty file
+    summary = pd.read_csv(tmp_path / "results" / "summary.csv").set_index("scenario")
+    assert summary.loc["hover", "failed"] == 1 and summary.loc["descent", "failed"] == 0
+    index = pd.read_csv(tmp_path / "results" / "descent" / "index.csv")  # the healthy scenario is complete
+    assert list(index["id"]) == [0, 1] and (tmp_path / "results" / "descent" / "0001" / "events.png").exists()
+
+
 def test_invalid_config_stops_before_any_job(tmp_path):
     config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
     config["ocp"]["n_nodes"] = 2

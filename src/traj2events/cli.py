@@ -144,7 +144,7 @@ def cmd_picture(args) -> int:
 def cmd_index(args) -> int:
     from .stages.index import dataset_index
 
-    dataset_index(args.trajectories, args.output)
+    dataset_index(args.trajectories, args.output, args.samples)
     return 0
 
 
@@ -328,6 +328,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("index", help="one CSV row per trajectory file of a scenario (the dataset index)")
     p.add_argument("trajectories", nargs="*", help="trajectory.h5 files (other files are ignored)")
     p.add_argument("--output", "-o", required=True, help="index.csv")
+    p.add_argument("--samples", help="the scenario's samples.csv: a scenario with no solved sample is then an error")
     p.set_defaults(func=cmd_index)
 
     p = sub.add_parser("summary", help="one CSV row per scenario: counts, failures, final mass, t_f, errors")

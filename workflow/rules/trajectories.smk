@@ -56,7 +56,8 @@ rule camera_poses:
 
 rule dataset_index:
     input:
-        scenario_outputs,
+        trajectories=scenario_outputs,
+        samples="results/{scenario}/samples.csv",
     output:
         "results/{scenario}/index.csv",
     log:
@@ -66,7 +67,7 @@ rule dataset_index:
     params:
         code=code("index"),
     shell:
-        "traj2events index {input} --output {output} 2> {log}"
+        "traj2events index {input.trajectories} --samples {input.samples} --output {output} 2> {log}"
 
 
 rule trajectory_summary:

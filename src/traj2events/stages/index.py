@@ -30,9 +30,29 @@ def index_row(path: str | os.PathLike) -> dict:
     }
 
 
-def dataset_index(paths: list[str | os.PathLike], output: str | os.PathLike) -> pd.DataFrame:
-    """index.csv from the trajectory.h5 files among `paths` (other files are ignored)."""
+class NoSolvedSampleError(ValueError):
+    """A scenario none of whose samples solved: its index would be empty."""
+
+
+def failure_summary(samples: pd.DataFrame) -> str:
+    """The reasons samples failed, most frequent first: 'reason (count), ...'."""
+    reasons = samples.loc[~samples["success"], "reason"].fillna("unknown").value_counts()
+    return ", ".join(f"{reason} ({count})" for reason, count in reasons.items())
+
+
+def dataset_index(
+    paths: list[str | os.PathLike], output: str | os.PathLike, samples: str | os.PathLike | None = None
+) -> pd.DataFrame:
+    """index.csv from the trajectory.h5 files among `paths` (other files are ignored).
+    Given the scenario's samples.csv, a scenario with no solved sample is an error that
+    says why its samples failed (not an empty index)."""
     rows = [index_row(p) for p in paths if Path(p).name == "trajectory.h5"]
+    if not rows and samples is not None:
+        table = pd.read_csv(samples)
+        raise NoSolvedSampleError(
+            f"{samples}: none of the {len(table)} samples solved ({failure_summary(table)}); "
+            f"the scenario has no trajectory. Check its ranges and the vehicle in the config."
+        )
     table = pd.DataFrame(rows)
     with atomic_output(output) as tmp:
         table.to_csv(tmp, index=False, float_format="%.9g")
