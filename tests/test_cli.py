@@ -1,8 +1,14 @@
-"""The command line: argument handling only (the stages are tested in test_stages.py)."""
+"""The command line: argument handling, and a corpus of bad inputs each refused with one
+line naming the file or option (the stages themselves are tested in test_stages.py)."""
 
+import h5py
+import numpy as np
 import pytest
 
 from traj2events.cli import build_parser, main
+from traj2events.formats.frames import FramesWriter
+from traj2events.formats.trajectory import vehicle_attrs, write_trajectory
+from traj2events.vehicle import Vehicle
 
 SUBCOMMANDS = ["check-config", "base", "sample", "upsample", "render", "motion-field", "events", "picture", "index",
                "summary"]  # fmt: skip
@@ -49,3 +55,108 @@ def test_events_chunk_must_be_positive(tmp_path, capsys):
 def test_picture_needs_a_kind():
     with pytest.raises(SystemExit):
         build_parser().parse_args(["picture"])
+
+
+# -- a corpus of bad inputs: each is refused with one line naming the file or option ------
+
+
+def trajectory_file(path, drop_attr=None, nan=False, columns=13):
+    t = np.linspace(0.0, 1.0, 11)
+    state = np.zeros((11, columns))
+    state[:, 2] = -100.0 + 50 * t  # descending, 100 m up
+    state[:, -1] = 9000.0
+    if nan:
+        state[5, 0] = np.nan
+    attrs = {**vehicle_attrs(Vehicle()), "fps": 10.0, "scenario": "s", "id": 0}
+    attrs.pop(drop_attr, None)
+    write_trajectory(path, (t, state, np.zeros((11, 4))), (t, state, np.zeros((11, 4))), attrs)
+    return path
+
+
+@pytest.fixture()
+def bad_inputs(tmp_path):
+    files = {
+        "missing": tmp_path / "missing.h5",
+        "text": tmp_path / "text.h5",
+        "truncated": tmp_path / "truncated.h5",
+        "empty_h5": tmp_path / "empty.h5",
+        "no_fps": trajectory_file(tmp_path / "no_fps.h5", drop_attr="fps"),
+        "nan_pose": trajectory_file(tmp_path / "nan_pose.h5", nan=True),
+        "wrong_shape": trajectory_file(tmp_path / "wrong_shape.h5", columns=7),
+    }
+    files["text"].write_text("not an HDF5 file\n")
+    good = trajectory_file(tmp_path / "good.h5")
+    files["truncated"].write_bytes(good.read_bytes()[:900])
+    with h5py.File(files["empty_h5"], "w") as f:
+        f["something"] = np.zeros(3)
+    return files
+
+
+def motion_field_args(trajectory, out):
+    return ["motion-field", str(trajectory), "-o", str(out / "m.h5"), "--flo-dir", str(out / "flow"), "--width", "8",
+            "--height", "8"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "case, fragment",
+    [
+        ("missing", "no such file"),
+        ("text", "not a readable HDF5 file"),
+        ("truncated", "not a readable HDF5 file"),
+        ("empty_h5", "nodes"),
+        ("no_fps", "missing attribute 'fps'"),
+        ("nan_pose", "NaN or infinite"),
+        ("wrong_shape", "expected (11, 13)"),
+    ],
+)
+def test_bad_trajectory_files_are_refused_naming_the_file(bad_inputs, case, fragment, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(motion_field_args(bad_inputs[case], out)) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and str(bad_inputs[case]) in err and fragment in err, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert not out.exists() or not [p for p in out.rglob("*") if p.is_file()]
+
+
+def test_bad_frames_file_for_the_motion_field_is_named(bad_inputs, tmp_path, capsys):
+    good = trajectory_file(tmp_path / "good2.h5")
+    frames = tmp_path / "frames.h5"
+    with FramesWriter(frames, np.arange(5) / 10.0, np.arange(5), 8, 8, {}) as w:
+        for k in range(5):
+            w.write(k, np.ones((8, 8)), np.ones((8, 8)))
+    out = tmp_path / "out"
+    assert main([*motion_field_args(good, out), "--frames", str(frames)]) == 2
+    err = capsys.readouterr().err
+    assert str(frames) in err and "shape" in err and not (out / "m.h5").exists()
+    assert main([*motion_field_args(good, out), "--frames", str(bad_inputs["text"])]) == 2
+    assert str(bad_inputs["text"]) in capsys.readouterr().err
+
+
+def test_bad_settings_and_options_are_named(tmp_path, capsys):
+    good = trajectory_file(tmp_path / "good.h5")
+    out = [str(tmp_path / n) for n in ("f.h5", "v.mkv", "p.mp4")]
+    assert main(["render", str(good), "--settings", '{"width": 8}', "--frames", out[0], "--video", out[1],
+                 "--preview", out[2]]) == 2  # fmt: skip
+    assert "--settings" in capsys.readouterr().err and not list(tmp_path.glob("*.mkv"))
+    assert main(["motion-field", str(good), "-o", str(tmp_path / "m.h5"), "--flo-dir", str(tmp_path / "f"),
+                 "--moon-radius-m", "-1"]) == 2  # fmt: skip
+    assert "moon_radius_m" in capsys.readouterr().err
+    for option, value in (("--window-ms", "0"), ("--white", "-3"), ("--fps", "0"), ("--seed", "-1")):
+        assert main(["events", str(good), "-o", str(tmp_path / "e.h5"), option, value]) == 2
+        assert option in capsys.readouterr().err and not (tmp_path / "e.h5").exists()
+
+
+def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):
+    from traj2events.video import VideoWriter
+
+    rng = np.random.default_rng(0)
+    with VideoWriter(tmp_path / "v.mkv", 32, 24, 50.0) as video:
+        for _ in range(60):
+            video.write(rng.integers(0, 255, (24, 32), dtype=np.uint8))
+    data = (tmp_path / "v.mkv").read_bytes()
+    (tmp_path / "cut.mkv").write_bytes(data[: len(data) // 2])
+    assert main(["events", str(tmp_path / "cut.mkv"), "-o", str(tmp_path / "e.h5"), "--chunk", "8"]) == 2
+    err = capsys.readouterr().err
+    assert "cut.mkv" in err and "truncated" in err and not (tmp_path / "e.h5").exists()
+    assert not list(tmp_path.glob(".e.h5*"))
+    assert main(["events", str(tmp_path / "v.mkv"), "-o", str(tmp_path / "e.h5")]) == 0  # the whole one is fine

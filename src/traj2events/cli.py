@@ -16,9 +16,13 @@ from . import __version__
 from .defaults import section
 
 
-def _settings_text(value: str) -> str:
-    """--settings: JSON inline, or @file."""
-    return Path(value[1:]).read_text() if value.startswith("@") else value
+def _settings(kind, value: str):
+    """--settings (JSON inline, or @file) as a `kind` settings object."""
+    text = Path(value[1:]).read_text() if value.startswith("@") else value
+    try:
+        return kind.from_json(text)
+    except (ValueError, TypeError, KeyError, AttributeError) as exc:
+        raise ValueError(f"--settings: expected the JSON of {kind.__name__} (the workflow writes it): {exc}") from None
 
 
 def cmd_check_config(args) -> int:
@@ -36,7 +40,7 @@ def cmd_base(args) -> int:
     from .scenarios import ScenarioSettings
     from .stages.base_solution import base_solution
 
-    base_solution(ScenarioSettings.from_json(_settings_text(args.settings)), args.output)
+    base_solution(_settings(ScenarioSettings, args.settings), args.output)
     return 0
 
 
@@ -46,9 +50,7 @@ def cmd_sample(args) -> int:
 
     if args.jobs < 1:
         raise ValueError(f"sample: --jobs: expected >= 1, got {args.jobs}")
-    sample_trajectories(
-        ScenarioSettings.from_json(_settings_text(args.settings)), args.base, args.output, args.table, args.jobs
-    )
+    sample_trajectories(_settings(ScenarioSettings, args.settings), args.base, args.output, args.table, args.jobs)
     return 0
 
 
@@ -64,9 +66,7 @@ def cmd_upsample(args) -> int:
 def cmd_render(args) -> int:
     from .stages.render import RenderSettings, render_trajectory
 
-    render_trajectory(
-        args.trajectory, RenderSettings.from_json(_settings_text(args.settings)), args.frames, args.video, args.preview
-    )
+    render_trajectory(args.trajectory, _settings(RenderSettings, args.settings), args.frames, args.video, args.preview)
     return 0
 
 
@@ -86,8 +86,18 @@ def cmd_motion_field(args) -> int:
     return 0
 
 
+def _positive(option: str, value: float | None) -> None:
+    if value is not None and not value > 0:
+        raise ValueError(f"{option}: expected a value > 0, got {value}")
+
+
 def cmd_events(args) -> int:
     from .stages.events import emulate, emulator_params, export_events, frame_source
+
+    for option, value in (("--fps", args.fps), ("--white", args.white), ("--window-ms", args.window_ms)):
+        _positive(option, value)
+    if args.seed < 0:
+        raise ValueError(f"--seed: expected a value >= 0, got {args.seed}")
 
     params = emulator_params(
         args.preset,
@@ -135,6 +145,7 @@ def cmd_picture(args) -> int:
             args.trajectory, Camera(args.width, args.height, args.fov_deg), args.moon_radius_m, args.output, args.video
         )
     elif args.kind == "events":
+        _positive("--window-ms", args.window_ms)
         pictures.trajectory_events_picture(args.events, args.trajectory, args.window_ms, args.output)
     else:
         pictures.dataset_picture(args.solutions, args.output)

@@ -93,7 +93,8 @@ def read_video(path: str | os.PathLike, frames: list[int] | None = None) -> np.n
 
 
 def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
-    """(width, height, frames per second, frame count if the container says) of a video."""
+    """(width, height, frames per second, frame count) of a video; the count is the
+    container's, else its duration times the frame rate, else None."""
     import ffmpeg
 
     try:
@@ -108,15 +109,19 @@ def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
     num, den = (int(v) for v in stream.get("avg_frame_rate", "0/1").split("/"))
     fps = num / den if den else 0.0
     count = int(stream["nb_frames"]) if str(stream.get("nb_frames", "")).isdigit() else None
+    duration = stream.get("duration") or probe.get("format", {}).get("duration")
+    if count is None and duration and fps > 0:
+        count = int(round(float(duration) * fps))
     return int(stream["width"]), int(stream["height"]), fps, count
 
 
 def iter_video(path: str | os.PathLike, chunk: int = 64):
     """Decode a video to 8-bit grey, yielding (k, H, W) uint8 chunks: memory bounded by
-    `chunk` frames, whatever the video's length."""
+    `chunk` frames, whatever the video's length. A video that decodes to fewer frames
+    than its container announces (truncated, corrupt) raises ValueError at its end."""
     import ffmpeg
 
-    width, height, _, _ = video_info(path)
+    width, height, _, expected = video_info(path)
     process = (
         ffmpeg.input(str(path))
         .output("pipe:", format="rawvideo", pix_fmt="gray")
@@ -124,13 +129,20 @@ def iter_video(path: str | os.PathLike, chunk: int = 64):
         .run_async(pipe_stdout=True)
     )
     size = width * height
+    decoded = 0
     try:
         while True:
             data = process.stdout.read(size * chunk)
             if not data:
                 break
             n = len(data) // size
+            decoded += n
             yield np.frombuffer(data[: n * size], np.uint8).reshape(n, height, width)
     finally:
         process.stdout.close()
-        process.wait()
+        code = process.wait()
+    # One frame of slack: a duration rounds to the nearest frame.
+    if code != 0 or (expected is not None and decoded < expected - 1):
+        raise ValueError(
+            f"{path}: truncated or corrupt video: decoded {decoded} of {expected} frames (ffmpeg exit {code})"
+        )

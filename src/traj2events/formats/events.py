@@ -5,11 +5,10 @@ from __future__ import annotations
 
 import os
 
-import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import create, set_attrs
+from .hdf5 import Attributes, create, open_file, set_attrs
 
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
 
@@ -83,24 +82,24 @@ class EventsWriter:
 def read_events(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
     """events.h5 -> (structured array x, y, t (absolute us), p; attributes)."""
     _blosc_zstd()
-    with h5py.File(path, "r") as f:
+    with open_file(path, "events.h5 (DSEC layout)") as f:
         g = f["events"]
         out = np.empty(len(g["t"]), EVENT_DTYPE)
         out["x"], out["y"], out["p"] = g["x"][()], g["y"][()], g["p"][()]
         out["t"] = g["t"][()] + int(f["t_offset"][()])
-        return out, dict(f.attrs)
+        return out, Attributes(path, f.attrs)
 
 
 def read_events_attrs(path: str | os.PathLike) -> dict:
     """events.h5's attributes (width, height, the emulator's parameters), no events."""
-    with h5py.File(path, "r") as f:
-        return dict(f.attrs)
+    with open_file(path, "events.h5 (DSEC layout)") as f:
+        return Attributes(path, f.attrs)
 
 
 def read_events_window(path: str | os.PathLike, t_start_us: int, t_end_us: int) -> np.ndarray:
     """Events with t in [t_start, t_end) (absolute us), read through ms_to_idx: only that slice."""
     _blosc_zstd()
-    with h5py.File(path, "r") as f:
+    with open_file(path, "events.h5 (DSEC layout)") as f:
         offset = int(f["t_offset"][()])
         ms_to_idx = f["ms_to_idx"]
         n_ms = len(ms_to_idx)

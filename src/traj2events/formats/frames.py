@@ -14,7 +14,7 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import create, set_attrs, write_dataset
+from .hdf5 import Attributes, FileFormatError, create, set_attrs, write_dataset
 
 
 def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
@@ -73,13 +73,21 @@ class FramesFile:
 
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
-        self._file = h5py.File(self.path, "r")
+        if not self.path.is_file():
+            raise FileNotFoundError(f"{self.path}: no such file (expected frames.h5)")
+        try:
+            self._file = h5py.File(self.path, "r")
+        except OSError as exc:
+            raise FileFormatError(f"{self.path}: not a readable HDF5 file (expected frames.h5): {exc}") from None
         if "radiance" not in self._file or "t" not in self._file:
             self._file.close()
-            raise ValueError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' and 't')")
+            raise FileFormatError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' and 't')")
         self.t = self._file["t"][()]
-        self.attrs = dict(self._file.attrs)
+        self.attrs = Attributes(self.path, self._file.attrs)
         self.shape = self._file["radiance"].shape
+        if len(self.shape) != 3 or len(self.t) != self.shape[0]:
+            self._file.close()
+            raise FileFormatError(f"{self.path}: radiance has shape {self.shape}, expected ({len(self.t)}, H, W)")
 
     def radiance(self, k: int) -> np.ndarray:
         return self._file["radiance"][k]

@@ -3,8 +3,11 @@ in insertion order; the same content gives the same bytes."""
 
 from __future__ import annotations
 
+import contextlib
 import json
+import os
 from pathlib import Path
+from typing import Iterator
 
 import h5py
 import numpy as np
@@ -33,3 +36,36 @@ def set_attrs(obj: h5py.HLObject, attrs: dict) -> None:
 def plain(value):
     """An attribute as a plain Python value (numpy scalars unwrapped)."""
     return value.item() if isinstance(value, np.generic) else value
+
+
+class FileFormatError(ValueError):
+    """An input file that is not what a stage expects; the message names the file."""
+
+
+class Attributes(dict):
+    """A file's attributes: a missing one is a FileFormatError naming the file."""
+
+    def __init__(self, path: str | os.PathLike, items):
+        super().__init__(items)
+        self.path = path
+
+    def __missing__(self, key):
+        raise FileFormatError(f"{self.path}: missing attribute '{key}'")
+
+
+@contextlib.contextmanager
+def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
+    """An HDF5 file for reading; a missing, unreadable or truncated file, or a missing
+    dataset, group or attribute, is an error that names the file and what was expected."""
+    if not Path(path).is_file():
+        raise FileNotFoundError(f"{path}: no such file (expected {expected})")
+    try:
+        f = h5py.File(path, "r")
+    except OSError as exc:
+        raise FileFormatError(f"{path}: not a readable HDF5 file (expected {expected}): {exc}") from None
+    try:
+        yield f
+    except KeyError as exc:
+        raise FileFormatError(f"{path}: {exc.args[0] if exc.args else exc} (expected {expected})") from None
+    finally:
+        f.close()

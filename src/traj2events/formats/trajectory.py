@@ -16,7 +16,7 @@ import numpy as np
 
 from ..state import CONTROL_NAMES, STATE_NAMES
 from .atomic import atomic_output
-from .hdf5 import create, plain, set_attrs, write_dataset
+from .hdf5 import Attributes, FileFormatError, create, open_file, plain, set_attrs, write_dataset
 
 VEHICLE_KEYS = ("mass_kg", "dry_mass_kg", "thrust_main_N", "thrust_rcs_N", "lever_arm_m", "inertia_kgm2", "isp_s",
                 "g_m_s2", "g0_m_s2", "tilt_max_deg")  # fmt: skip
@@ -87,15 +87,21 @@ class Trajectory:
 
 
 def read_trajectory(path: str | os.PathLike) -> Trajectory:
-    with h5py.File(path, "r") as f:
+    with open_file(path, "a trajectory file (nodes and poses)") as f:
         poses = [f[f"poses/{k}"][()] for k in ("t", "state", "control")] if "poses" in f else [None] * 3
-        return Trajectory(
-            f["nodes/t"][()],
-            f["nodes/state"][()],
-            f["nodes/control"][()],
-            *poses,
-            attrs=dict(f.attrs),
+        tr = Trajectory(
+            f["nodes/t"][()], f["nodes/state"][()], f["nodes/control"][()], *poses, Attributes(path, f.attrs)
         )
+    for group, t, state in (("nodes", tr.t_nodes, tr.state_nodes), ("poses", tr.t, tr.state)):
+        if t is None:
+            continue
+        if state.ndim != 2 or state.shape != (len(t), len(STATE_NAMES)):
+            raise FileFormatError(
+                f"{path}: {group}/state has shape {state.shape}, expected ({len(t)}, {len(STATE_NAMES)})"
+            )
+        if not (np.isfinite(t).all() and np.isfinite(state).all()):
+            raise FileFormatError(f"{path}: {group} holds NaN or infinite times or states")
+    return tr
 
 
 def write_solution_set(path: str | os.PathLike, samples: dict[int, tuple[tuple, dict]], attrs: dict) -> None:
@@ -112,7 +118,7 @@ def write_solution_set(path: str | os.PathLike, samples: dict[int, tuple[tuple, 
 
 def read_solution_set(path: str | os.PathLike) -> dict:
     """{"attrs": root attributes, "samples": {id: {"t", "state", "control", **attrs}}}."""
-    with h5py.File(path, "r") as f:
+    with open_file(path, "solutions.h5 from `traj2events sample`") as f:
         samples = {}
         for name, g in f["samples"].items():
             samples[int(name)] = {
@@ -121,4 +127,4 @@ def read_solution_set(path: str | os.PathLike) -> dict:
                 "control": g["control"][()],
                 **{k: plain(v) for k, v in g.attrs.items()},
             }
-        return {"attrs": dict(f.attrs), "samples": samples}
+        return {"attrs": Attributes(path, f.attrs), "samples": samples}

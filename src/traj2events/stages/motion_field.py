@@ -50,6 +50,8 @@ def motion_field(
     """Write motion_field.h5 and one .flo per field (the sphere displacement) into flo_dir."""
     if every_n_frames < 1:
         raise ValueError(f"motion field: every_n_frames: expected >= 1, got {every_n_frames}")
+    if not moon_radius_m > 0:
+        raise ValueError(f"motion field: moon_radius_m: expected > 0, got {moon_radius_m}")
     tr = read_trajectory(trajectory)
     if tr.t is None or len(tr.t) < 2:
         raise ValueError(f"{trajectory}: expected poses/t with at least 2 poses")
@@ -63,6 +65,18 @@ def motion_field(
         picked = np.arange(0, len(tr.t) - 1, every_n_frames)  # each needs its next frame
         n, h, w = len(picked), camera.height, camera.width
         fields = _empty_fields(n, h, w, rendered is not None)
+        attrs = {
+            "width": w,
+            "height": h,
+            "fov_deg": camera.fov_deg,
+            "focal_px": camera.focal_px,
+            "moon_radius_m": moon_radius_m,
+            "fps": float(tr.attrs["fps"]),
+            "every_n_frames": every_n_frames,
+            "scenario": tr.attrs["scenario"],
+            "id": int(tr.attrs["id"]),
+            "traj2events_version": __version__,
+        }
         log(
             f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"
             + (f", terrain-true from {frames}" if rendered is not None else "")
@@ -87,18 +101,6 @@ def motion_field(
                         fields["sphere_minus_terrain_rms_px_s"][i] = np.sqrt(np.mean(np.sum(diff**2, axis=1)))
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
-            attrs = {
-                "width": w,
-                "height": h,
-                "fov_deg": camera.fov_deg,
-                "focal_px": camera.focal_px,
-                "moon_radius_m": moon_radius_m,
-                "fps": float(tr.attrs["fps"]),
-                "every_n_frames": every_n_frames,
-                "scenario": tr.attrs["scenario"],
-                "id": int(tr.attrs["id"]),
-                "traj2events_version": __version__,
-            }
             if rendered is not None:
                 rms = fields["sphere_minus_terrain_rms_px_s"]
                 median = float(np.nanmedian(rms)) if np.isfinite(rms).any() else np.nan
