@@ -160,3 +160,39 @@ def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):
     assert "cut.mkv" in err and "truncated" in err and not (tmp_path / "e.h5").exists()
     assert not list(tmp_path.glob(".e.h5*"))
     assert main(["events", str(tmp_path / "v.mkv"), "-o", str(tmp_path / "e.h5")]) == 0  # the whole one is fine
+
+
+@pytest.fixture()
+def small_disk(tmp_path):
+    """A tmpfs nearly full: 2 MiB, all but 50 kB taken by a file (root only)."""
+    import subprocess
+
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=2048k", "tmpfs", str(disk)], capture_output=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {mounted.stderr.decode().strip()}")
+    (disk / "filler").write_bytes(b"\0" * ((2048 - 50) << 10))
+    yield disk
+    subprocess.run(["umount", str(disk)], check=True)
+
+
+def test_a_full_disk_is_a_write_error_not_a_crash(small_disk, tmp_path):
+    import json
+    import os
+    import subprocess
+    import sys
+
+    from traj2events.config import resolve_config
+    from traj2events.stages.render import RenderSettings
+
+    trajectory = trajectory_file(tmp_path / "good.h5")
+    config = resolve_config({"camera": {"width": 64, "height": 64}, "scenarios": {"descent": {}}})
+    settings = json.loads(RenderSettings.from_config(config, "descent").to_json())
+    outputs = [str(small_disk / name) for name in ("frames.h5", "video.mkv", "preview.mp4")]
+    command = [sys.executable, "-m", "traj2events.cli", "render", str(trajectory), "--settings", json.dumps(settings),
+               "--frames", outputs[0], "--video", outputs[1], "--preview", outputs[2]]  # fmt: skip
+    run = subprocess.run(command, capture_output=True, text=True, env={**os.environ, "LP_NUM_THREADS": "1"})
+    assert run.returncode == 2, run.stderr[-2000:]  # not a segfault (-11 / 139)
+    assert "frames.h5: cannot write (No space left on device" in run.stderr
+    assert [p.name for p in small_disk.iterdir()] == ["filler"]  # nothing half-written, no temporaries

@@ -3,7 +3,10 @@ through ffmpeg (ffmpeg-python builds the command lines)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
+import subprocess
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -49,23 +52,38 @@ class VideoWriter:
             )
         else:
             raise ValueError(f"video kind: expected 'ffv1' or 'h264', got {kind!r}")
-        self._process = out.overwrite_output().global_args("-loglevel", "error").run_async(pipe_stdin=True)
+        # ffmpeg can exit 0 after a failed write (a full disk): its error lines decide too.
+        self._errors = tempfile.TemporaryFile()
+        command = out.overwrite_output().global_args("-loglevel", "error").compile()
+        self._process = subprocess.Popen(command, stdin=subprocess.PIPE, stderr=self._errors)
         self.n_frames = 0
 
     def write(self, frame: np.ndarray) -> None:
         frame = np.ascontiguousarray(frame, dtype=np.uint8)
         if frame.shape != (self.height, self.width):
             raise ValueError(f"{self.path}: expected a {self.height} x {self.width} frame, got {frame.shape}")
-        self._process.stdin.write(frame.tobytes())
+        try:
+            self._process.stdin.write(frame.tobytes())
+        except BrokenPipeError:
+            raise OSError(f"{self.path}: ffmpeg stopped reading frames: {self._error_text()}") from None
         self.n_frames += 1
 
+    def _error_text(self) -> str:
+        self._errors.seek(0)
+        return self._errors.read().decode(errors="replace").strip()
+
     def close(self, keep: bool = True) -> None:
-        self._process.stdin.close()
+        with contextlib.suppress(BrokenPipeError):
+            self._process.stdin.close()
         code = self._process.wait()
-        if code != 0 or not keep:
-            error = RuntimeError(f"ffmpeg failed writing {self.path} (exit {code})" if code else "not kept")
+        errors = self._error_text()
+        self._errors.close()
+        failed = code != 0 or bool(errors)
+        if failed or not keep:
+            lines = errors.splitlines()
+            error = OSError(f"{self.path}: ffmpeg failed (exit {code}): {lines[-1] if lines else 'no message'}")
             self._context.__exit__(type(error), error, None)  # removes the temporary file
-            if code != 0:
+            if failed:
                 raise error
             return
         self._context.__exit__(None, None, None)

@@ -7,6 +7,7 @@ it left."""
 from __future__ import annotations
 
 import contextlib
+import errno
 import glob
 import os
 import shutil
@@ -66,3 +67,15 @@ def atomic_directory(path: str | os.PathLike) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+FREE_SPACE_MARGIN_BYTES = 64 << 20  # room left for the writer to close its file cleanly
+
+
+def ensure_free_space(path: str | os.PathLike, n_bytes: int) -> None:
+    """Raise OSError(ENOSPC) naming `path` unless `n_bytes` plus a margin are free where
+    it is written. HDF5 cannot recover from a write that fails on a full disk (it crashes
+    at exit), so writers check before they write."""
+    free = shutil.disk_usage(Path(path).parent).free
+    if free < n_bytes + FREE_SPACE_MARGIN_BYTES:
+        raise OSError(errno.ENOSPC, f"{path}: cannot write ({os.strerror(errno.ENOSPC)}: {free >> 20} MiB free)")

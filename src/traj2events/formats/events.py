@@ -7,7 +7,7 @@ import os
 
 import numpy as np
 
-from .atomic import atomic_output
+from .atomic import atomic_output, ensure_free_space
 from .hdf5 import Attributes, create, open_file, set_attrs
 
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
@@ -30,6 +30,7 @@ class EventsWriter:
         self, path: str | os.PathLike, width: int, height: int, attrs: dict, t_offset_us: int = 0, chunk: int = 1 << 18
     ):
         compression = _blosc_zstd()
+        self._path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
@@ -51,6 +52,7 @@ class EventsWriter:
     def append(self, events: np.ndarray) -> None:
         if not len(events):
             return
+        ensure_free_space(self._path, len(events) * events.dtype.itemsize)
         t = events["t"].astype(np.int64) - self.t_offset_us
         if t[0] < self._last_t or np.any(np.diff(t) < 0):
             raise ValueError("events.h5: events must arrive sorted by t")

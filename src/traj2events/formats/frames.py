@@ -13,8 +13,8 @@ from typing import Iterator
 import h5py
 import numpy as np
 
-from .atomic import atomic_output
-from .hdf5 import Attributes, FileFormatError, create, set_attrs, write_dataset
+from .atomic import atomic_output, ensure_free_space
+from .hdf5 import Attributes, FileFormatError, create, set_attrs, write_dataset, write_errors_named
 
 
 def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
@@ -34,6 +34,7 @@ class FramesWriter:
     def __init__(
         self, path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, height: int, width: int, attrs: dict
     ):
+        self.path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
@@ -56,14 +57,21 @@ class FramesWriter:
         set_attrs(self._file, attrs)
 
     def write(self, i: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
-        self._sets["radiance"][i] = round_mantissa(radiance)
-        self._sets["depth_m"][i] = round_mantissa(depth_m)
+        ensure_free_space(self.path, 2 * np.asarray(radiance).size * 4)  # both images, uncompressed
+        with write_errors_named(self.path):
+            self._sets["radiance"][i] = round_mantissa(radiance)
+            self._sets["depth_m"][i] = round_mantissa(depth_m)
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
-        self._file.close()
+        try:
+            with write_errors_named(self.path):
+                self._file.close()
+        except OSError as error:
+            self._context.__exit__(type(error), error, None)
+            raise
         return self._context.__exit__(*exc)
 
 

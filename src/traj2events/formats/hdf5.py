@@ -69,3 +69,14 @@ def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
         raise FileFormatError(f"{path}: {exc.args[0] if exc.args else exc} (expected {expected})") from None
     finally:
         f.close()
+
+
+@contextlib.contextmanager
+def write_errors_named(path: str | os.PathLike) -> Iterator[None]:
+    """HDF5's write errors (a full disk: a paragraph naming the temporary file) as one
+    line naming the output."""
+    try:
+        yield
+    except OSError as exc:
+        reason = os.strerror(exc.errno) if exc.errno else str(exc).splitlines()[0]
+        raise OSError(exc.errno, f"{path}: cannot write ({reason})") from None
