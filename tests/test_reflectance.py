@@ -44,3 +44,25 @@ def test_dark_where_the_sun_or_camera_is_below_the_surface():
     assert hapke_radiance_factor(0.5, 0.0, 0.0, p) == 0.0
     with pytest.raises(ValueError, match="render.reflectance.model"):
         ReflectanceParams(model="phong")
+
+
+def test_hapke_phase_function_has_the_published_values():
+    from traj2events.reflectance import hapke_phase
+
+    # Worked by hand from P(g) = (1+c)/2 (1-b^2)/(1-2b cos g+b^2)^1.5 + (1-c)/2 (1-b^2)/(1+2b cos g+b^2)^1.5,
+    # b = c = 0.5: at g = 0, 0.75 * 0.75/0.125 + 0.25 * 0.75/3.375 = 41/9; at g = 180 deg, 5/3;
+    # at g = 90 deg both lobes are 0.75/1.25^1.5.
+    cos_g = np.cos(np.radians([0.0, 90.0, 180.0]))
+    np.testing.assert_allclose(hapke_phase(0.5, 0.5, cos_g), [41 / 9, 0.75 / 1.25**1.5, 5 / 3], rtol=1e-12)
+    # c > 0 backscatters: brighter toward the Sun than away from it, for the config's values too.
+    p = ReflectanceParams()
+    assert hapke_phase(p.phase_b, p.phase_c, 1.0) > 1.5 * hapke_phase(p.phase_b, p.phase_c, -1.0)
+
+
+@pytest.mark.parametrize("b, c", [(0.26, 0.4), (0.5, -0.3), (0.0, 0.0)])
+def test_hapke_phase_function_is_normalised(b, c):
+    from traj2events.reflectance import hapke_phase
+
+    # (1/4 pi) integral of P over the sphere = (1/2) integral of P(g) sin g dg over [0, pi] = 1.
+    g = np.linspace(0.0, np.pi, 200_001)
+    assert np.trapezoid(hapke_phase(b, c, np.cos(g)) * np.sin(g), g) / 2 == pytest.approx(1.0, rel=1e-6)

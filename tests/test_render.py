@@ -211,3 +211,19 @@ def test_rendered_crater_shadow_has_the_analytic_length():
     expected = 2 * radius - radius**2 * np.tan(np.radians(elevation)) / depth
     assert length == pytest.approx(expected, abs=2.0)  # a few cells and pixels
     assert ground_x[dark].max() == pytest.approx(radius, abs=2.0)  # it starts at the Sun-side rim
+
+
+def test_rendered_regolith_backscatters():
+    """Equal incidence and emission (60 deg), opposition surge off: a flat plane seen with
+    the Sun behind the camera (g = 0) is brighter than with the Sun ahead (g = 120 deg),
+    as Hapke's c > 0 says (a mirrored phase function gives the reverse: P(0) < P(120))."""
+    flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
+    camera = Camera(16, 16, 10.0)
+    pose = camera_pose(state(altitude=100.0, pitch=60.0))  # boresight 60 deg from nadir, toward +x
+    reflectance = ReflectanceParams(opposition_b0=0.0)
+    centre = {}
+    for name, azimuth in (("opposition", 180.0), ("g = 120 deg", 0.0)):  # Sun behind, then ahead
+        frame, _ = render(flat, camera, pose, radius=1e12, half_extent=5e3, sun=Sun(1.496e11, azimuth, 30.0),
+                          reflectance=reflectance)  # fmt: skip
+        centre[name] = frame.radiance[6:10, 6:10].mean()
+    assert centre["opposition"] > 1.3 * centre["g = 120 deg"] > 0

@@ -10,8 +10,10 @@ Hapke (Hapke 1981, 2002; the paper's choice), without the macroscopic-roughness
 correction (the terrain's relief is modelled as geometry instead):
     I/F = (w / 4) mu0 / (mu0 + mu) [ (1 + B(g)) P(g) + H(mu0) H(mu) - 1 ]
     B(g) = B0 / (1 + tan(g / 2) / h)                          (shadow-hiding opposition)
-    P(g) = (1 + c)/2 HG(b, g) + (1 - c)/2 HG(-b, g),  HG(b, g) = (1 - b^2) / (1 + 2 b cos g + b^2)^1.5
-           (c > 0 weights the backward lobe: HG(b, g) peaks at g = 0 for b > 0)
+    P(g) = (1 + c)/2 HG(b, g) + (1 - c)/2 HG(-b, g),  HG(b, g) = (1 - b^2) / (1 - 2 b cos g + b^2)^1.5
+           (the double Henyey-Greenstein function of Hapke 2012, ch. 6, in phase angle:
+           HG(b, g) peaks at g = 0 for b > 0, so c > 0 weights the backward lobe and the
+           Moon is brightest toward the Sun)
     H(x) = 1 / (1 - w x (r0 + (1 - 2 r0 x)/2 ln((1 + x)/x))),  r0 = (1 - sqrt(1-w)) / (1 + sqrt(1-w))
 Lunar-Lambert (McEwen 1991, 1996):
     I/F = A [ 2 L(g) mu0 / (mu0 + mu) + (1 - L(g)) mu0 ],
@@ -66,7 +68,15 @@ def chandrasekhar_h(x: np.ndarray, w: float) -> np.ndarray:
 
 
 def henyey_greenstein(b: float, cos_g: np.ndarray) -> np.ndarray:
-    return (1.0 - b * b) / (1.0 + 2.0 * b * cos_g + b * b) ** 1.5
+    """One Henyey-Greenstein lobe in phase angle g: backscattering (peak at g = 0) for
+    b > 0, forward scattering (peak at g = 180 deg) for b < 0."""
+    return (1.0 - b * b) / (1.0 - 2.0 * b * cos_g + b * b) ** 1.5
+
+
+def hapke_phase(b: float, c: float, cos_g: np.ndarray) -> np.ndarray:
+    """Hapke's double-lobed phase function P(g): a backward lobe weighted (1 + c)/2 and a
+    forward lobe weighted (1 - c)/2; it integrates to 1 over the sphere (4 pi sr)."""
+    return 0.5 * (1 + c) * henyey_greenstein(b, cos_g) + 0.5 * (1 - c) * henyey_greenstein(-b, cos_g)
 
 
 def hapke_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams) -> np.ndarray:
@@ -74,9 +84,7 @@ def hapke_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p:
     w = p.single_scattering_albedo
     g = np.arccos(np.clip(cos_g, -1.0, 1.0))
     opposition = p.opposition_b0 / (1.0 + np.tan(g / 2.0) / p.opposition_h)
-    phase = 0.5 * (1 + p.phase_c) * henyey_greenstein(p.phase_b, cos_g) + 0.5 * (1 - p.phase_c) * henyey_greenstein(
-        -p.phase_b, cos_g
-    )
+    phase = hapke_phase(p.phase_b, p.phase_c, cos_g)
     multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0
     with np.errstate(invalid="ignore", divide="ignore"):
         rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple)

@@ -35,9 +35,10 @@ float chandrasekhar_h(float x, float w_)
     return 1.0 / (1.0 - w_ * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log_term));
 }
 
+// One Henyey-Greenstein lobe in phase angle: peaks at g = 0 (backscatter) for b > 0.
 float hg(float b_, float cos_g)
 {
-    return (1.0 - b_ * b_) / pow(1.0 + 2.0 * b_ * cos_g + b_ * b_, 1.5);
+    return (1.0 - b_ * b_) / pow(1.0 - 2.0 * b_ * cos_g + b_ * b_, 1.5);
 }
 
 void main()
