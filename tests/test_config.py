@@ -260,6 +260,8 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"events": {"hot_pixel_fraction": 0.01}}, ["events.hot_pixel_hz", "> 0"]),
     ({"scenarios": {"descent": {"altitude_m": [-10.0, 100.0]}}}, ["scenarios.descent.altitude_m", "above the ground"]),
     ({"scenarios": {"descent": None}}, ["scenarios.descent", "expected object"]),
+    ({"vehicle": {"thrust_main_N": 10000.0}}, ["vehicle.thrust_main_N", "weight"]),
+    ({"motion_field": {"moon_radius_m": 1.0}}, ["motion_field.moon_radius_m", ">= 1.7e+06"]),
     ({"terrain": {"elevation_grid": "no/such/dem.npy", "grid_spacing_m": 1.0}}, ["terrain.elevation_grid", "dem.npy"]),
 ]
 

@@ -126,6 +126,12 @@ def _semantic_errors(config: dict) -> list[str]:
     vehicle, ocp, terrain = config["vehicle"], config["ocp"], config["terrain"]
     if vehicle["dry_mass_kg"] >= vehicle["mass_kg"]:
         errors.append("config key 'vehicle.dry_mass_kg': expected less than vehicle.mass_kg")
+    weight_n = vehicle["mass_kg"] * vehicle["g_m_s2"]
+    if vehicle["thrust_main_N"] <= weight_n:
+        errors.append(
+            f"config key 'vehicle.thrust_main_N': expected more than the lander's weight "
+            f"mass_kg * g_m_s2 = {weight_n:.0f} N (it could not stop), got {vehicle['thrust_main_N']}"
+        )
     if ocp["tf_min_s"] >= ocp["tf_max_s"]:
         errors.append(f"config key 'ocp.tf_min_s': expected less than ocp.tf_max_s = {ocp['tf_max_s']}, "
                       f"got {ocp['tf_min_s']}")  # fmt: skip
