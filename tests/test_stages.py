@@ -158,10 +158,83 @@ def test_centred_windows_stay_inside_the_recording():
 
 def test_a_scenario_without_a_solved_sample_is_an_error_not_an_empty_index(tmp_path):
     from traj2events.stages.index import NoSolvedSampleError
+    from traj2events.stages.summary import SAMPLE_COLUMNS
 
     samples = tmp_path / "samples.csv"
-    pd.DataFrame({"id": [0, 1, 2], "success": [False] * 3,
-                  "reason": ["infeasible", "infeasible", "iteration limit"]}).to_csv(samples, index=False)  # fmt: skip
+    table = {c: [np.nan] * 3 for c in SAMPLE_COLUMNS}
+    table.update(id=[0, 1, 2], success=[False] * 3, method=["failed"] * 3,
+                 reason=["infeasible", "infeasible", "iteration limit"])  # fmt: skip
+    pd.DataFrame(table).to_csv(samples, index=False)
     with pytest.raises(NoSolvedSampleError, match=r"none of the 3 samples solved \(infeasible \(2\), iteration limit"):
         dataset_index([], tmp_path / "index.csv", samples)
     assert not (tmp_path / "index.csv").exists()
+
+
+WRONG_KIND = ["trajectory.h5", "frames.h5", "events.h5", "solutions.h5", "samples.csv", "video.mkv", "frames.png",
+              "empty", "text", "a folder", "missing"]  # fmt: skip
+
+
+def command_lines(f):
+    """Each standalone command with `f` in one input slot and good files in the others."""
+    return [
+        ["upsample", "--solutions", f, "--id", "0", "-o", "out/t.h5"],
+        ["motion-field", f, "-o", "out/m.h5", "--flo-dir", "out/flow", "--width", "16", "--height", "16"],
+        [
+            "motion-field",
+            "trajectory.h5",
+            "--frames",
+            f,
+            "-o",
+            "out/m.h5",
+            "--flo-dir",
+            "out/flow",
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ],  # fmt: skip
+        ["events", f, "-o", "out/e.h5", "--fps", "10"],
+        ["events", "frames.h5", "-o", "out/e.h5", "--npz", "out/e.npz", "--trajectory", f],
+        ["picture", "frames", f, "--video", "video.mkv", "-o", "out/p.png"],
+        ["picture", "frames", "trajectory.h5", "--video", f, "-o", "out/p.png"],
+        ["picture", "motion-field", f, "-o", "out/p.png"],
+        ["picture", "events", f, "--trajectory", "trajectory.h5", "-o", "out/p.png"],
+        ["picture", "events", "events.h5", "--trajectory", f, "-o", "out/p.png"],
+        ["picture", "dataset", f, "-o", "out/p.png"],
+        ["index", f, "-o", "out/i.csv"],
+        ["index", "-o", "out/i.csv", "--samples", f],
+        ["summary", "--solutions", f, "--tables", "samples.csv", "--output", "out/s.csv"],
+        ["summary", "--solutions", "solutions.h5", "--tables", f, "--output", "out/s.csv"],
+        ["sample", "--settings", "@" + f, "--base", "trajectory.h5", "-o", "out/s.h5", "--table", "out/t.csv"],
+        ["check-config", f],
+    ]
+
+
+def test_every_command_refuses_a_wrong_kind_of_file_in_one_line(built, tmp_path, monkeypatch):
+    """187 command lines: each either works or fails with one `error:` line, writing nothing."""
+    import contextlib
+    import io
+    import shutil
+
+    from traj2events.cli import main
+
+    emulate(frame_source(built / "frames.h5"), emulator_params("clean"), 0, tmp_path / "events.h5", "clean", "f")
+    pictures.frames_picture(built / "trajectory.h5", built / "video.mkv", tmp_path / "frames.png")
+    for name in ("trajectory.h5", "frames.h5", "solutions.h5", "samples.csv", "video.mkv"):
+        shutil.copy(built / name, tmp_path / name)
+    (tmp_path / "empty").write_bytes(b"")
+    (tmp_path / "text").write_text("hello\n")
+    (tmp_path / "a folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    failures = []
+    for f in WRONG_KIND:
+        for argv in command_lines(f):
+            shutil.rmtree(tmp_path / "out", ignore_errors=True)
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                rc = main(argv)
+            errors = [line for line in err.getvalue().splitlines() if line.startswith("error:")]
+            left = list((tmp_path / "out").rglob("*")) if rc else []
+            if rc not in (0, 2) or (rc == 2 and len(errors) != 1) or left:
+                failures.append((argv, rc, err.getvalue()[-300:], left))
+    assert not failures, failures[:5]

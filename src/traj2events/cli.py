@@ -106,6 +106,10 @@ def cmd_events(args) -> int:
         hot_pixel_fraction=args.hot_pixel_fraction,
         hot_pixel_hz=args.hot_pixel_hz,
     )
+    if args.trajectory:
+        from .formats.trajectory import read_trajectory
+
+        read_trajectory(args.trajectory)  # refused now, not after the emulation
     source = frame_source(args.input, args.chunk, args.fps, args.white)
     from .progress import log
 
@@ -357,6 +361,11 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, OSError) as exc:  # ConfigError and FileNotFoundError included
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except Exception as exc:  # a case no check foresaw: one line, the traceback on request
+        if os.environ.get("TRAJ2EVENTS_TRACEBACK"):
+            raise
+        print(f"error: unexpected {type(exc).__name__}: {exc} (TRAJ2EVENTS_TRACEBACK=1 shows where)", file=sys.stderr)
+        return 3
 
 
 if __name__ == "__main__":

@@ -107,7 +107,12 @@ def read_video(path: str | os.PathLike, frames: list[int] | None = None) -> np.n
     else:
         out = source.output("pipe:", format="rawvideo", pix_fmt="gray")
     data, _ = out.global_args("-loglevel", "error").run(capture_stdout=True)
-    return np.frombuffer(data, np.uint8).reshape(-1, height, width)
+    decoded = np.frombuffer(data, np.uint8).reshape(-1, height, width)
+    if frames is not None and len(decoded) != len(frames):
+        raise ValueError(
+            f"{path}: expected frames {frames[0]}..{frames[-1]}, the video has only {len(decoded)} of them"
+        )
+    return decoded
 
 
 def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
@@ -118,9 +123,8 @@ def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
     try:
         probe = ffmpeg.probe(str(path))
     except ffmpeg.Error as exc:
-        raise ValueError(
-            f"{path}: not a video ffmpeg can read ({exc.stderr.decode(errors='replace').strip()[-200:]})"
-        ) from None
+        lines = exc.stderr.decode(errors="replace").strip().splitlines()
+        raise ValueError(f"{path}: not a video ffmpeg can read ({lines[-1] if lines else 'no message'})") from None
     stream = next((s for s in probe["streams"] if s["codec_type"] == "video"), None)
     if stream is None:
         raise ValueError(f"{path}: has no video stream")

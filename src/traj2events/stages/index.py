@@ -11,6 +11,7 @@ from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_trajectory
 from ..progress import log
 from ..state import MASS
+from .summary import read_sample_table
 
 
 def index_row(path: str | os.PathLike) -> dict:
@@ -48,7 +49,7 @@ def dataset_index(
     says why its samples failed (not an empty index)."""
     rows = [index_row(p) for p in paths if Path(p).name == "trajectory.h5"]
     if not rows and samples is not None:
-        table = pd.read_csv(samples)
+        table = read_sample_table(samples)
         raise NoSolvedSampleError(
             f"{samples}: none of the {len(table)} samples solved ({failure_summary(table)}); "
             f"the scenario has no trajectory. Check its ranges and the vehicle in the config."

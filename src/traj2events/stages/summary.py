@@ -11,6 +11,29 @@ import pandas as pd
 from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_solution_set
 
+SAMPLE_COLUMNS = (
+    "id",
+    "success",
+    "method",
+    "reason",
+    "final_mass_kg",
+    "tf_s",
+    "error_position_m",
+    "error_velocity_m_s",
+)
+
+
+def read_sample_table(path: str | os.PathLike) -> pd.DataFrame:
+    """samples.csv, with the columns the index and summary use checked."""
+    try:
+        table = pd.read_csv(path)
+    except (ValueError, OSError) as exc:
+        raise ValueError(f"{path}: not a samples.csv ({str(exc).splitlines()[0]})") from None
+    missing = [c for c in SAMPLE_COLUMNS if c not in table.columns]
+    if missing:
+        raise ValueError(f"{path}: not a samples.csv from `traj2events sample` (missing columns {missing})")
+    return table
+
 
 def summary_table(scenarios: list[str], sample_tables: list[pd.DataFrame]) -> pd.DataFrame:
     """Per scenario: count, failures, final mass and t_f ranges, worst re-integration error."""
@@ -44,7 +67,7 @@ def dataset_summary(
     if len(solutions) != len(tables):
         raise ValueError(f"summary: expected one samples.csv per solutions.h5, got {len(tables)} and {len(solutions)}")
     names = [read_solution_set(p)["attrs"]["scenario"] for p in solutions]
-    table = summary_table(names, [pd.read_csv(p) for p in tables])
+    table = summary_table(names, [read_sample_table(p) for p in tables])
     with atomic_output(output) as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")
     print(table.to_string(index=False), file=sys.stderr)
