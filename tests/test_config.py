@@ -261,6 +261,8 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"scenarios": {"descent": {"altitude_m": [-10.0, 100.0]}}}, ["scenarios.descent.altitude_m", "above the ground"]),
     ({"scenarios": {"descent": None}}, ["scenarios.descent", "expected object"]),
     ({"vehicle": {"thrust_main_N": 10000.0}}, ["vehicle.thrust_main_N", "weight"]),
+    ({"render": {"display_white_w_m2_sr": 1e6}}, ["render.display_white_w_m2_sr", "black"]),
+    ({"camera": {"fps": 0.01}}, ["camera.fps", "at least 2 frames"]),
     ({"motion_field": {"moon_radius_m": 1.0}}, ["motion_field.moon_radius_m", ">= 1.7e+06"]),
     ({"terrain": {"elevation_grid": "no/such/dem.npy", "grid_spacing_m": 1.0}}, ["terrain.elevation_grid", "dem.npy"]),
 ]

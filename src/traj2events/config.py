@@ -96,6 +96,12 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"config key 'scenarios.{name}.tf_guess_s': expected a value within [ocp.tf_min_s, ocp.tf_max_s] = "
             f"[{ocp['tf_min_s']}, {ocp['tf_max_s']}], got {sc['tf_guess_s']}"
         )
+    frames = sc["tf_guess_s"] * config["camera"]["fps"]
+    if frames < 2:
+        errors.append(
+            f"config key 'camera.fps': expected at least 2 frames per trajectory, scenario '{name}' would have "
+            f"{frames:.3g} (t_f ~ {sc['tf_guess_s']} s at {config['camera']['fps']} fps)"
+        )
     if sc["altitude_m"][0] <= 0:
         errors.append(f"config key 'scenarios.{name}.altitude_m': expected a start above the ground (> 0 m), "
                       f"got {sc['altitude_m']}")  # fmt: skip
@@ -142,9 +148,28 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append("config key 'terrain.crater_diameter_min_m': expected at most terrain.crater_diameter_max_m")
     if config["events"]["hot_pixel_fraction"] > 0 and not config["events"]["hot_pixel_hz"] > 0:
         errors.append("config key 'events.hot_pixel_hz': expected > 0 when events.hot_pixel_fraction > 0")
+    errors += _display_errors(config)
     for name, sc in config["scenarios"].items():
         errors += _scenario_errors(config, name, sc)
     return errors or _elevation_grid_error(terrain)
+
+
+def _display_errors(config: dict) -> list[str]:
+    """A display white far above any radiance the scene can have gives black videos."""
+    from .reflectance import ReflectanceParams, max_radiance_factor
+
+    reflectance = ReflectanceParams(**config["render"]["reflectance"])
+    brightest = max(
+        max_radiance_factor(reflectance, n=21) * 1361.0 * (1.495978707e11 / sc["sun"]["range_m"]) ** 2 / math.pi
+        for sc in config["scenarios"].values()
+    )
+    white = config["render"]["display_white_w_m2_sr"]
+    if white > 10 * brightest:
+        return [
+            f"config key 'render.display_white_w_m2_sr': expected at most 10x the brightest radiance the scenes can "
+            f"have ({brightest:.3g} W m^-2 sr^-1), got {white} (the videos would be black)"
+        ]
+    return []
 
 
 def validate_config(config: Any, schema: dict | None = None) -> None:
