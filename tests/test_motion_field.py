@@ -7,6 +7,8 @@ from scipy.spatial.transform import Rotation
 from traj2events.camera import Camera, camera_motion, camera_pose
 from traj2events.motion_field import (
     MOON_RADIUS_M,
+    OUT_OF_VIEW,
+    VISIBLE,
     inverse_depth_from_depth,
     inverse_depth_plane,
     inverse_depth_sphere,
@@ -203,8 +205,8 @@ def test_discrete_displacement_converges_to_field_times_dt_as_dt_squared(seed):
     flow, terrain = sphere_flow(CAM, state, dtype=np.float64)
     errors = []
     for dt in (0.02, 0.01):
-        disp, valid = sphere_displacement(CAM, state, rigid_motion(state, dt))
-        ok = valid & terrain
+        disp, status = sphere_displacement(CAM, state, rigid_motion(state, dt))
+        ok = (status <= OUT_OF_VIEW) & terrain
         errors.append(np.abs(disp[ok] - flow[ok] * dt).max())  # px (relative to flow*dt it is O(dt))
     assert errors[0] / errors[1] == pytest.approx(4.0, rel=0.2)
     assert errors[1] < 1e-2 * np.abs(flow[terrain] * 0.01).max() * np.abs(flow[terrain] * 0.01).max()
@@ -212,8 +214,8 @@ def test_discrete_displacement_converges_to_field_times_dt_as_dt_squared(seed):
 
 def test_zero_motion_gives_zero_displacement():
     state = random_state(np.random.default_rng(3), 300.0)
-    disp, valid = sphere_displacement(CAM, state, state)
-    assert valid.any()
+    disp, status = sphere_displacement(CAM, state, state)
+    assert (status == VISIBLE).any() and not (status == OUT_OF_VIEW).any()  # nothing moved out
     np.testing.assert_allclose(disp, 0, atol=1e-9)
 
 
@@ -261,6 +263,77 @@ def test_huge_time_step_keeps_valid_displacements_finite():
     state[3:6] = [40.0, 0.0, 15.0]  # 10 s later the camera is below the initial ground height
     state[9:12] = [0.0, 0.3, 0.0]
     later = rigid_motion(state, 10.0)
-    disp, valid = sphere_displacement(CAM, state, later)
+    disp, status = sphere_displacement(CAM, state, later)
+    valid = status <= OUT_OF_VIEW
     assert np.isfinite(disp[valid]).all()
     assert not valid.all()  # points behind the camera or the limb are flagged, not projected
+
+
+def plate_scene_depth(camera, camera_x_m, altitude_m=100.0, plate=(-10.0, 10.0), plate_height_m=50.0):
+    """Depth seen looking straight down from (camera_x, 0, -altitude) at flat ground (z = 0)
+    under a plate at height `plate_height_m` spanning x in `plate` (all y): a known occluder."""
+    x_s, y_s = camera.pixel_coordinates()
+    a = np.broadcast_to(x_s / camera.focal_px, (camera.height, camera.width))
+    to_plate = altitude_m - plate_height_m
+    on_plate = (camera_x_m + to_plate * a >= plate[0]) & (camera_x_m + to_plate * a <= plate[1])
+    return np.where(on_plate, to_plate, altitude_m), a
+
+
+def test_terrain_displacement_marks_what_a_known_occluder_hides():
+    from traj2events.motion_field import OCCLUDED, depth_displacement
+
+    camera = Camera(128, 48, 60.0)
+    state_k, state_next = np.zeros(13), np.zeros(13)
+    state_k[2] = state_next[2] = -100.0
+    state_next[0] = 10.0  # the camera moves 10 m along +x between the frames
+    depth_k, a = plate_scene_depth(camera, 0.0)
+    depth_next, _ = plate_scene_depth(camera, 10.0)
+    disp, status = depth_displacement(camera, state_k, state_next, depth_k, depth_next)
+    # Worked out: ground point x = 100 a is seen from x = 10 through the plate's height at
+    # x = (10 + 100 a) / 2, hidden when that is on the plate: a in [-0.3, 0.1]; the plate
+    # itself covers a in [-0.2, 0.2] at frame k. So ground pixels with -0.3 < a < -0.2 are occluded.
+    ground = depth_k == 100.0
+    expected = ground & (a > -0.3) & (a < -0.2)
+    margin = 1.5 / camera.focal_px  # a pixel and a half from the band's edges
+    clear = (np.abs(a + 0.3) > margin) & (np.abs(a + 0.2) > margin)
+    assert expected[clear].sum() >= 3 * camera.height  # a band several pixels wide
+    np.testing.assert_array_equal((status == OCCLUDED)[clear], expected[clear])
+    assert (status[~expected & clear] <= OUT_OF_VIEW).all()
+    # Without frame k+1's depth occlusion is not checked.
+    _, unchecked = depth_displacement(camera, state_k, state_next, depth_k)
+    assert not (unchecked == OCCLUDED).any()
+
+
+def test_sphere_displacement_marks_sky_out_of_view_and_beyond_the_limb():
+    from traj2events.motion_field import OCCLUDED, SKY, local_vertical
+
+    radius = 1_737_400.0
+    state_k = np.zeros(13)
+    state_k[2] = -2000.0
+    state_k[7] = np.radians(80.0)  # pitched up: the horizon (2 km up: 83 km away) is in view
+    state_next = state_k.copy()
+    state_next[2] = -10.0  # 10 m up, whose horizon is 5.9 km away
+    disp, status = sphere_displacement(CAM, state_k, state_next, radius)
+    flow, terrain = sphere_flow(CAM, state_k, radius)
+    assert (status[~terrain] == SKY).all() and (~terrain).any()
+    # Beyond the limb seen from k+1, by the great-circle angle from the point below camera
+    # k+1: a point farther than acos(R / (R + h)) is below its horizon (independent of the code).
+    pose_k, pose_next = camera_pose(state_k), camera_pose(state_next)
+    normal, height = local_vertical(pose_k.position, pose_k.rotation, radius)
+    x_s, y_s = CAM.pixel_coordinates()
+    h = inverse_depth_sphere(x_s / CAM.focal_px, y_s / CAM.focal_px, normal, height, radius)
+    rays = np.stack(np.broadcast_arrays(x_s / CAM.focal_px, y_s / CAM.focal_px, np.ones_like(h)), axis=-1)
+    points = pose_k.position + (rays / np.where(h > 0, h, np.inf)[..., None]) @ pose_k.rotation.T
+    centre = np.array([0.0, 0.0, radius])
+    below_next = (pose_next.position - centre) / np.linalg.norm(pose_next.position - centre)
+    to_point = (points - centre) / np.linalg.norm(points - centre, axis=-1, keepdims=True)
+    angle = np.arccos(np.clip(to_point @ below_next, -1, 1))
+    beyond = terrain & (angle > np.arccos(radius / (radius + 10.0)) * 1.01)
+    within = terrain & (angle < np.arccos(radius / (radius + 10.0)) * 0.99)
+    assert beyond.any() and within.any()
+    assert (status[beyond] == OCCLUDED).all()
+    assert not (status[within] == OCCLUDED).any()
+    # Out of view: where the displacement lands outside the image, and only there.
+    x_next, y_next = x_s + disp[..., 0], y_s + disp[..., 1]
+    outside = (np.abs(x_next) > CAM.width / 2) | (np.abs(y_next) > CAM.height / 2)
+    np.testing.assert_array_equal(status[within] == OUT_OF_VIEW, outside[within])

@@ -152,38 +152,97 @@ def depth_flow(camera: Camera, state: np.ndarray, depth_m: np.ndarray) -> tuple[
     return np.stack([u, v], axis=-1), h > 0
 
 
+# Status of each pixel of a displacement field (motion_field.h5 `status_*`, uint8): where
+# frame k's surface point is in frame k+1.
+VISIBLE = 0  # seen at k+1 where the displacement puts it
+OUT_OF_VIEW = 1  # in front of camera k+1 but outside its image
+OCCLUDED = 2  # hidden at k+1: behind nearer terrain, or beyond the sphere's limb
+BEHIND_CAMERA = 3  # behind camera k+1's image plane: the displacement is meaningless
+SKY = 4  # no surface at k (the displacement moves a direction at infinity)
+STATUS_NAMES = ("visible", "out of view", "occluded", "behind camera", "sky")
+
+
+def displacement_status(
+    camera: Camera, displacement: np.ndarray, surface: np.ndarray, in_front: np.ndarray, hidden: np.ndarray
+) -> np.ndarray:
+    """Status codes (H, W) uint8 from the displacement and masks of frame k's pixels: a
+    surface point, in front of camera k+1, hidden at k+1 (the first that applies wins,
+    in the order SKY, BEHIND_CAMERA, OCCLUDED, OUT_OF_VIEW)."""
+    x_s, y_s = camera.pixel_coordinates(np.float64)
+    with np.errstate(invalid="ignore"):
+        x_next, y_next = x_s + displacement[..., 0], y_s + displacement[..., 1]
+        inside = (np.abs(x_next) <= camera.width / 2) & (np.abs(y_next) <= camera.height / 2)
+    status = np.full(surface.shape, VISIBLE, np.uint8)
+    status[~inside] = OUT_OF_VIEW
+    status[hidden] = OCCLUDED
+    status[~in_front] = BEHIND_CAMERA
+    status[~surface] = SKY
+    return status
+
+
 def sphere_displacement(
     camera: Camera, state_k: np.ndarray, state_next: np.ndarray, radius_m: float = MOON_RADIUS_M
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Exact displacement (H, W, 2) in px from frame k to frame k+1, and the mask of pixels
-    whose surface point is on the sphere at k and in front of, and not hidden by the limb
-    from, camera k+1. Sky pixels move as directions at infinity (rotation only). float64."""
+    """Exact displacement (H, W, 2) in px from frame k to frame k+1 over the sphere, and
+    each pixel's status (H, W) uint8: VISIBLE, OUT_OF_VIEW, OCCLUDED (beyond the limb
+    seen from camera k+1), BEHIND_CAMERA or SKY. Sky pixels move as directions at infinity
+    (rotation only). float64."""
     pose_k, pose_next = camera_pose(state_k), camera_pose(state_next)
     normal, height = local_vertical(pose_k.position, pose_k.rotation, radius_m)
     x_s, y_s = camera.pixel_coordinates(np.float64)
     f = camera.focal_px
     h = inverse_depth_sphere(x_s / f, y_s / f, normal, height, radius_m)
-    displacement, in_front, point_world = _displace(camera, pose_k, pose_next, h)
+    displacement, z_next, point_world = _displace(camera, pose_k, pose_next, h)
     centre = np.array([0.0, 0.0, radius_m])
     outward = point_world + pose_next.position - centre  # surface point - centre
     facing = np.einsum("hwk,hwk->hw", outward, -point_world) > 0  # camera k+1 above its tangent plane
-    return displacement, (h > 0) & in_front & facing
+    return displacement, displacement_status(camera, displacement, h > 0, z_next > 0, ~facing)
 
 
 def depth_displacement(
-    camera: Camera, state_k: np.ndarray, state_next: np.ndarray, depth_m: np.ndarray
+    camera: Camera,
+    state_k: np.ndarray,
+    state_next: np.ndarray,
+    depth_m: np.ndarray,
+    depth_next_m: np.ndarray | None = None,
+    rel_tol: float = 0.01,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Exact displacement (H, W, 2) in px from frame k to k+1 of the surface seen in a
     depth map (metric depth along the boresight at k; 0 = sky, moved as a direction), and
-    the mask of terrain pixels in front of camera k+1. Occlusion at k+1 is not checked. float64."""
+    each pixel's status (H, W) uint8. Given frame k+1's depth map, a point is OCCLUDED when
+    every pixel around where it lands at k+1 shows something nearer than its own depth by
+    more than `rel_tol` (relative: the rasteriser interpolates depth across edges); without
+    it occlusion is not checked. float64."""
     h = inverse_depth_from_depth(np.asarray(depth_m, dtype=np.float64))
-    displacement, in_front, _ = _displace(camera, camera_pose(state_k), camera_pose(state_next), h)
-    return displacement, (h > 0) & in_front
+    displacement, z_next, _ = _displace(camera, camera_pose(state_k), camera_pose(state_next), h)
+    hidden = np.zeros(h.shape, bool)
+    if depth_next_m is not None:
+        hidden = _hidden_by_nearer_surface(camera, displacement, z_next, np.asarray(depth_next_m, np.float64), rel_tol)
+    return displacement, displacement_status(camera, displacement, h > 0, z_next > 0, hidden)
+
+
+def _hidden_by_nearer_surface(
+    camera: Camera, displacement: np.ndarray, z_next: np.ndarray, depth_next: np.ndarray, rel_tol: float
+) -> np.ndarray:
+    """True where the point lands in view and all four pixels around it show a surface
+    nearer than the point (sky counts as infinitely far: it hides nothing)."""
+    x_s, y_s = camera.pixel_coordinates(np.float64)
+    with np.errstate(invalid="ignore"):
+        col = x_s + displacement[..., 0] + camera.width / 2 - 0.5  # continuous pixel index at k+1
+        row = y_s + displacement[..., 1] + camera.height / 2 - 0.5
+    ok = (col > -1) & (col < camera.width) & (row > -1) & (row < camera.height)  # in view (NaN: not)
+    c0 = np.clip(np.floor(np.where(ok, col, 0.0)), 0, camera.width - 1).astype(np.intp)
+    r0 = np.clip(np.floor(np.where(ok, row, 0.0)), 0, camera.height - 1).astype(np.intp)
+    c1, r1 = np.minimum(c0 + 1, camera.width - 1), np.minimum(r0 + 1, camera.height - 1)
+    far = np.where(depth_next > 0, depth_next, np.inf)
+    farthest = np.maximum.reduce([far[r0, c0], far[r0, c1], far[r1, c0], far[r1, c1]])
+    return ok & (z_next > 0) & (farthest < z_next * (1.0 - rel_tol))
 
 
 def _displace(camera: Camera, pose_k, pose_next, h: np.ndarray):
     """Pixels of frame k with inverse depth h (0: at infinity) -> centred coordinates in
-    frame k+1; returns (displacement, in front of camera k+1, points relative to camera k+1)."""
+    frame k+1; returns (displacement, depth along camera k+1's boresight (> 0: in front),
+    points relative to camera k+1)."""
     x_s, y_s = camera.pixel_coordinates(np.float64)
     f = camera.focal_px
     a, b = x_s / f, y_s / f
@@ -199,4 +258,4 @@ def _displace(camera: Camera, pose_k, pose_next, h: np.ndarray):
     with np.errstate(divide="ignore", invalid="ignore"):
         x_next = f * point_next[..., 0] / z
         y_next = f * point_next[..., 1] / z
-    return np.stack([x_next - x_s, y_next - y_s], axis=-1), z > 0, point_world
+    return np.stack([x_next - x_s, y_next - y_s], axis=-1), z, point_world

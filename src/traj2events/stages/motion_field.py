@@ -15,7 +15,15 @@ from ..formats.atomic import atomic_directory
 from ..formats.flow import write_flo, write_motion_field
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
-from ..motion_field import depth_displacement, depth_flow, sphere_displacement, sphere_flow
+from ..motion_field import (
+    OCCLUDED,
+    OUT_OF_VIEW,
+    STATUS_NAMES,
+    depth_displacement,
+    depth_flow,
+    sphere_displacement,
+    sphere_flow,
+)
 from ..progress import log
 
 
@@ -24,6 +32,7 @@ def _empty_fields(n: int, h: int, w: int, terrain: bool) -> dict[str, np.ndarray
         "flow_sphere": np.empty((n, h, w, 2), np.float32),
         "displacement_sphere": np.empty((n, h, w, 2), np.float32),
         "valid": np.empty((n, h, w), bool),
+        "status_sphere": np.empty((n, h, w), np.uint8),
     }
     if terrain:
         fields.update(
@@ -31,6 +40,7 @@ def _empty_fields(n: int, h: int, w: int, terrain: bool) -> dict[str, np.ndarray
                 "flow_terrain": np.empty((n, h, w, 2), np.float32),
                 "displacement_terrain": np.empty((n, h, w, 2), np.float32),
                 "valid_terrain": np.empty((n, h, w), bool),
+                "status_terrain": np.empty((n, h, w), np.uint8),
                 "sphere_minus_terrain_mean_px_s": np.full((n, 2), np.nan, np.float32),
                 "sphere_minus_terrain_rms_px_s": np.full(n, np.nan, np.float32),
             }
@@ -76,6 +86,7 @@ def motion_field(
             "scenario": tr.attrs["scenario"],
             "id": int(tr.attrs["id"]),
             "traj2events_version": __version__,
+            "status_codes": ", ".join(f"{code} {name}" for code, name in enumerate(STATUS_NAMES)),
         }
         log(
             f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"
@@ -85,15 +96,19 @@ def motion_field(
             for i, k in enumerate(picked):
                 flow, on_sphere = sphere_flow(camera, tr.state[k], moon_radius_m, np.float32)
                 fields["flow_sphere"][i] = flow
-                disp, fields["valid"][i] = sphere_displacement(camera, tr.state[k], tr.state[k + 1], moon_radius_m)
-                fields["displacement_sphere"][i] = disp
+                disp, status = sphere_displacement(camera, tr.state[k], tr.state[k + 1], moon_radius_m)
+                fields["displacement_sphere"][i], fields["status_sphere"][i] = disp, status
+                fields["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
                 write_flo(Path(tmp_dir) / f"{k:06d}.flo", fields["displacement_sphere"][i])
                 if rendered is not None:
                     depth = rendered.depth_m(k)
                     terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
                     fields["flow_terrain"][i] = terrain_flow
-                    disp, fields["valid_terrain"][i] = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth)
-                    fields["displacement_terrain"][i] = disp
+                    disp, status = depth_displacement(
+                        camera, tr.state[k], tr.state[k + 1], depth, rendered.depth_m(k + 1)
+                    )
+                    fields["displacement_terrain"][i], fields["status_terrain"][i] = disp, status
+                    fields["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
                     both = seen & on_sphere
                     if both.any():
                         diff = (flow - terrain_flow)[both]
