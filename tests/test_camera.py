@@ -74,3 +74,12 @@ def test_bad_intrinsics_are_rejected():
         Camera(10, 10, 180.0)
     with pytest.raises(ValueError, match="width"):
         Camera(0, 10, 45.0)
+
+
+def test_camera_matrix_projects_as_the_camera_model_does():
+    camera = Camera(64, 48, 60.0)
+    points = np.array([[1.0, -2.0, 10.0], [-3.0, 0.5, 7.0], [0.0, 0.0, 5.0]])
+    homogeneous = points @ camera.matrix.T
+    pixel_index = homogeneous[:, :2] / homogeneous[:, 2:]
+    np.testing.assert_allclose(pixel_index, camera.to_pixel_index(camera.project(points)), atol=1e-12)
+    np.testing.assert_allclose(pixel_index[2], [31.5, 23.5])  # the boresight between the four centre pixels

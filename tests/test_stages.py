@@ -115,6 +115,8 @@ def test_motion_field_with_the_terrain_field(built, config):
         assert frames[0] == 0 and np.all(np.diff(frames) == 7)
         assert f["displacement_terrain"].shape == (len(frames), SIZE, SIZE, 2)
         assert np.nanmedian(f["sphere_minus_terrain_rms_px_s"][()]) < np.abs(f["flow_sphere"][()]).max()
+        np.testing.assert_allclose(f.attrs["camera_matrix_px"], camera.matrix)
+        assert set(np.unique(f["status_terrain"][()])) <= {0, 1, 2, 3, 4}
     assert sorted(p.name for p in (built / "flow").iterdir()) == [f"{k:06d}.flo" for k in frames]
     with pytest.raises(ValueError, match="every_n_frames"):
         motion_field(built / "trajectory.h5", camera, 1_737_400.0, 0, built / "x.h5", built / "x")
@@ -238,3 +240,23 @@ def test_every_command_refuses_a_wrong_kind_of_file_in_one_line(built, tmp_path,
             if rc not in (0, 2) or (rc == 2 and len(errors) != 1) or left:
                 failures.append((argv, rc, err.getvalue()[-300:], left))
     assert not failures, failures[:5]
+
+
+def test_kept_files_describe_themselves(built, config):
+    """Units, frames, intrinsics and the scene travel with the files that need them."""
+    camera = Camera(SIZE, SIZE, config["camera"]["fov_deg"])
+    with h5py.File(built / "trajectory.h5") as f:
+        assert (
+            list(f["poses"].attrs["state_units"])[:3] == ["m", "m", "m"] and f["poses"].attrs["state_units"][-1] == "kg"
+        )
+        assert "z down" in f.attrs["inertial_frame"] and "boresight is +z" in f.attrs["body_frame"]
+    with h5py.File(built / "frames.h5") as f:
+        np.testing.assert_allclose(f.attrs["camera_matrix_px"], camera.matrix)
+        assert f.attrs["distortion"] == "none"
+    if not (built / "events.h5").exists():
+        emulate(frame_source(built / "frames.h5"), emulator_params("clean"), 0, built / "events.h5", "clean", "f")
+    _, attrs = read_events(built / "events.h5")
+    np.testing.assert_allclose(attrs["camera_matrix_px"], camera.matrix)
+    sun = config["scenarios"]["descent"]["sun"]
+    assert attrs["sun_elevation_deg"] == sun["elevation_deg"] and attrs["scenario"] == "descent"
+    assert '"seed": 1' in attrs["terrain"]  # the terrain's settings, as JSON

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .state import rotation_matrix
+from .state import CONVENTIONS, rotation_matrix
 
 
 @dataclass(frozen=True)
@@ -30,6 +30,18 @@ class Camera:
     @property
     def focal_px(self) -> float:
         return self.width / (2.0 * np.tan(np.radians(self.fov_deg) / 2.0))
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """K (3 x 3, px) in the convention of OpenCV (pixel centres at integer indices):
+        f on the diagonal, principal point (W/2 - 0.5, H/2 - 0.5); no distortion."""
+        return np.array(
+            [[self.focal_px, 0.0, self.width / 2 - 0.5], [0.0, self.focal_px, self.height / 2 - 0.5], [0.0, 0.0, 1.0]]
+        )
+
+    def intrinsics_attrs(self) -> dict:
+        """What a file needs to be used with this camera alone."""
+        return {"camera_matrix_px": self.matrix, "distortion": "none", "image_convention": CONVENTIONS["image"]}
 
     def pixel_coordinates(self, dtype=np.float64) -> tuple[np.ndarray, np.ndarray]:
         """Centred pixel coordinates: x_s as a row (1, W) and y_s as a column (H, 1),

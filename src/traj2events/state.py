@@ -17,6 +17,18 @@ CONTROL_NAMES = ("uT", "uphi", "utheta", "upsi")
 N_STATE = len(STATE_NAMES)
 N_CONTROL = len(CONTROL_NAMES)
 
+STATE_UNITS = ("m", "m", "m", "m/s", "m/s", "m/s", "rad", "rad", "rad", "rad/s", "rad/s", "rad/s", "kg")
+CONTROL_UNITS = ("1 (0..1 of thrust_main_N)", "1 (-1..1 of a thruster couple)", "1 (-1..1)", "1 (-1..1)")
+# The frames every file refers to (also in docs/dataset.md), stored with the trajectories.
+CONVENTIONS = {
+    "inertial_frame": "origin at the landing site on the surface; x horizontal toward the site (down-range), "
+    "y horizontal cross-range, z down (gravity +g along z; altitude = -z)",
+    "body_frame": "x forward, y right, z down; the main engine pushes along -z; the camera boresight is +z "
+    "(camera frame = body frame)",
+    "attitude": "roll phi, pitch theta, yaw psi in rad; R_iv = Rz(psi) Ry(theta) Rx(phi) maps body to inertial",
+    "image": "column j along body x, row i along body y, pixel centre (j + 0.5, i + 0.5) px from the top-left corner",
+}
+
 # Named slices of the state vector (race_car.py style: `state[..., VELOCITY]`).
 POSITION = slice(0, 3)  # m, inertial
 VELOCITY = slice(3, 6)  # m/s, inertial

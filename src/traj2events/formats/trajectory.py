@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from ..state import CONTROL_NAMES, STATE_NAMES
+from ..state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, STATE_NAMES, STATE_UNITS
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, plain, set_attrs, write_dataset
 
@@ -50,6 +50,8 @@ def _write_nodes(group: h5py.Group, t: np.ndarray, state: np.ndarray, control: n
     write_dataset(group, "control", control)
     group.attrs["state_names"] = list(STATE_NAMES)
     group.attrs["control_names"] = list(CONTROL_NAMES)
+    group.attrs["state_units"] = list(STATE_UNITS)
+    group.attrs["control_units"] = list(CONTROL_UNITS)
 
 
 def write_trajectory(
@@ -63,7 +65,7 @@ def write_trajectory(
         _write_nodes(f.create_group("nodes"), *nodes)
         if poses is not None:
             _write_nodes(f.create_group("poses"), *poses)
-        set_attrs(f, attrs)
+        set_attrs(f, {**attrs, **CONVENTIONS})
 
 
 @dataclass

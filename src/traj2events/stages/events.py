@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Iterator
 
@@ -38,6 +38,13 @@ class FrameSource:
     height: int
     kind: str
     chunks: Iterator[tuple[np.ndarray, np.ndarray]]
+    scene: dict = field(default_factory=dict)  # what frames.h5 says of the camera and the scene
+
+
+# frames.h5 attributes that events.h5 repeats, so that it can be used alone.
+SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_convention", "fps", "sun_range_m",
+               "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "reflectance", "terrain",
+               "moon_radius_m", "scenario", "id")  # fmt: skip
 
 
 def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
@@ -74,7 +81,8 @@ def frames_source(path: Path, white: float | None, chunk: int) -> FrameSource:
             for chunk_radiance, times in frames.radiance_chunks(chunk):
                 yield radiance_to_dn(chunk_radiance, white), times
 
-    return FrameSource(width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", radiance())
+    scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
+    return FrameSource(width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", radiance(), scene)
 
 
 def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
@@ -137,6 +145,7 @@ def emulate(
         "input_kind": source.kind,
         **{f"emulator_{k}": v for k, v in asdict(params).items()},
         "traj2events_version": __version__,
+        **source.scene,
     }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
     writer = EventsWriter(output, source.width, source.height, attrs)

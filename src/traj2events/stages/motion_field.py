@@ -87,6 +87,7 @@ def motion_field(
             "id": int(tr.attrs["id"]),
             "traj2events_version": __version__,
             "status_codes": ", ".join(f"{code} {name}" for code, name in enumerate(STATUS_NAMES)),
+            **camera.intrinsics_attrs(),
         }
         log(
             f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"

@@ -101,6 +101,7 @@ class RenderSettings:
             "terrain_half_extent_m": self.half_extent_m,
             "display_white_w_m2_sr": self.display_white_w_m2_sr,
             "display_gamma": self.display_gamma,
+            **camera.intrinsics_attrs(),
         }
 
 
@@ -181,4 +182,7 @@ FRAME_ATTR_ORDER = (
     "scenario",
     "id",
     "traj2events_version",
+    "camera_matrix_px",
+    "distortion",
+    "image_convention",
 )
