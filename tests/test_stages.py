@@ -25,6 +25,10 @@ from traj2events.state import MASS
 SIZE = 16
 
 
+def camera_focal(config) -> float:
+    return Camera(SIZE, SIZE, config["camera"]["fov_deg"]).focal_px
+
+
 @pytest.fixture(scope="module")
 def config():
     return resolve_config(
@@ -133,6 +137,12 @@ def test_events_exports_and_pictures(built, config):
                   frames=built / "frames.h5")  # fmt: skip
     npz = np.load(built / "e.npz")
     assert len(npz["events"]) == n_events and npz["traj"].shape[1] == 12 and npz["range_meter"][0, 1] > 0
+    assert npz["events"]["p"].dtype == bool and (npz["events"]["p"] == (events["p"] == 1)).all()
+    np.testing.assert_allclose(np.diff(npz["range_meter"][:, 0]), 0.1)  # ELOPE's 10 Hz range meter
+    with h5py.File(built / "frames.h5") as f:  # at 5 fps every other sample falls on a frame
+        centre = f["depth_m"][:, SIZE // 2, SIZE // 2]
+    ray = np.sqrt(1 + 2 * (0.5 / camera_focal(config)) ** 2)  # the central pixel is half a pixel off the axis
+    np.testing.assert_allclose(npz["range_meter"][::2, 1], centre[: len(npz["range_meter"][::2])] * ray, rtol=1e-6)
     camera = Camera(SIZE, SIZE, config["camera"]["fov_deg"])
     pictures.frames_picture(built / "trajectory.h5", built / "video.mkv", built / "frames.png")
     pictures.motion_field_picture(built / "trajectory.h5", camera, 1_737_400.0, built / "mf.png", built / "video.mkv")

@@ -18,13 +18,15 @@ def write_elope_npz(
     traj: np.ndarray | None = None,
     range_meter: np.ndarray | None = None,
 ) -> None:
-    """An ELOPE-style .npz: `events` (structured x, y, p, t in us) and, when given,
+    """An ELOPE-style .npz: `events` (structured x, y, p (bool, True = ON), t in us, in
+    the field order ELOPE's loaders unpack) and, when given,
     `timestamps` (s), `traj` (N x 12: position (z negative above the site, our z-down
     frame), velocity, roll/pitch/yaw, body rates) and `range_meter` (N x 2: t, distance
-    along the central pixel's ray, 0 = sky)."""
-    elope = np.empty(len(events), [("x", "<u2"), ("y", "<u2"), ("p", "u1"), ("t", "<i8")])
-    for name in ("x", "y", "p", "t"):
+    along the central pixel's ray, 0 = sky; the workflow samples it at 10 Hz, as ELOPE)."""
+    elope = np.empty(len(events), [("x", "<u2"), ("y", "<u2"), ("p", "?"), ("t", "<i8")])
+    for name in ("x", "y", "t"):
         elope[name] = events[name]
+    elope["p"] = events["p"] == 1
     data = {"events": elope}
     if timestamps_s is not None:
         data["timestamps"] = timestamps_s

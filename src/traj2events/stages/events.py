@@ -170,15 +170,23 @@ def emulate(
     return n_frames, n_events, t_last
 
 
-def central_range(frames: str | os.PathLike) -> np.ndarray:
-    """(n, 2): t (s) and the distance along the central pixel's ray (m, 0 = sky), from
-    frames.h5's depth (which is along the boresight)."""
+RANGE_METER_HZ = 10.0  # ELOPE's range meter rate
+
+
+def central_range(frames: str | os.PathLike, rate_hz: float = RANGE_METER_HZ) -> np.ndarray:
+    """(n, 2): t (s) every 1/rate_hz and the distance along the central pixel's ray (m,
+    0 = sky) in the frame nearest that time, from frames.h5's depth (along the boresight)."""
     with FramesFile(frames) as f:
         _, h, w = f.shape
         i, j = h // 2, w // 2
         focal = float(f.attrs["focal_px"])
         ray = np.sqrt(1.0 + ((j + 0.5 - w / 2) / focal) ** 2 + ((i + 0.5 - h / 2) / focal) ** 2)
-        return np.stack([f.t, f.depth_at(i, j) * ray], axis=1)
+        distance = f.depth_at(i, j) * ray
+        t_frames = f.t
+    t = np.arange(int(np.floor(t_frames[-1] * rate_hz + 1e-9)) + 1) / rate_hz
+    nearest = np.clip(np.searchsorted(t_frames, t), 1, len(t_frames) - 1)
+    nearest -= (t - t_frames[nearest - 1]) < (t_frames[nearest] - t)
+    return np.stack([t, distance[nearest]], axis=1)
 
 
 def export_events(
