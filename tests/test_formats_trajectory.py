@@ -125,7 +125,7 @@ def test_reading_outputs_needs_only_numpy_and_h5py(tmp_path, solved30, vehicle):
     heavy = ("casadi", "numba", "pyrender", "OpenGL", "scipy", "matplotlib", "yaml", "pandas")
     code = (
         "import sys, traj2events.formats.events, traj2events.formats.flow, traj2events.formats.frames, "
-        "traj2events.formats.exports\n"
+        "traj2events.formats.exports, traj2events.data\n"
         "from traj2events.formats.trajectory import read_trajectory\n"
         f"read_trajectory({str(tmp_path / 't.h5')!r})\n"
         f"print(sorted(m for m in {heavy!r} if m in sys.modules))"

@@ -119,6 +119,32 @@ def test_smoke_dataset_is_complete(built):
     assert not list(results.rglob("*.part"))  # no temporary files left
 
 
+def test_the_loader_reads_the_built_dataset(built):
+    from traj2events.data import EventWindows, open_dataset
+    from traj2events.formats.events import read_events
+
+    dataset = open_dataset(built / "results")
+    assert [(x.scenario, x.id) for x in dataset] == [("descent", 0), ("descent", 1), ("hover", 0)]
+    landing = dataset.find("descent", 1)
+    everything, attrs = read_events(landing.folder / "events.h5")
+    window = landing.events(1.0, 1.5)
+    expected = everything[(everything["t"] >= 1_000_000) & (everything["t"] < 1_500_000)]
+    assert len(window) > 0 and window.tobytes() == expected.tobytes()
+    t, state = landing.poses()
+    assert state.shape == (len(t), 13) and np.allclose(np.diff(t), 0.1)
+    field = landing.motion_field(2)
+    assert field["frame_index"] == 2 and field["displacement_terrain"].shape == (32, 32, 2)
+    assert field["status_terrain"].dtype == np.uint8
+    radiance, depth = landing.frame(5)
+    with h5py.File(landing.folder / "frames.h5") as f:
+        assert (radiance == f["radiance"][5]).all() and (depth == f["depth_m"][5]).all()
+    np.testing.assert_allclose(landing.camera_matrix[0, 0], attrs["focal_px"])
+    windows = EventWindows(dataset, 0.5)
+    assert len(windows) == sum(int(x.poses()[0][-1] / 0.5 + 1e-9) for x in dataset)
+    events, start, owner = windows[3]
+    assert owner == dataset[0] and start == 1.5 and events.tobytes() == dataset[0].events(1.5, 2.0).tobytes()
+
+
 def test_second_run_has_nothing_to_do(built):
     run = snakemake(built)
     assert "Nothing to be done" in run.stdout + run.stderr

@@ -1,0 +1,127 @@
+"""Load a built dataset from Python, with numpy and h5py only.
+
+    from traj2events.data import open_dataset
+
+    dataset = open_dataset("results")
+    landing = dataset[0]                     # or dataset.find("descent", 0)
+    events = landing.events(1.0, 1.01)       # structured x, y, t (us), p in [1.00, 1.01) s
+    t, state = landing.poses()               # (K,) s, (K, 13) in the units of state_units
+    fields = landing.motion_field(3)         # the 4th field written: arrays by name
+    radiance, depth = landing.frame(100)     # frames.h5, when kept
+
+Each `Landing` reads only what is asked, when it is asked (event windows through
+`ms_to_idx`), so a dataset far larger than memory iterates fine; a torch `DataLoader`
+can wrap `EventWindows` (map-style: `len` and `[i]`) without this module importing torch.
+"""
+
+from __future__ import annotations
+
+import csv
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from .formats.events import read_events_attrs, read_events_window
+from .formats.frames import FramesFile
+from .formats.hdf5 import open_file
+from .formats.trajectory import read_trajectory
+
+
+@dataclass(frozen=True)
+class Landing:
+    """One trajectory's files: `folder` is results/{scenario}/{id}/."""
+
+    scenario: str
+    id: int
+    folder: Path
+
+    def poses(self) -> tuple[np.ndarray, np.ndarray]:
+        """Camera pose times (K,) s and states (K, 13) at the frame rate."""
+        tr = read_trajectory(self.folder / "trajectory.h5")
+        return tr.t, tr.state
+
+    @property
+    def camera_matrix(self) -> np.ndarray:
+        """K (3 x 3, px), from events.h5 (or frames.h5)."""
+        return np.asarray(self._scene_attrs()["camera_matrix_px"])
+
+    def _scene_attrs(self) -> dict:
+        if (self.folder / "events.h5").exists():
+            return read_events_attrs(self.folder / "events.h5")
+        with FramesFile(self.folder / "frames.h5") as frames:
+            return dict(frames.attrs)
+
+    def events(self, t_start_s: float, t_end_s: float) -> np.ndarray:
+        """Events with t in [t_start, t_end) s: structured x, y, t (us), p (1 = ON)."""
+        return read_events_window(self.folder / "events.h5", round(t_start_s * 1e6), round(t_end_s * 1e6))
+
+    def motion_field(self, i: int) -> dict[str, np.ndarray]:
+        """The i-th written field: every dataset of motion_field.h5 at index i (and `t`,
+        `frame_index`), e.g. `displacement_terrain` (H, W, 2) px and `status_terrain`."""
+        with open_file(self.folder / "motion_field.h5", "motion_field.h5") as f:
+            n = len(f["t"])
+            if not -n <= i < n:
+                raise IndexError(f"{self.folder / 'motion_field.h5'}: field {i} of {n}")
+            return {name: f[name][i] for name in f if isinstance(f[name], h5py.Dataset) and len(f[name]) == n}
+
+    def frame(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Frame k's linear radiance (H, W) W m^-2 sr^-1 and depth (H, W) m (frames.h5 kept)."""
+        with FramesFile(self.folder / "frames.h5") as frames:
+            return frames.radiance(k), frames.depth_m(k)
+
+
+class Dataset:
+    """The landings of a built results/ folder, in the order of each scenario's index.csv."""
+
+    def __init__(self, results: str | os.PathLike):
+        self.results = Path(results)
+        indexes = sorted(self.results.glob("*/index.csv"))
+        if not indexes:
+            raise FileNotFoundError(f"{self.results}: no */index.csv (build the dataset with snakemake first)")
+        self.landings = []
+        for index in indexes:
+            with open(index, newline="") as fh:
+                for row in csv.DictReader(fh):
+                    folder = self.results / row["scenario"] / f"{int(row['id']):04d}"
+                    self.landings.append(Landing(row["scenario"], int(row["id"]), folder))
+
+    def __len__(self) -> int:
+        return len(self.landings)
+
+    def __getitem__(self, i: int) -> Landing:
+        return self.landings[i]
+
+    def find(self, scenario: str, id: int) -> Landing:
+        for landing in self.landings:
+            if landing.scenario == scenario and landing.id == id:
+                return landing
+        raise KeyError(f"{self.results}: no landing {scenario} {id:04d}")
+
+
+def open_dataset(results: str | os.PathLike = "results") -> Dataset:
+    return Dataset(results)
+
+
+class EventWindows:
+    """Fixed windows of events over every landing, map-style (`len`, `[i]`), for a
+    training loop or a torch DataLoader: item i is (events, t_start_s, landing)."""
+
+    def __init__(self, dataset: Dataset, window_s: float):
+        if not window_s > 0:
+            raise ValueError(f"window_s: expected > 0, got {window_s}")
+        self.window_s = window_s
+        self.items: list[tuple[Landing, float]] = []
+        for landing in dataset.landings:
+            t, _ = landing.poses()
+            n = int(np.floor(t[-1] / window_s + 1e-9))
+            self.items += [(landing, k * window_s) for k in range(n)]
+
+    def __len__(self) -> int:
+        return len(self.items)
+
+    def __getitem__(self, i: int) -> tuple[np.ndarray, float, Landing]:
+        landing, start = self.items[i]
+        return landing.events(start, start + self.window_s), start, landing
