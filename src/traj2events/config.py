@@ -156,13 +156,12 @@ def _semantic_errors(config: dict) -> list[str]:
 
 def _display_errors(config: dict) -> list[str]:
     """A display white far above any radiance the scene can have gives black videos."""
+    from .illumination import Sun
     from .reflectance import ReflectanceParams, max_radiance_factor
 
-    reflectance = ReflectanceParams(**config["render"]["reflectance"])
-    brightest = max(
-        max_radiance_factor(reflectance, n=21) * 1361.0 * (1.495978707e11 / sc["sun"]["range_m"]) ** 2 / math.pi
-        for sc in config["scenarios"].values()
-    )
+    factor = max_radiance_factor(ReflectanceParams(**config["render"]["reflectance"]), n=21)
+    irradiance = max(Sun(**sc["sun"]).irradiance_w_m2 for sc in config["scenarios"].values())
+    brightest = factor * irradiance / math.pi
     white = config["render"]["display_white_w_m2_sr"]
     if white > 10 * brightest:
         return [

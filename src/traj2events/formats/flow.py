@@ -14,15 +14,24 @@ from .hdf5 import create, set_attrs, write_dataset
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
 
-def write_flo(path: str | os.PathLike, flow: np.ndarray) -> None:
+def flo_bytes(flow: np.ndarray) -> bytes:
     """Middlebury .flo: magic, int32 width, int32 height, then (u, v) float32 per pixel,
     row by row. cv2.readOpticalFlow reads it back bit for bit."""
     flow = np.ascontiguousarray(flow, dtype="<f4")
     if flow.ndim != 3 or flow.shape[2] != 2:
-        raise ValueError(f"{path}: expected a flow of shape (H, W, 2), got {flow.shape}")
+        raise ValueError(f"expected a flow of shape (H, W, 2), got {flow.shape}")
     header = np.array([FLO_MAGIC], dtype="<f4").tobytes() + np.array(flow.shape[1::-1], dtype="<i4").tobytes()
+    return header + flow.tobytes()
+
+
+def write_flo(path: str | os.PathLike, flow: np.ndarray) -> None:
+    """One .flo file, written atomically (see flo_bytes)."""
+    try:
+        data = flo_bytes(flow)
+    except ValueError as exc:
+        raise ValueError(f"{path}: {exc}") from None
     with atomic_output(path) as tmp:
-        tmp.write_bytes(header + flow.tobytes())
+        tmp.write_bytes(data)
 
 
 def read_flo(path: str | os.PathLike) -> np.ndarray:

@@ -10,11 +10,10 @@ import os
 from pathlib import Path
 from typing import Iterator
 
-import h5py
 import numpy as np
 
 from .atomic import atomic_output, ensure_free_space
-from .hdf5 import Attributes, FileFormatError, create, set_attrs, write_dataset, write_errors_named
+from .hdf5 import Attributes, FileFormatError, create, open_for_reading, set_attrs, write_dataset, write_errors_named
 
 
 def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
@@ -81,12 +80,7 @@ class FramesFile:
 
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
-        if not self.path.is_file():
-            raise FileNotFoundError(f"{self.path}: no such file (expected frames.h5)")
-        try:
-            self._file = h5py.File(self.path, "r")
-        except OSError as exc:
-            raise FileFormatError(f"{self.path}: not a readable HDF5 file (expected frames.h5): {exc}") from None
+        self._file = open_for_reading(self.path, "frames.h5")
         if "radiance" not in self._file or "t" not in self._file:
             self._file.close()
             raise FileFormatError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' and 't')")

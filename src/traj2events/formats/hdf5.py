@@ -53,16 +53,22 @@ class Attributes(dict):
         raise FileFormatError(f"{self.path}: missing attribute '{key}'")
 
 
-@contextlib.contextmanager
-def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
-    """An HDF5 file for reading; a missing, unreadable or truncated file, or a missing
-    dataset, group or attribute, is an error that names the file and what was expected."""
+def open_for_reading(path: str | os.PathLike, expected: str) -> h5py.File:
+    """An HDF5 file opened for reading; a missing, unreadable or truncated file is an
+    error that names the file and what was expected."""
     if not Path(path).is_file():
         raise FileNotFoundError(f"{path}: no such file (expected {expected})")
     try:
-        f = h5py.File(path, "r")
+        return h5py.File(path, "r")
     except OSError as exc:
         raise FileFormatError(f"{path}: not a readable HDF5 file (expected {expected}): {exc}") from None
+
+
+@contextlib.contextmanager
+def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
+    """open_for_reading as a context; a missing dataset, group or attribute inside it is
+    also an error naming the file."""
+    f = open_for_reading(path, expected)
     try:
         yield f
     except KeyError as exc:

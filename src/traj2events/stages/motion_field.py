@@ -12,7 +12,7 @@ import numpy as np
 from .. import __version__
 from ..camera import Camera
 from ..formats.atomic import atomic_directory
-from ..formats.flow import write_flo, write_motion_field
+from ..formats.flow import flo_bytes, write_motion_field
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
 from ..motion_field import (
@@ -93,6 +93,7 @@ def motion_field(
             f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"
             + (f", terrain-true from {frames}" if rendered is not None else "")
         )
+        next_depth = (-1, None)  # frame k+1's depth, reused as frame k's when every frame is written
         with atomic_directory(flo_dir) as tmp_dir:
             for i, k in enumerate(picked):
                 flow, on_sphere = sphere_flow(camera, tr.state[k], moon_radius_m, np.float32)
@@ -100,14 +101,14 @@ def motion_field(
                 disp, status = sphere_displacement(camera, tr.state[k], tr.state[k + 1], moon_radius_m)
                 fields["displacement_sphere"][i], fields["status_sphere"][i] = disp, status
                 fields["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
-                write_flo(Path(tmp_dir) / f"{k:06d}.flo", fields["displacement_sphere"][i])
+                # The folder is atomic as a whole: its files need no temporary of their own.
+                (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(fields["displacement_sphere"][i]))
                 if rendered is not None:
-                    depth = rendered.depth_m(k)
+                    depth = next_depth[1] if next_depth[0] == k else rendered.depth_m(k)
+                    next_depth = (k + 1, rendered.depth_m(k + 1))
                     terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
                     fields["flow_terrain"][i] = terrain_flow
-                    disp, status = depth_displacement(
-                        camera, tr.state[k], tr.state[k + 1], depth, rendered.depth_m(k + 1)
-                    )
+                    disp, status = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth, next_depth[1])
                     fields["displacement_terrain"][i], fields["status_terrain"][i] = disp, status
                     fields["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
                     both = seen & on_sphere
