@@ -18,7 +18,7 @@ from traj2events.stages.events import emulate, emulator_params, export_events, f
 from traj2events.stages.index import dataset_index
 from traj2events.stages.motion_field import motion_field
 from traj2events.stages.render import RenderSettings, render_trajectory
-from traj2events.stages.sample_trajectories import initial_values, sample_trajectories
+from traj2events.stages.sample_trajectories import SAMPLE_TABLE_COLUMNS, initial_values, sample_trajectories
 from traj2events.stages.summary import dataset_summary
 from traj2events.state import MASS
 
@@ -65,6 +65,7 @@ def test_base_and_samples_are_solved_and_tabled(built, config):
     assert base.t is None and base.attrs["solver_success"] and base.attrs["scenario"] == "descent"
     table = pd.read_csv(built / "samples.csv")
     assert list(table["id"]) == [0, 1] and list(table["draw"]) == [0, 1] and table["success"].all()
+    assert list(table.columns) == list(SAMPLE_TABLE_COLUMNS) and not table.drop(columns="reason").isna().any().any()
     solutions = read_solution_set(built / "solutions.h5")
     for i, row in table.iterrows():
         sample = solutions["samples"][i]
@@ -95,6 +96,24 @@ def test_an_unsolvable_base_problem_is_named(config, tmp_path):
     with pytest.raises(BaseSolveError, match="scenario 'descent'"):
         base_solution(s, tmp_path / "base.h5")
     assert not list(tmp_path.iterdir())
+
+
+def test_a_recorded_base_failure_reaches_the_summary_and_names_itself(config, tmp_path):
+    # What the workflow does: base.h5 records the failure, sampling draws nothing, the
+    # summary reports the scenario, and each of its trajectories fails naming the cause.
+    bad = dict(config["scenarios"]["descent"], altitude_m=[90000.0, 90000.0])
+    s = ScenarioSettings.from_config(
+        resolve_config({"ocp": {"max_iter": 15}, "scenarios": {"descent": bad}}), "descent"
+    )
+    sol = base_solution(s, tmp_path / "base.h5", record_failure=True)
+    assert not sol.success and not read_trajectory(tmp_path / "base.h5").attrs["solver_success"]
+    assert sample_trajectories(s, tmp_path / "base.h5", tmp_path / "solutions.h5", tmp_path / "samples.csv") == []
+    assert list(pd.read_csv(tmp_path / "samples.csv").columns) == list(SAMPLE_TABLE_COLUMNS)
+    summary = dataset_summary([tmp_path / "solutions.h5"], [tmp_path / "samples.csv"], tmp_path / "summary.csv")
+    row = summary.iloc[0]
+    assert (row["draws"], row["solved"], row["missing"]) == (0, 0, 2) and row["base_status"] == sol.status
+    with pytest.raises(ValueError, match=f"no trajectory 0: the base solve of 'descent' failed \\({sol.status}\\)"):
+        camera_poses(tmp_path / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "t.h5")
 
 
 def test_render_writes_frames_and_a_lossless_video_of_them(built):

@@ -365,18 +365,25 @@ def test_a_failing_scenario_does_not_stop_the_others(tmp_path):
     # 90 km up at 15-20 m/s: the base problem solves, but no sample meets the accuracy
     # (measured with the earlier descent ranges: 8.8 m off).
     config["scenarios"]["hover"].update(altitude_m=[90000.0, 90000.0], speed_forward_m_s=[15.0, 20.0], n_trajectories=1)
+    # 900 m/s down: even the base problem has no solution (IPOPT gives up within ~2 s).
+    config["scenarios"]["crash"] = dict(config["scenarios"]["hover"], speed_down_m_s=[900.0, 900.0])
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
     run = snakemake(tmp_path, check=False)
     assert run.returncode != 0  # the run ends non-zero, naming what failed and why
     out = run.stdout + run.stderr
     assert "Error in rule camera_poses" in out and "scenario=hover" in out
     assert "no trajectory 0: 0 of 1 samples of 'hover' solved in 5 draws" in out  # 1 + 4 replacements
+    assert "no trajectory 0: the base solve of 'crash' failed (" in out
+    assert not (tmp_path / "results" / "crash" / "index.csv").exists()
     assert not (tmp_path / "results" / "hover" / "index.csv").exists()  # not an empty file
     summary = pd.read_csv(tmp_path / "results" / "summary.csv").set_index("scenario")
     assert summary.loc["hover", "failed"] == 5 and summary.loc["hover", "missing"] == 1
     assert summary.loc["descent", "failed"] == 0 and summary.loc["descent", "missing"] == 0
+    assert summary.loc["crash", "base_status"] != "Solve_Succeeded" and summary.loc["crash", "draws"] == 0
+    assert summary.loc["descent", "base_status"] == "Solve_Succeeded"
     index = pd.read_csv(tmp_path / "results" / "descent" / "index.csv")  # the healthy scenario is complete
     assert list(index["id"]) == [0, 1] and (tmp_path / "results" / "descent" / "0001" / "events.png").exists()
+    assert (tmp_path / "results" / "figures" / "trajectories.png").exists()
 
 
 def test_invalid_config_stops_before_any_job(tmp_path):

@@ -40,7 +40,7 @@ def cmd_base(args) -> int:
     from .scenarios import ScenarioSettings
     from .stages.base_solution import base_solution
 
-    base_solution(_settings(ScenarioSettings, args.settings), args.output)
+    base_solution(_settings(ScenarioSettings, args.settings), args.output, record_failure=args.record_failure)
     return 0
 
 
@@ -225,6 +225,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("base", help="solve a scenario's base problem (every range at its midpoint)")
     p.add_argument("--settings", required=True, help=settings_help)
     p.add_argument("--output", "-o", required=True, help="base.h5 (nodes only)")
+    p.add_argument(
+        "--record-failure",
+        action="store_true",
+        help="if the problem does not solve, write base.h5 recording it (solver_success 0) and exit 0 "
+        "(the workflow does, so that the failure reaches summary.csv); default: exit 1 and write nothing",
+    )
     p.set_defaults(func=cmd_base)
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")

@@ -15,7 +15,7 @@ rule base_solution:
         settings=scenario_settings,
         code=code("base_solution"),
     shell:
-        "traj2events base --settings {params.settings:q} --output {output} 2> {log}"
+        "traj2events base --settings {params.settings:q} --record-failure --output {output} 2> {log}"
 
 
 rule sample_trajectories:

@@ -20,8 +20,8 @@ class BaseSolveError(ValueError):
 
 
 def solve_base(settings: ScenarioSettings) -> tuple[Solution, object]:
-    """(solution, boundary conditions) of the scenario's base problem; BaseSolveError if
-    no t_f guess converges."""
+    """(solution, boundary conditions) of the scenario's base problem: the first t_f guess
+    that converges, else the last failed attempt (solution.success is False)."""
     s = settings
     problem = LandingProblem(s.vehicle, s.ocp)
     bc = base_conditions(s.scenario, s.vehicle)
@@ -31,16 +31,28 @@ def solve_base(settings: ScenarioSettings) -> tuple[Solution, object]:
         sol = problem.solve(trial)
         log(f"{s.scenario.name}: {sol.status} after {sol.iterations} iterations, {sol.solve_time_s:.2f} s")
         if sol.success:
-            return sol, bc
-    raise BaseSolveError(
-        f"scenario '{s.scenario.name}': the base problem (midpoint of every range) did not "
-        f"solve: {sol.status}. Check the ranges and vehicle in the config."
+            break
+    return sol, bc
+
+
+def failure_message(scenario: str, status: str) -> str:
+    return (
+        f"scenario '{scenario}': the base problem (midpoint of every range) did not solve: {status}. "
+        "Check the ranges and vehicle in the config."
     )
 
 
-def base_solution(settings: ScenarioSettings, output: str | os.PathLike) -> Solution:
-    """Solve the base problem and write base.h5 (nodes only)."""
+def base_solution(settings: ScenarioSettings, output: str | os.PathLike, record_failure: bool = False) -> Solution:
+    """Solve the base problem and write base.h5 (nodes only). A base problem that does not
+    solve is a BaseSolveError, or with `record_failure` a base.h5 that records it
+    (solver_success 0, the last attempt's nodes), so that the workflow samples nothing for
+    the scenario but still reports it in the summary."""
     sol, bc = solve_base(settings)
+    if not sol.success:
+        message = failure_message(settings.scenario.name, sol.status)
+        if not record_failure:
+            raise BaseSolveError(message)
+        log(f"ERROR {message} Recorded in {output}; the scenario will have no trajectory.")
     attrs = {
         **vehicle_attrs(settings.vehicle),
         **solution_attrs(sol, bc),

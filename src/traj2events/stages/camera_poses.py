@@ -25,6 +25,12 @@ def camera_poses(
     data = read_solution_set(solutions)
     s = ScenarioSettings.from_json(data["attrs"]["settings"])
     sample = next((x for x in data["samples"].values() if x.get("id") == sample_id), None)
+    if sample is None and not data["attrs"]["base_solver_success"]:
+        raise ValueError(
+            f"{solutions}: no trajectory {sample_id}: the base solve of {s.scenario.name!r} failed "
+            f"({data['attrs']['base_solver_status']}), so no sample was drawn. "
+            "Check the scenario's ranges and the vehicle in the config."
+        )
     if sample is None:
         draws = list(data["samples"].values())
         solved = sum(x.get("id", -1) >= 0 for x in draws)

@@ -81,6 +81,12 @@ def sample_row(r: SampleResult, trajectory_id: int) -> dict:
     }
 
 
+# samples.csv's columns (named also when no sample was drawn).
+SAMPLE_TABLE_COLUMNS = ("draw", "id", "success", "method", "attempts", "reason", "status", "N", "iterations",
+                        "total_iterations", "tf_s", "final_mass_kg", "cost", "error_position_m", "error_velocity_m_s",
+                        "solve_time_s", *RANGE_KEYS)  # fmt: skip
+
+
 def read_base(path: str | os.PathLike, settings: ScenarioSettings) -> Solution:
     base = read_trajectory(path)
     return Solution(
@@ -88,7 +94,7 @@ def read_base(path: str | os.PathLike, settings: ScenarioSettings) -> Solution:
         base.state_nodes,
         base.control_nodes,
         float(base.attrs["cost"]),
-        True,
+        bool(base.attrs["solver_success"]),
         str(base.attrs["solver_status"]),
         0,
         0.0,
@@ -104,20 +110,26 @@ def sample_trajectories(
     jobs: int = 1,
 ) -> list[SampleResult]:
     """Solve the scenario's samples (drawing again for failed ones); write solutions.h5
-    and samples.csv."""
+    and samples.csv. A base that did not solve (recorded by `traj2events base
+    --record-failure`) draws nothing: both files say so and hold no sample."""
     s = settings
-    log(f"{s.scenario.name}: solving {s.scenario.n_trajectories} samples on {jobs} process(es)")
-    start = time.perf_counter()
-    results = solve_samples(
-        s.vehicle,
-        s.ocp,
-        s.scenario,
-        s.seed,
-        base_conditions(s.scenario, s.vehicle),
-        read_base(base, s),
-        jobs=jobs,
-        progress=print_progress,
-    )
+    base_solution = read_base(base, s)
+    if base_solution.success:
+        log(f"{s.scenario.name}: solving {s.scenario.n_trajectories} samples on {jobs} process(es)")
+        start = time.perf_counter()
+        results = solve_samples(
+            s.vehicle,
+            s.ocp,
+            s.scenario,
+            s.seed,
+            base_conditions(s.scenario, s.vehicle),
+            base_solution,
+            jobs=jobs,
+            progress=print_progress,
+        )
+    else:
+        log(f"{s.scenario.name}: ERROR the base solve failed ({base_solution.status}): no sample drawn")
+        start, results = time.perf_counter(), []
     failed = [r for r in results if not r.success]
     solved = len(results) - len(failed)
     log(
@@ -132,6 +144,8 @@ def sample_trajectories(
         "seed": s.seed,
         "settings": s.to_json(),
         "n_trajectories": s.scenario.n_trajectories,
+        "base_solver_status": base_solution.status,
+        "base_solver_success": base_solution.success,
         "traj2events_version": __version__,
     }
     samples = {
@@ -140,5 +154,6 @@ def sample_trajectories(
     }
     write_solution_set(solutions, samples, attrs)
     with atomic_output(table) as tmp:
-        pd.DataFrame([sample_row(r, i) for r, i in zip(results, ids)]).to_csv(tmp, index=False, float_format="%.9g")
+        rows = [sample_row(r, i) for r, i in zip(results, ids)]
+        pd.DataFrame(rows, columns=SAMPLE_TABLE_COLUMNS).to_csv(tmp, index=False, float_format="%.9g")
     return results

@@ -36,19 +36,23 @@ def read_sample_table(path: str | os.PathLike) -> pd.DataFrame:
     return table
 
 
-def summary_table(scenarios: list[str], wanted: list[int], sample_tables: list[pd.DataFrame]) -> pd.DataFrame:
-    """Per scenario: trajectories wanted, draws, solved, failed, missing (wanted but not
-    solved), final mass and t_f ranges, worst re-integration error."""
+def summary_table(
+    scenarios: list[str], wanted: list[int], base_status: list[str], sample_tables: list[pd.DataFrame]
+) -> pd.DataFrame:
+    """Per scenario: trajectories wanted, the base solve's status, draws, solved, failed,
+    missing (wanted but not solved), final mass and t_f ranges, worst re-integration error."""
     rows = []
-    for name, n_wanted, table in zip(scenarios, wanted, sample_tables):
-        ok = table[table["success"]]
+    for name, n_wanted, status, table in zip(scenarios, wanted, base_status, sample_tables):
+        success = table["success"].astype(bool)
+        ok = table[success]
         rows.append(
             {
                 "scenario": name,
                 "wanted": n_wanted,
+                "base_status": status,
                 "draws": len(table),
                 "solved": len(ok),
-                "failed": int((~table["success"]).sum()),
+                "failed": int((~success).sum()),
                 "missing": max(n_wanted - len(ok), 0),
                 "solved_first_try": int((table["method"] == "warm").sum()),
                 "refined": int(table["method"].str.endswith("+refined").sum()),
@@ -74,13 +78,17 @@ def dataset_summary(
     table = summary_table(
         [a["scenario"] for a in attrs],
         [int(a["n_trajectories"]) for a in attrs],
+        [str(a["base_solver_status"]) for a in attrs],
         [read_sample_table(p) for p in tables],
     )
     with atomic_output(output) as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")
     print(table.to_string(index=False), file=sys.stderr)
-    for row in table.itertuples():
-        if row.missing:
+    for row, a in zip(table.itertuples(), attrs):
+        if not a["base_solver_success"]:
+            print(f"WARNING: {row.scenario}: the base solve failed ({row.base_status}), so it has no trajectory",
+                  file=sys.stderr)  # fmt: skip
+        elif row.missing:
             print(f"WARNING: {row.scenario}: {row.missing} of {row.wanted} trajectories have no solved sample",
                   file=sys.stderr)  # fmt: skip
     return table
