@@ -11,6 +11,15 @@ from snakemake.utils import min_version
 
 min_version("9.0")
 
+from traj2events.config import ConfigError, load_yaml
+
+# Snakemake's own reader answers a file that is not UTF-8 YAML with a traceback; ours names
+# the file and the fault. (Files given by --configfile Snakemake reads before this line.)
+try:
+    load_yaml("config/config.yaml", missing_ok=True)
+except ConfigError as error:
+    raise WorkflowError(f"invalid configuration: {error}")
+
 
 configfile: "config/config.yaml"
 

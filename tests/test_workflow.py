@@ -396,6 +396,17 @@ def test_invalid_config_stops_before_any_job(tmp_path):
     assert not (tmp_path / "results").exists()
 
 
+def test_a_config_file_that_is_not_utf8_is_named(tmp_path):
+    # config/config.yaml is read by the Snakefile: its faults get a message, not a traceback.
+    (tmp_path / "config").mkdir()
+    (tmp_path / "config" / "config.yaml").write_bytes(b"camera:\n  width: \xff\xfe64\n")
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump({}))
+    run = snakemake(tmp_path, "-n", check=False)
+    out = run.stdout + run.stderr
+    assert run.returncode != 0 and "config file 'config/config.yaml' is not UTF-8 text" in out
+    assert "Traceback" not in out and not (tmp_path / "results").exists()
+
+
 def test_lint_passes():
     run = subprocess.run(
         [str(SNAKEMAKE), "--lint", "-s", str(ROOT / "Snakefile")], capture_output=True, text=True, cwd=ROOT

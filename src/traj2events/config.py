@@ -184,12 +184,18 @@ def validate_config(config: Any, schema: dict | None = None) -> None:
         raise ConfigError(semantic[0])
 
 
-def load_yaml(path: str | Path) -> Any:
+def load_yaml(path: str | Path, missing_ok: bool = False) -> Any:
+    """A YAML file's content; ConfigError naming the file if it is missing (None with
+    `missing_ok`), unreadable, not UTF-8 or not YAML."""
     try:
         with open(path, encoding="utf-8") as fh:
             return yaml.safe_load(fh)
     except FileNotFoundError:
+        if missing_ok:
+            return None
         raise ConfigError(f"config file '{path}' not found") from None
+    except OSError as exc:
+        raise ConfigError(f"config file '{path}' cannot be read: {exc.strerror}") from None
     except UnicodeDecodeError as exc:
         raise ConfigError(f"config file '{path}' is not UTF-8 text: {exc}") from None
     except yaml.YAMLError as exc:
