@@ -16,6 +16,12 @@ python bench/trajectories.py compare --a JSON --b JSON [--samples 30]
     accepted (ocp.accept_error_m / _m_s, as the workflow), worst error. JSON keys: ocp settings (n_nodes,
     mesh_clustering, tol, ...) or IPOPT options (mu_init, ...), e.g.
     --a '{}' --b '{"mu_init": 0.1}'.
+python bench/trajectories.py motion [--config config/config.yaml] [--vehicle config/vehicle-agile.yaml]
+        [--samples 12] [--jobs 2]
+    How the samples move with the config's vehicle (A) and with a vehicle overlay (B), scenario
+    by scenario, A and B alternated: solved share, t_f, whether the pitch keeps decreasing
+    (its rise above the running minimum; "monotone" = at most 2 deg), how often it reaches
+    the tilt limit, roll and yaw swings, horizontal travel per altitude lost, solve CPU time.
 """
 
 from __future__ import annotations
@@ -37,8 +43,9 @@ sys.path.insert(0, str(ROOT / "src"))
 import numpy as np  # noqa: E402
 
 from traj2events.batch import solve_samples  # noqa: E402
-from traj2events.config import load_config  # noqa: E402
+from traj2events.config import load_config, load_yaml, merge_config, resolve_config  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
+from traj2events.motion_stats import motion_summary  # noqa: E402
 from traj2events.ocp import LandingProblem  # noqa: E402
 from traj2events.scenarios import (  # noqa: E402
     ScenarioSettings,  # noqa: E402
@@ -168,9 +175,56 @@ def compare(config: dict, a: dict, b: dict, n_samples: int) -> None:
         )
 
 
+MONOTONE_DEG = 2.0  # a pitch rise up to this is read as "keeps decreasing"
+
+
+def solve_scenario(config: dict, name: str, n_samples: int, jobs: int) -> tuple[list, float]:
+    """(solved results, solve CPU seconds) of one scenario's first n_samples trajectories."""
+    config = merge_config(config, {"scenarios": {name: {"n_trajectories": n_samples}}})
+    s = ScenarioSettings.from_config(config, name)
+    base = LandingProblem(s.vehicle, s.ocp).solve(base_conditions(s.scenario, s.vehicle))
+    if not base.success:
+        return [], base.solve_time_s
+    results = solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base, jobs)
+    return results, base.solve_time_s + sum(r.total_time_s for r in results)
+
+
+def motion(config: dict, overlay_path: str, n_samples: int, jobs: int) -> None:
+    variant_b = resolve_config(merge_config(config, load_yaml(ROOT / overlay_path)))
+    variants = {"A (config)": config, f"B ({overlay_path})": variant_b}
+    print(
+        "| scenario | vehicle | solved / draws | t_f (s, median) | pitch start (deg) | monotone pitch "
+        f"(rise <= {MONOTONE_DEG:g} deg) | pitch rise (deg, median / max) | at the tilt limit "
+        "| roll swing (deg, median / max) | yaw swing (deg, median / max) | travel / drop (median) | solve CPU (s) |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for name in config["scenarios"]:
+        for label, cfg in variants.items():
+            results, cpu_s = solve_scenario(cfg, name, n_samples, jobs)
+            ok = [r for r in results if r.success]
+            if not ok:
+                print(f"| {name} | {label} | 0 / {len(results)} | | | | | | | | | {cpu_s:.1f} |", flush=True)
+                continue
+            rows = [motion_summary(r.solution.state) for r in ok]
+            m = {k: np.array([row[k] for row in rows]) for k in rows[0]}
+            tilt = cfg["vehicle"]["tilt_max_deg"]
+            med = np.median
+            print(
+                f"| {name} | {label} | {len(ok)} / {len(results)} | {med([r.solution.tf_s for r in ok]):.0f} "
+                f"| {med(m['pitch_start_deg']):.0f} | {np.mean(m['pitch_rise_deg'] <= MONOTONE_DEG):.0%} "
+                f"| {med(m['pitch_rise_deg']):.1f} / {m['pitch_rise_deg'].max():.1f} "
+                f"| {np.mean(m['pitch_max_deg'] >= tilt - 1.0):.0%} "
+                f"| {med(m['roll_excursion_deg']):.0f} / {m['roll_excursion_deg'].max():.0f} "
+                f"| {med(m['yaw_excursion_deg']):.0f} / {m['yaw_excursion_deg'].max():.0f} "
+                f"| {med(m['travel_per_drop']):.2f} | {cpu_s:.1f} |",
+                flush=True,
+            )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("mesh", "batch", "compare"))
+    parser.add_argument("what", choices=("mesh", "batch", "compare", "motion"))
+    parser.add_argument("--vehicle", default="config/vehicle-agile.yaml", help="motion: variant B's overlay")
     parser.add_argument("--a", default="{}", help="compare: variant A as JSON")
     parser.add_argument("--b", default="{}", help="compare: variant B as JSON")
     parser.add_argument("--samples", type=int, default=30, help="compare: samples per scenario")
@@ -183,13 +237,15 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--verify", action="store_true", help="batch: re-check every sample with DOP853 afterwards")
     args = parser.parse_args()
-    default = "config/config.yaml" if args.what == "mesh" else "config/paper.yaml"
+    default = "config/config.yaml" if args.what in ("mesh", "motion") else "config/paper.yaml"
     config = load_config(ROOT / (args.config or default))
     print(f"# {args.what} on {machine()}, {time.strftime('%Y-%m-%d')}")
     if args.what == "mesh":
         mesh(config, args.repeat)
     elif args.what == "batch":
         batch(config, args.jobs, args.nodes, args.clustering, args.verify)
+    elif args.what == "motion":
+        motion(config, args.vehicle, args.samples, args.jobs)
     else:
         compare(config, json.loads(args.a), json.loads(args.b), args.samples)
 

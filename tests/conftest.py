@@ -11,7 +11,7 @@ from traj2events.ocp import BoundaryConditions, LandingProblem, OcpSettings
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def landing_bc(downrange=1500.0, altitude=600.0, speed=15.0, pitch_deg=5.0, mass=10_000.0, tf_guess=50.0):
+def landing_bc(downrange=1500.0, altitude=600.0, speed=15.0, pitch_deg=5.0, mass=Vehicle().mass_kg, tf_guess=50.0):
     """A descent-like landing towards the site at the origin (z down)."""
     initial = np.array(
         [

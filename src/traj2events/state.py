@@ -33,6 +33,7 @@ CONVENTIONS = {
 POSITION = slice(0, 3)  # m, inertial
 VELOCITY = slice(3, 6)  # m/s, inertial
 ATTITUDE = slice(6, 9)  # rad: roll phi, pitch theta, yaw psi
+ROLL, PITCH, YAW = 6, 7, 8  # rad: the attitude's elements
 BODY_RATES = slice(9, 12)  # rad/s: p, q, r
 MASS = 12  # kg
 POSE = slice(0, 9)  # position, velocity, attitude: what the camera sees
