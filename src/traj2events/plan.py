@@ -23,12 +23,12 @@ EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # meas
 RENDER_S = (0.012, 1.9e-7)  # 128^2: 15 ms/frame, 1024^2: 0.17-0.21 s/frame
 EVENTS_S = (0.0005, 2.0e-8)  # the whole events command (decoding, emulation, writing)
 FIELD_S_PER_PX = 1.5e-6  # motion field with the terrain-true field
-# Peak memory per job (MB): a fixed part and one per pixel (per pixel-field for the motion
-# field, which holds every field it writes), measured with /usr/bin/time on the smoke
-# descent trajectory (694 frames) at 128^2 and 512^2 (docs/benchmarks.md).
+# Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
+# the smoke descent trajectory (694 frames) at 128^2 and 512^2, the motion field at 256^2
+# and 1024^2 (docs/benchmarks.md).
 MEMORY_MB = {
     "render": (1000.0, 4.5e-3),  # 1.15 GB at 128^2, 2.25 GB at 512^2 (tiles in view grow with it)
-    "motion_field": (300.0, 3.5e-5),  # 0.46 GB at 128^2, 6.5 GB at 512^2, 693 fields
+    "motion_field": (300.0, 4e-4),  # 68 MB at 256^2 with terrain, 0.27 GB at 1024^2 sphere only: one field at a time
     "events": (300.0, 3.2e-3),  # 0.28 GB at 128^2, 1.06 GB at 512^2 (64-frame chunks)
     "sample_trajectories": (500.0, 0.0),  # plus 500 MB per process
 }
@@ -143,7 +143,7 @@ def job_resources(config: dict, stage: str, scenario: str | None, threads: int =
         n = config["scenarios"][scenario]["n_trajectories"] if scenario else 1
         seconds = 2 * n * 5.0 / threads  # ~1-5 s per draw, ~2 n draws at most (batch.max_draws)
     fixed, per_px = MEMORY_MB.get(stage, (1000.0, 0.0))
-    mem = fixed + per_px * pixels * (fields if stage == "motion_field" else 1)
+    mem = fixed + per_px * pixels
     if stage == "sample_trajectories":
         mem += 500.0 * threads
     return {"mem_mb": int(mem * 1.25) + 1, "runtime": max(10, int(RUNTIME_MARGIN * seconds / 60.0) + 1)}

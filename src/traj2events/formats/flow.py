@@ -3,13 +3,16 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
+import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import create, set_attrs, write_dataset
+from .hdf5 import create, write_dataset
 
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
@@ -42,17 +45,25 @@ def read_flo(path: str | os.PathLike) -> np.ndarray:
     return np.frombuffer(data[12:], dtype="<f4").reshape(height, width, 2).copy()
 
 
-def write_motion_field(
-    path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, np.ndarray], attrs: dict
-) -> None:
-    """motion_field.h5: t (K,), frame_index (K,), and each (K, H, W, ...) field, chunked
-    one frame per chunk and compressed."""
+# Compression of motion_field.h5's datasets: one field per chunk, gzip level 4 with shuffle.
+FIELD_COMPRESSION = {"compression": "gzip", "compression_opts": 4, "shuffle": True, "track_times": False}
+
+
+@contextlib.contextmanager
+def motion_field_file(
+    path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, tuple[tuple, np.dtype]]
+) -> Iterator[h5py.File]:
+    """motion_field.h5, written one field at a time: t (K,), frame_index (K,) and, per
+    name in `fields` ({name: (shape of one field, dtype)}), a (K, *shape) dataset chunked
+    one field per chunk and compressed. Yields the open file: the caller sets
+    `f[name][i]` for every field i and may add small datasets and attributes. The file
+    appears under `path` only if the block completes, so memory stays one field whatever K."""
+    n = len(t)
     with atomic_output(path) as tmp, create(tmp) as f:
         write_dataset(f, "t", t)
         write_dataset(f, "frame_index", frame_index)
-        for name, data in fields.items():
-            chunks = (1, *data.shape[1:]) if len(data) else None
+        for name, (shape, dtype) in fields.items():
             f.create_dataset(
-                name, data=data, chunks=chunks, compression="gzip", compression_opts=4, shuffle=True, track_times=False
+                name, shape=(n, *shape), dtype=dtype, chunks=(1, *shape) if n else None, **FIELD_COMPRESSION
             )
-        set_attrs(f, attrs)
+        yield f

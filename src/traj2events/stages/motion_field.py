@@ -12,8 +12,9 @@ import numpy as np
 from .. import __version__
 from ..camera import Camera
 from ..formats.atomic import atomic_directory
-from ..formats.flow import flo_bytes, write_motion_field
+from ..formats.flow import flo_bytes, motion_field_file
 from ..formats.frames import FramesFile
+from ..formats.hdf5 import set_attrs, write_dataset
 from ..formats.trajectory import read_trajectory
 from ..motion_field import (
     OCCLUDED,
@@ -27,25 +28,22 @@ from ..motion_field import (
 from ..progress import log
 
 
-def _empty_fields(n: int, h: int, w: int, terrain: bool) -> dict[str, np.ndarray]:
-    fields = {
-        "flow_sphere": np.empty((n, h, w, 2), np.float32),
-        "displacement_sphere": np.empty((n, h, w, 2), np.float32),
-        "valid": np.empty((n, h, w), bool),
-        "status_sphere": np.empty((n, h, w), np.uint8),
+def field_layout(h: int, w: int, terrain: bool) -> dict[str, tuple[tuple, type]]:
+    """motion_field.h5's per-pixel datasets: name -> (shape of one field, dtype)."""
+    layout = {
+        "flow_sphere": ((h, w, 2), np.float32),
+        "displacement_sphere": ((h, w, 2), np.float32),
+        "valid": ((h, w), bool),
+        "status_sphere": ((h, w), np.uint8),
     }
     if terrain:
-        fields.update(
-            {
-                "flow_terrain": np.empty((n, h, w, 2), np.float32),
-                "displacement_terrain": np.empty((n, h, w, 2), np.float32),
-                "valid_terrain": np.empty((n, h, w), bool),
-                "status_terrain": np.empty((n, h, w), np.uint8),
-                "sphere_minus_terrain_mean_px_s": np.full((n, 2), np.nan, np.float32),
-                "sphere_minus_terrain_rms_px_s": np.full(n, np.nan, np.float32),
-            }
-        )
-    return fields
+        layout |= {
+            "flow_terrain": ((h, w, 2), np.float32),
+            "displacement_terrain": ((h, w, 2), np.float32),
+            "valid_terrain": ((h, w), bool),
+            "status_terrain": ((h, w), np.uint8),
+        }
+    return layout
 
 
 def motion_field(
@@ -74,7 +72,9 @@ def motion_field(
             )
         picked = np.arange(0, len(tr.t) - 1, every_n_frames)  # each needs its next frame
         n, h, w = len(picked), camera.height, camera.width
-        fields = _empty_fields(n, h, w, rendered is not None)
+        # Per field: sphere minus terrain-true flow where both exist (mean (u, v) and RMS, px/s).
+        offset_mean = np.full((n, 2), np.nan, np.float32)
+        offset_rms = np.full(n, np.nan, np.float32)
         attrs = {
             "width": w,
             "height": h,
@@ -94,39 +94,43 @@ def motion_field(
             + (f", terrain-true from {frames}" if rendered is not None else "")
         )
         next_depth = (-1, None)  # frame k+1's depth, reused as frame k's when every frame is written
-        with atomic_directory(flo_dir) as tmp_dir:
+        layout = field_layout(h, w, rendered is not None)
+        with (
+            atomic_directory(flo_dir) as tmp_dir,
+            motion_field_file(output, tr.t[picked], picked, layout) as out,
+        ):
             for i, k in enumerate(picked):
                 flow, on_sphere = sphere_flow(camera, tr.state[k], moon_radius_m, np.float32)
-                fields["flow_sphere"][i] = flow
                 disp, status = sphere_displacement(camera, tr.state[k], tr.state[k + 1], moon_radius_m)
-                fields["displacement_sphere"][i], fields["status_sphere"][i] = disp, status
-                fields["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
+                out["flow_sphere"][i], out["displacement_sphere"][i], out["status_sphere"][i] = flow, disp, status
+                out["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
                 # The folder is atomic as a whole: its files need no temporary of their own.
-                (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(fields["displacement_sphere"][i]))
+                (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(disp.astype(np.float32)))
                 if rendered is not None:
                     depth = next_depth[1] if next_depth[0] == k else rendered.depth_m(k)
                     next_depth = (k + 1, rendered.depth_m(k + 1))
                     terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
-                    fields["flow_terrain"][i] = terrain_flow
                     disp, status = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth, next_depth[1])
-                    fields["displacement_terrain"][i], fields["status_terrain"][i] = disp, status
-                    fields["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
+                    out["flow_terrain"][i], out["displacement_terrain"][i] = terrain_flow, disp
+                    out["status_terrain"][i] = status
+                    out["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
                     both = seen & on_sphere
                     if both.any():
                         diff = (flow - terrain_flow)[both]
-                        fields["sphere_minus_terrain_mean_px_s"][i] = diff.mean(axis=0)
-                        fields["sphere_minus_terrain_rms_px_s"][i] = np.sqrt(np.mean(np.sum(diff**2, axis=1)))
+                        offset_mean[i] = diff.mean(axis=0)
+                        offset_rms[i] = np.sqrt(np.mean(np.sum(diff**2, axis=1)))
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
             if rendered is not None:
-                rms = fields["sphere_minus_terrain_rms_px_s"]
-                median = float(np.nanmedian(rms)) if np.isfinite(rms).any() else np.nan
+                write_dataset(out, "sphere_minus_terrain_mean_px_s", offset_mean)
+                write_dataset(out, "sphere_minus_terrain_rms_px_s", offset_rms)
+                median = float(np.nanmedian(offset_rms)) if np.isfinite(offset_rms).any() else np.nan
                 attrs["sphere_minus_terrain_rms_px_s_median"] = median
                 log(
                     f"sphere minus terrain-true field: median RMS {median:.3g} px/s, "
-                    f"mean offset {np.nanmean(fields['sphere_minus_terrain_mean_px_s'], axis=0)} px/s"
+                    f"mean offset {np.nanmean(offset_mean, axis=0)} px/s"
                 )
-            write_motion_field(output, tr.t[picked], picked, fields, attrs)
+            set_attrs(out, attrs)
     finally:
         if rendered is not None:
             rendered.close()
