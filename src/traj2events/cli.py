@@ -235,7 +235,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
     p.add_argument("--settings", required=True, help=settings_help)
-    p.add_argument("--base", required=True, help="base.h5 from `traj2events base`")
+    p.add_argument(
+        "--base",
+        required=True,
+        help="base.h5 from `traj2events base` (one recording a failed solve gives a solutions.h5 and "
+        "samples.csv without samples, which say so)",
+    )
     p.add_argument("--output", "-o", required=True, help="solutions.h5: every sample's nodes and status")
     p.add_argument("--table", required=True, help="samples.csv: one row per sample (status, reason, errors)")
     p.add_argument("--jobs", "-j", type=int, default=1, help="worker processes (default 1)")
