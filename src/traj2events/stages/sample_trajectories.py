@@ -81,7 +81,8 @@ def sample_row(r: SampleResult, trajectory_id: int) -> dict:
     }
 
 
-# samples.csv's columns (named also when no sample was drawn).
+# samples.csv's columns: sample_row's keys, named here for a table without samples
+# (tests/test_stages.py checks the two agree).
 SAMPLE_TABLE_COLUMNS = ("draw", "id", "success", "method", "attempts", "reason", "status", "N", "iterations",
                         "total_iterations", "tf_s", "final_mass_kg", "cost", "error_position_m", "error_velocity_m_s",
                         "solve_time_s", *RANGE_KEYS)  # fmt: skip
@@ -155,5 +156,6 @@ def sample_trajectories(
     write_solution_set(solutions, samples, attrs)
     with atomic_output(table) as tmp:
         rows = [sample_row(r, i) for r, i in zip(results, ids)]
-        pd.DataFrame(rows, columns=SAMPLE_TABLE_COLUMNS).to_csv(tmp, index=False, float_format="%.9g")
+        frame = pd.DataFrame(rows) if rows else pd.DataFrame(columns=SAMPLE_TABLE_COLUMNS)
+        frame.to_csv(tmp, index=False, float_format="%.9g")
     return results
