@@ -192,10 +192,12 @@ def sphere_displacement(
     x_s, y_s = camera.pixel_coordinates(np.float64)
     f = camera.focal_px
     h = inverse_depth_sphere(x_s / f, y_s / f, normal, height, radius_m)
-    displacement, z_next, point_world = _displace(camera, pose_k, pose_next, h)
-    centre = np.array([0.0, 0.0, radius_m])
-    outward = point_world + pose_next.position - centre  # surface point - centre
-    facing = np.einsum("hwk,hwk->hw", outward, -point_world) > 0  # camera k+1 above its tangent plane
+    displacement, z_next, (x, y, z) = _displace(camera, pose_k, pose_next, h)
+    # Camera k+1 sees the point when it is above the point's tangent plane:
+    # (p + c - centre) . (-p) > 0, p the point relative to camera k+1, c that camera's
+    # position; in camera k+1's frame, -(|p|^2 + p . q) > 0 with q = R_next^T (c - centre).
+    q = pose_next.rotation.T @ (pose_next.position - np.array([0.0, 0.0, radius_m]))
+    facing = -(x * (x + q[0]) + y * (y + q[1]) + z * (z + q[2])) > 0
     return displacement, displacement_status(camera, displacement, h > 0, z_next > 0, ~facing)
 
 
@@ -242,20 +244,23 @@ def _hidden_by_nearer_surface(
 def _displace(camera: Camera, pose_k, pose_next, h: np.ndarray):
     """Pixels of frame k with inverse depth h (0: at infinity) -> centred coordinates in
     frame k+1; returns (displacement, depth along camera k+1's boresight (> 0: in front),
-    points relative to camera k+1)."""
+    points relative to camera k+1 in camera k+1's frame: (x, y, z) of (H, W) each)."""
     x_s, y_s = camera.pixel_coordinates(np.float64)
     f = camera.focal_px
-    a, b = x_s / f, y_s / f
+    a, b = x_s / f, y_s / f  # the ray (a, b, 1) of each pixel at k: a per column, b per row
+    # A ray's direction in camera k+1's frame, M (a, b, 1) with M = R_next^T R_k, is separable
+    # in a and b: three (H, W) arrays from a row and a column, no (H, W, 3) products.
+    m = pose_next.rotation.T @ pose_k.rotation
+    shift = pose_next.rotation.T @ (pose_k.position - pose_next.position)  # camera k in frame k+1
     hit = h > 0
-    ray = np.stack(np.broadcast_arrays(a, b, np.ones_like(h)), axis=-1)  # (H, W, 3)
-    # Positions relative to camera k+1 (small numbers: no loss to the Moon's radius).
-    depth = np.where(hit, 1.0 / np.where(hit, h, 1.0), 0.0)[..., None]
-    shift = pose_k.position - pose_next.position
-    point_world = ray @ pose_k.rotation.T  # directions in the inertial frame
-    point_world = np.where(hit[..., None], depth * point_world + shift, point_world)
-    point_next = point_world @ pose_next.rotation  # R_next^T p, camera frame k+1
-    z = point_next[..., 2]
+    depth = np.where(hit, 1.0 / np.where(hit, h, 1.0), 0.0)
+    # Positions relative to camera k+1 (small numbers: no loss to the Moon's radius); a
+    # point at infinity stays a direction.
+    x, y, z = (
+        np.where(hit, depth * (m[i, 0] * a + m[i, 1] * b + m[i, 2]) + shift[i], m[i, 0] * a + m[i, 1] * b + m[i, 2])
+        for i in range(3)
+    )
     with np.errstate(divide="ignore", invalid="ignore"):
-        x_next = f * point_next[..., 0] / z
-        y_next = f * point_next[..., 1] / z
-    return np.stack([x_next - x_s, y_next - y_s], axis=-1), z, point_world
+        x_next = f * x / z
+        y_next = f * y / z
+    return np.stack([x_next - x_s, y_next - y_s], axis=-1), z, (x, y, z)
