@@ -64,6 +64,10 @@ def test_the_profile_sizes_jobs_from_the_config(cluster, tmp_path):
         need = job_resources(config, rule, "descent")
         block = out.split(f"rule {rule}:")[1].split("rule ")[0]
         assert f"mem_mb={need['mem_mb']}," in block and f"runtime={need['runtime']}" in block, block
-    assert job_resources(config, "motion_field", "descent")["mem_mb"] > 5000  # every field held: 512^2 x 600
+    assert job_resources(config, "render", "descent")["mem_mb"] > 2000  # beyond the profile's default
+    fewer_fields = resolve_config({**overlay, "motion_field": {"every_n_frames": 50}})
+    # One field at a time: the memory does not grow with the number of fields.
+    memory = [job_resources(c, "motion_field", "descent")["mem_mb"] for c in (config, fewer_fields)]
+    assert memory[0] == memory[1], memory
     block = out.split("rule dataset_index:")[1].split("rule ")[0]
     assert "mem_mb=1000," in block and "runtime=10" in block
