@@ -52,6 +52,7 @@ from traj2events.scenarios import (  # noqa: E402
     base_conditions,
     sample_conditions,
 )
+from traj2events.stages.base_solution import solve_base  # noqa: E402
 from traj2events.upsample import ShootingCheck, final_state_error  # noqa: E402
 
 
@@ -182,10 +183,10 @@ def solve_scenario(config: dict, name: str, n_samples: int, jobs: int) -> tuple[
     """(solved results, solve CPU seconds) of one scenario's first n_samples trajectories."""
     config = merge_config(config, {"scenarios": {name: {"n_trajectories": n_samples}}})
     s = ScenarioSettings.from_config(config, name)
-    base = LandingProblem(s.vehicle, s.ocp).solve(base_conditions(s.scenario, s.vehicle))
+    base, bc = solve_base(s)
     if not base.success:
         return [], base.solve_time_s
-    results = solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base, jobs)
+    results = solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, bc, base, jobs)
     return results, base.solve_time_s + sum(r.total_time_s for r in results)
 
 

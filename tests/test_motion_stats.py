@@ -42,15 +42,14 @@ def test_the_default_vehicle_brakes_without_riding_the_tilt_limit(tmp_path):
     authority (132 N m) keeps them below it, with roll and yaw swings of tens of degrees."""
     from traj2events.batch import solve_samples
     from traj2events.config import resolve_config
-    from traj2events.ocp import LandingProblem
-    from traj2events.scenarios import ScenarioSettings, base_conditions
+    from traj2events.scenarios import ScenarioSettings
+    from traj2events.stages.base_solution import solve_base
 
     config = resolve_config(
         {"ocp": {"n_nodes": 30, "refine_n_nodes": 60}, "scenarios": {"braking": {"n_trajectories": 4}}}
     )
     s = ScenarioSettings.from_config(config, "braking")
-    bc = base_conditions(s.scenario, s.vehicle)
-    base = LandingProblem(s.vehicle, s.ocp).solve(bc)
+    base, bc = solve_base(s)
     solved = [r for r in solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, bc, base) if r.success]
     assert len(solved) == 4
     stats = [motion_summary(r.solution.state) for r in solved]

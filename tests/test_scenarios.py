@@ -145,6 +145,7 @@ def test_the_default_descent_is_near_ventral(tmp_path):
     a quarter of the altitude lost (the earlier ranges gave 0.3-8)."""
     from traj2events.config import resolve_config
     from traj2events.formats.trajectory import read_solution_set
+    from traj2events.motion_stats import travel_per_drop
     from traj2events.stages.base_solution import base_solution
     from traj2events.stages.sample_trajectories import sample_trajectories
 
@@ -158,6 +159,5 @@ def test_the_default_descent_is_near_ventral(tmp_path):
     assert len(solved) == 4
     for sample in solved:
         state = sample["state"]
-        travel = np.hypot(np.diff(state[:, 0]), np.diff(state[:, 1])).sum()
         drop = state[-1, 2] - state[0, 2]
-        assert drop > 90.0 and travel / drop < 0.25, (sample["id"], travel, drop)
+        assert drop > 90.0 and travel_per_drop(state) < 0.25, (sample["id"], travel_per_drop(state), drop)

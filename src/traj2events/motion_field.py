@@ -256,10 +256,8 @@ def _displace(camera: Camera, pose_k, pose_next, h: np.ndarray):
     depth = np.where(hit, 1.0 / np.where(hit, h, 1.0), 0.0)
     # Positions relative to camera k+1 (small numbers: no loss to the Moon's radius); a
     # point at infinity stays a direction.
-    x, y, z = (
-        np.where(hit, depth * (m[i, 0] * a + m[i, 1] * b + m[i, 2]) + shift[i], m[i, 0] * a + m[i, 1] * b + m[i, 2])
-        for i in range(3)
-    )
+    direction = [m[i, 0] * a + m[i, 1] * b + m[i, 2] for i in range(3)]
+    x, y, z = (np.where(hit, depth * d + shift[i], d) for i, d in enumerate(direction))
     with np.errstate(divide="ignore", invalid="ignore"):
         x_next = f * x / z
         y_next = f * y / z

@@ -35,13 +35,6 @@ def solve_base(settings: ScenarioSettings) -> tuple[Solution, object]:
     return sol, bc
 
 
-def failure_message(scenario: str, status: str) -> str:
-    return (
-        f"scenario '{scenario}': the base problem (midpoint of every range) did not solve: {status}. "
-        "Check the ranges and vehicle in the config."
-    )
-
-
 def base_solution(settings: ScenarioSettings, output: str | os.PathLike, record_failure: bool = False) -> Solution:
     """Solve the base problem and write base.h5 (nodes only). A base problem that does not
     solve is a BaseSolveError, or with `record_failure` a base.h5 that records it
@@ -49,7 +42,10 @@ def base_solution(settings: ScenarioSettings, output: str | os.PathLike, record_
     the scenario but still reports it in the summary."""
     sol, bc = solve_base(settings)
     if not sol.success:
-        message = failure_message(settings.scenario.name, sol.status)
+        message = (
+            f"scenario '{settings.scenario.name}': the base problem (midpoint of every range) did not solve: "
+            f"{sol.status}. Check the ranges and vehicle in the config."
+        )
         if not record_failure:
             raise BaseSolveError(message)
         log(f"ERROR {message} Recorded in {output}; the scenario will have no trajectory.")

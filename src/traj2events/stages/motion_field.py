@@ -105,7 +105,7 @@ def motion_field(
                 out["flow_sphere"][i], out["displacement_sphere"][i], out["status_sphere"][i] = flow, disp, status
                 out["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
                 # The folder is atomic as a whole: its files need no temporary of their own.
-                (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(disp.astype(np.float32)))
+                (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(disp))
                 if rendered is not None:
                     depth = next_depth[1] if next_depth[0] == k else rendered.depth_m(k)
                     next_depth = (k + 1, rendered.depth_m(k + 1))
