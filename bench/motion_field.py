@@ -6,7 +6,7 @@ One core (OMP_NUM_THREADS=1). For a braking-like pose (2 km up, pitched 55 deg, 
 horizon is in view) and a descent-like one (100 m, near nadir): median milliseconds per
 instantaneous sphere field in float32 and float64, the float32 error against float64,
 the textbook inverse-depth formula's float32 error for comparison, the exact discrete
-displacement (float64), and the bytes per field on disk (gzip-4 + shuffle, as written).
+displacement (float64), and the bytes per field on disk (Blosc/zstd-1 + bit shuffle, as written).
 Goal (issue 3): < 20 ms per 1024 x 1024 sphere field on one core.
 """
 
@@ -28,6 +28,7 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 from traj2events.camera import Camera, camera_pose  # noqa: E402
+from traj2events.formats.flow import field_compression  # noqa: E402
 from traj2events.motion_field import (  # noqa: E402
     inverse_depth_sphere,
     inverse_depth_sphere_textbook,
@@ -59,9 +60,7 @@ def median_ms(fn, repeat: int) -> float:
 def stored_bytes(field: np.ndarray) -> int:
     buffer = io.BytesIO()
     with h5py.File(buffer, "w") as f:
-        f.create_dataset(
-            "x", data=field[None], chunks=(1, *field.shape), compression="gzip", compression_opts=4, shuffle=True
-        )
+        f.create_dataset("x", data=field[None], chunks=(1, *field.shape), **field_compression())
     return buffer.getbuffer().nbytes
 
 

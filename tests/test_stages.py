@@ -2,6 +2,7 @@
 the command line: each output exists, reads back, and agrees with its inputs."""
 
 import h5py
+import hdf5plugin  # noqa: F401  (motion_field.h5 is Blosc-compressed)
 import numpy as np
 import pandas as pd
 import pytest

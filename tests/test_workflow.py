@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 import h5py
+import hdf5plugin  # noqa: F401  (motion_field.h5 is Blosc-compressed)
 import numpy as np
 import pandas as pd
 import pytest

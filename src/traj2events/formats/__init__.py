@@ -1,4 +1,4 @@
-"""File formats, with numpy and h5py (+ hdf5plugin for events) only: reading any output
+"""File formats, with numpy and h5py (+ hdf5plugin for events and motion fields) only: reading any output
 of the pipeline never loads the solver or the renderer.
 
     atomic      one helper for every write: a temporary name, renamed when complete

@@ -56,6 +56,8 @@ class Attributes(dict):
 def open_for_reading(path: str | os.PathLike, expected: str) -> h5py.File:
     """An HDF5 file opened for reading; a missing, unreadable or truncated file is an
     error that names the file and what was expected."""
+    import hdf5plugin  # noqa: F401  (registers Blosc: events.h5 and motion_field.h5 use it)
+
     if not Path(path).is_file():
         raise FileNotFoundError(f"{path}: no such file (expected {expected})")
     try:

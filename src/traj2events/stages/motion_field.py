@@ -102,6 +102,7 @@ def motion_field(
             for i, k in enumerate(picked):
                 flow, on_sphere = sphere_flow(camera, tr.state[k], moon_radius_m, np.float32)
                 disp, status = sphere_displacement(camera, tr.state[k], tr.state[k + 1], moon_radius_m)
+                disp = disp.astype(np.float32)  # as stored; numpy casts faster than HDF5 does
                 out["flow_sphere"][i], out["displacement_sphere"][i], out["status_sphere"][i] = flow, disp, status
                 out["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
                 # The folder is atomic as a whole: its files need no temporary of their own.
@@ -111,7 +112,7 @@ def motion_field(
                     next_depth = (k + 1, rendered.depth_m(k + 1))
                     terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
                     disp, status = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth, next_depth[1])
-                    out["flow_terrain"][i], out["displacement_terrain"][i] = terrain_flow, disp
+                    out["flow_terrain"][i], out["displacement_terrain"][i] = terrain_flow, disp.astype(np.float32)
                     out["status_terrain"][i] = status
                     out["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
                     both = seen & on_sphere
