@@ -121,13 +121,13 @@ def test_bad_trajectory_files_are_refused_naming_the_file(bad_inputs, case, frag
 def test_bad_frames_file_for_the_motion_field_is_named(bad_inputs, tmp_path, capsys):
     good = trajectory_file(tmp_path / "good2.h5")
     frames = tmp_path / "frames.h5"
-    with FramesWriter(frames, np.arange(5) / 10.0, np.arange(5), 8, 8, {}) as w:
+    with FramesWriter(frames, 8, 8, {}) as w:
         for k in range(5):
-            w.write(k, np.ones((8, 8)), np.ones((8, 8)))
+            w.append(k / 10.0, k, np.ones((8, 8)), np.ones((8, 8)))
     out = tmp_path / "out"
     assert main([*motion_field_args(good, out), "--frames", str(frames)]) == 2
     err = capsys.readouterr().err
-    assert str(frames) in err and "shape" in err and not (out / "m.h5").exists()
+    assert str(frames) in err and "5 poses' frames of 8 x 8" in err and not (out / "m.h5").exists()
     assert main([*motion_field_args(good, out), "--frames", str(bad_inputs["text"])]) == 2
     assert str(bad_inputs["text"]) in capsys.readouterr().err
 

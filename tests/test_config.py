@@ -325,3 +325,16 @@ def test_config_readme_lists_every_key_with_its_default():
         for key, value in scenario.items():
             row = next((line for line in text.splitlines() if line.startswith(f"| `{key}` |")), "")
             assert f"`{shown(value)}`" in row, (name, key)
+
+
+@pytest.mark.parametrize(
+    "timing, fragment",
+    [
+        ({"mode": "adaptive", "max_log_change": None, "max_displacement_px": None}, "render.timing"),
+        ({"mode": "adaptive", "max_fps": 50.0}, "render.timing.max_fps"),
+        ({"mode": "sometimes"}, "render.timing.mode"),
+    ],
+)
+def test_adaptive_timing_without_a_bound_or_room_is_refused(timing, fragment):
+    with pytest.raises(ConfigError, match=fragment.replace(".", r"\.")):
+        resolve_config({"camera": {"fps": 50.0}, "render": {"timing": timing}})

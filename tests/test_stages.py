@@ -30,16 +30,17 @@ def camera_focal(config) -> float:
     return Camera(SIZE, SIZE, config["camera"]["fov_deg"]).focal_px
 
 
+CONFIG_OVERLAY = {
+    "ocp": {"n_nodes": 30, "refine_n_nodes": 60},
+    "camera": {"fps": 5.0, "width": SIZE, "height": SIZE},
+    "motion_field": {"every_n_frames": 7},
+    "scenarios": {"descent": {"n_trajectories": 2}},
+}
+
+
 @pytest.fixture(scope="module")
 def config():
-    return resolve_config(
-        {
-            "ocp": {"n_nodes": 30, "refine_n_nodes": 60},
-            "camera": {"fps": 5.0, "width": SIZE, "height": SIZE},
-            "motion_field": {"every_n_frames": 7},
-            "scenarios": {"descent": {"n_trajectories": 2}},
-        }
-    )
+    return resolve_config(CONFIG_OVERLAY)
 
 
 @pytest.fixture(scope="module")
@@ -309,3 +310,26 @@ def test_kept_files_describe_themselves(built, config):
     sun = config["scenarios"]["descent"]["sun"]
     assert attrs["sun_elevation_deg"] == sun["elevation_deg"] and attrs["scenario"] == "descent"
     assert '"seed": 1' in attrs["terrain"]  # the terrain's settings, as JSON
+
+
+def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path):
+    import json
+
+    from traj2events.video import read_video
+
+    timing = {"mode": "adaptive", "max_log_change": 0.5, "max_displacement_px": 0.5, "max_fps": 40.0}
+    adaptive = resolve_config({**CONFIG_OVERLAY, "render": {"timing": timing}})
+    settings = RenderSettings.from_config(adaptive, "descent")
+    render_trajectory(built / "trajectory.h5", settings, tmp_path / "f.h5", tmp_path / "v.mkv", tmp_path / "p.mp4")
+    tr = read_trajectory(built / "trajectory.h5")
+    with h5py.File(tmp_path / "f.h5") as f, h5py.File(built / "frames.h5") as fixed:
+        t, index = f["t"][()], f["frame_index"][()]
+        poses = index >= 0
+        assert np.array_equal(index[poses], np.arange(len(tr.t))) and np.array_equal(t[poses], tr.t)
+        assert (~poses).sum() > 0 and np.all(np.diff(t) >= 1 / timing["max_fps"] - 1e-12)
+        # The pose frames are the fixed-timing render's, value for value.
+        assert np.array_equal(f["radiance"][np.flatnonzero(poses)], fixed["radiance"][()])
+        assert json.loads(f.attrs["timing"]) == timing
+    assert len(read_video(tmp_path / "v.mkv")) == len(tr.t)  # the video keeps the fixed rate
+    n_frames, _, _ = emulate(frame_source(tmp_path / "f.h5"), emulator_params("clean"), 1, tmp_path / "e.h5", "c", "f")
+    assert n_frames == len(t)  # the emulator takes every frame, in time order

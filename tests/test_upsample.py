@@ -3,7 +3,14 @@
 import numpy as np
 import pytest
 
-from traj2events.upsample import frame_times, interpolate_controls, reintegrate, spline_states, upsample
+from traj2events.upsample import (
+    ReintegratedStates,
+    frame_times,
+    interpolate_controls,
+    reintegrate,
+    spline_states,
+    upsample,
+)
 
 
 def test_frame_times_cover_zero_to_tf():
@@ -23,6 +30,22 @@ def test_free_fall_matches_closed_form(dynamics, vehicle):
     np.testing.assert_allclose(states[:, 2], -1000 + 2.0 * t + 0.5 * vehicle.g_m_s2 * t**2, rtol=1e-11, atol=1e-8)
     np.testing.assert_allclose(states[:, 0], 3.0 * t, atol=1e-9)
     np.testing.assert_allclose(final, states[-1])
+
+
+def test_states_at_any_time_are_the_free_fall_and_the_frames_own(dynamics, vehicle, solved30):
+    t_nodes = np.linspace(0, 10, 6)
+    x0 = np.array([0, 0, -1000, 3.0, 0, 2.0, 0, 0, 0, 0, 0, 0, 9000.0])
+    t = np.array([7.3, 0.0, 2.0, 0.001, 10.0, 4.999])  # any order, nodes and span ends included
+    z = ReintegratedStates(dynamics, t_nodes, x0, np.zeros((6, 4))).states(t)[:, 2]
+    np.testing.assert_allclose(z, -1000 + 2.0 * t + 0.5 * vehicle.g_m_s2 * t**2, rtol=1e-11, atol=1e-8)
+    # On a solved landing: at frame times, the poses `reintegrate` gives, bit for bit (the
+    # same steps; solve_ivp evaluates t_eval on the same dense output).
+    frames = frame_times(float(solved30.t[-1]), 40.0)
+    poses, _ = reintegrate(dynamics, solved30.t, solved30.state[0], solved30.control, frames)
+    dense = ReintegratedStates(dynamics, solved30.t, solved30.state[0], solved30.control)
+    np.testing.assert_array_equal(dense.states(frames), poses)
+    with pytest.raises(ValueError, match="node span"):
+        dense.states([solved30.t[-1] + 0.1])
 
 
 def test_reintegrated_poses_pass_through_nodes(solved30, dynamics):

@@ -148,6 +148,14 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append("config key 'terrain.crater_diameter_min_m': expected at most terrain.crater_diameter_max_m")
     if config["events"]["hot_pixel_fraction"] > 0 and not config["events"]["hot_pixel_hz"] > 0:
         errors.append("config key 'events.hot_pixel_hz': expected > 0 when events.hot_pixel_fraction > 0")
+    timing = config["render"]["timing"]
+    if timing["mode"] == "adaptive" and timing["max_log_change"] is None and timing["max_displacement_px"] is None:
+        errors.append(
+            "config key 'render.timing': adaptive needs max_log_change or max_displacement_px (both are null)"
+        )
+    if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:
+        errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
+                      f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
     errors += _display_errors(config)
     for name, sc in config["scenarios"].items():
         errors += _scenario_errors(config, name, sc)

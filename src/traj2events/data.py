@@ -80,9 +80,10 @@ class Landing:
             return {name: f[name][i] for name in f if isinstance(f[name], h5py.Dataset) and len(f[name]) == n}
 
     def frame(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """Frame k's linear radiance (H, W) W m^-2 sr^-1 and depth (H, W) m (frames.h5 kept)."""
+        """Pose k's frame: linear radiance (H, W) W m^-2 sr^-1 and depth (H, W) m (frames.h5 kept)."""
         with FramesFile(self.folder / "frames.h5") as frames:
-            return frames.radiance(k), frames.depth_m(k)
+            row = frames.row_of_pose(k)
+            return frames.radiance(row), frames.depth_m(row)
 
 
 class Dataset:

@@ -69,6 +69,51 @@ def reintegrate(
     return out, state
 
 
+class ReintegratedStates:
+    """The re-integrated dynamics at any time in [t_0, t_f]: the same DOP853 integration as
+    `reintegrate` (same steps, interval by interval), kept with its dense output, so a
+    state at any time (an adaptive frame's pose) is as exact as one at a frame time.
+    `states(t)` for sorted or unsorted t within the node span: (len(t), 13)."""
+
+    def __init__(
+        self,
+        dynamics: Dynamics,
+        t_nodes: np.ndarray,
+        state0: np.ndarray,
+        control_nodes: np.ndarray,
+        rtol: float = RTOL,
+        atol: np.ndarray = ATOL,
+    ) -> None:
+        self.t_nodes = np.asarray(t_nodes, dtype=float)
+        self._pieces = []
+        state = np.asarray(state0, dtype=float).copy()
+        self._state0 = state.copy()
+        f = dynamics.casadi
+        for k in range(len(t_nodes) - 1):
+            t_a, t_b = t_nodes[k], t_nodes[k + 1]
+            u_a, du = control_nodes[k], (control_nodes[k + 1] - control_nodes[k]) / (t_b - t_a)
+
+            def rhs(t, x, u_a=u_a, du=du, t_a=t_a):
+                return np.asarray(f(x, u_a + (t - t_a) * du)).ravel()
+
+            sol = solve_ivp(rhs, (t_a, t_b), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
+            self._pieces.append(sol.sol)
+            state = sol.y[:, -1]
+
+    def states(self, t: np.ndarray) -> np.ndarray:
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if len(t) and (t.min() < self.t_nodes[0] or t.max() > self.t_nodes[-1]):
+            raise ValueError(f"t: expected times within the node span [{self.t_nodes[0]}, {self.t_nodes[-1]}] s")
+        # Interval k holds (t_k, t_k+1], as in `reintegrate`; t_0 is the initial state.
+        piece = np.clip(np.searchsorted(self.t_nodes, t, side="left") - 1, 0, len(self._pieces) - 1)
+        out = np.empty((len(t), len(self._state0)))
+        for k in np.unique(piece):
+            at = piece == k
+            out[at] = self._pieces[k](t[at]).T
+        out[t == self.t_nodes[0]] = self._state0
+        return out
+
+
 def spline_states(t_nodes: np.ndarray, state_nodes: np.ndarray, t: np.ndarray) -> np.ndarray:
     """The paper's upsampling: a cubic spline through the node states."""
     return CubicSpline(t_nodes, state_nodes, axis=0)(t)

@@ -1,6 +1,7 @@
 """frames.h5: the rendered linear radiance and depth of every frame of a trajectory.
 
-`t` (n,) s, `frame_index` (n,), `radiance` (n, H, W) float32 W m^-2 sr^-1 and `depth_m`
+`t` (n,) s increasing, `frame_index` (n,) the pose's index in trajectory.h5 (-1: an
+adaptive frame between two poses, for the emulator only; render.timing), `radiance` (n, H, W) float32 W m^-2 sr^-1 and `depth_m`
 (n, H, W) float32 along the boresight (0 = sky), both rounded to 16 significant bits and
 compressed one frame per chunk; attributes: camera, Sun, terrain, reflectance, display."""
 
@@ -28,22 +29,22 @@ def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
 
 
 class FramesWriter:
-    """frames.h5, one frame at a time (see the module docstring)."""
+    """frames.h5, one frame at a time (see the module docstring): `append` adds a frame
+    with its time and the index of its pose in trajectory.h5 (-1: an adaptive frame
+    between two poses, rendered for the emulator only)."""
 
-    def __init__(
-        self, path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, height: int, width: int, attrs: dict
-    ):
+    def __init__(self, path: str | os.PathLike, height: int, width: int, attrs: dict):
         self.path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
-        write_dataset(self._file, "t", np.asarray(t, float))
-        write_dataset(self._file, "frame_index", np.asarray(frame_index, np.int64))
-        n = len(t)
+        self._t: list[float] = []
+        self._frame_index: list[int] = []
         self._sets = {
             name: self._file.create_dataset(
                 name,
-                shape=(n, height, width),
+                shape=(0, height, width),
+                maxshape=(None, height, width),
                 dtype=np.float32,
                 chunks=(1, height, width),
                 compression="gzip",
@@ -53,13 +54,22 @@ class FramesWriter:
             )
             for name in ("radiance", "depth_m")
         }
-        set_attrs(self._file, attrs)
+        self._attrs = attrs
 
-    def write(self, i: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
+    def append(self, t_s: float, frame_index: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
         ensure_free_space(self.path, 2 * np.asarray(radiance).size * 4)  # both images, uncompressed
+        i = len(self._t)
         with write_errors_named(self.path):
-            self._sets["radiance"][i] = round_mantissa(radiance)
-            self._sets["depth_m"][i] = round_mantissa(depth_m)
+            for name, image in (("radiance", radiance), ("depth_m", depth_m)):
+                self._sets[name].resize(i + 1, axis=0)
+                self._sets[name][i] = round_mantissa(image)
+        self._t.append(float(t_s))
+        self._frame_index.append(int(frame_index))
+
+    def _finish(self) -> None:
+        write_dataset(self._file, "t", np.asarray(self._t, float))
+        write_dataset(self._file, "frame_index", np.asarray(self._frame_index, np.int64))
+        set_attrs(self._file, self._attrs)
 
     def __enter__(self):
         return self
@@ -67,6 +77,8 @@ class FramesWriter:
     def __exit__(self, *exc):
         try:
             with write_errors_named(self.path):
+                if exc[0] is None:
+                    self._finish()
                 self._file.close()
         except OSError as error:
             self._context.__exit__(type(error), error, None)
@@ -75,8 +87,9 @@ class FramesWriter:
 
 
 class FramesFile:
-    """frames.h5 opened for reading: `t`, `attrs`, (n, H, W) `shape`, and frames or depth
-    read one at a time or in chunks (memory stays bounded)."""
+    """frames.h5 opened for reading: `t`, `frame_index`, `attrs`, (n, H, W) `shape`, and
+    frames or depth read one at a time or in chunks (memory stays bounded). Rows count
+    every rendered frame; `row_of_pose(k)` is the row of trajectory pose k."""
 
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
@@ -90,6 +103,19 @@ class FramesFile:
         if len(self.shape) != 3 or len(self.t) != self.shape[0]:
             self._file.close()
             raise FileFormatError(f"{self.path}: radiance has shape {self.shape}, expected ({len(self.t)}, H, W)")
+        self.frame_index = self._file["frame_index"][()] if "frame_index" in self._file else np.arange(len(self.t))
+        self._pose_rows = np.flatnonzero(self.frame_index >= 0)
+        if not np.array_equal(self.frame_index[self._pose_rows], np.arange(len(self._pose_rows))):
+            self._file.close()
+            raise FileFormatError(f"{self.path}: frame_index: expected poses 0, 1, 2, ... in order (and -1)")
+
+    @property
+    def n_poses(self) -> int:
+        """How many trajectory poses were rendered (rows with frame_index >= 0)."""
+        return len(self._pose_rows)
+
+    def row_of_pose(self, k: int) -> int:
+        return int(self._pose_rows[k])
 
     def radiance(self, k: int) -> np.ndarray:
         return self._file["radiance"][k]

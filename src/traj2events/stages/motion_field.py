@@ -65,10 +65,10 @@ def motion_field(
         raise ValueError(f"{trajectory}: expected poses/t with at least 2 poses")
     rendered = FramesFile(frames) if frames else None
     try:
-        if rendered is not None and rendered.shape != (len(tr.t), camera.height, camera.width):
+        if rendered is not None and (rendered.n_poses, *rendered.shape[1:]) != (len(tr.t), camera.height, camera.width):
             raise ValueError(
-                f"{frames}: depth_m has shape {rendered.shape}, expected "
-                f"({len(tr.t)}, {camera.height}, {camera.width}) to match {trajectory}"
+                f"{frames}: holds {rendered.n_poses} poses' frames of {rendered.shape[2]} x {rendered.shape[1]}, "
+                f"expected {len(tr.t)} of {camera.width} x {camera.height} to match {trajectory}"
             )
         picked = np.arange(0, len(tr.t) - 1, every_n_frames)  # each needs its next frame
         n, h, w = len(picked), camera.height, camera.width
@@ -108,8 +108,8 @@ def motion_field(
                 # The folder is atomic as a whole: its files need no temporary of their own.
                 (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(disp))
                 if rendered is not None:
-                    depth = next_depth[1] if next_depth[0] == k else rendered.depth_m(k)
-                    next_depth = (k + 1, rendered.depth_m(k + 1))
+                    depth = next_depth[1] if next_depth[0] == k else rendered.depth_m(rendered.row_of_pose(k))
+                    next_depth = (k + 1, rendered.depth_m(rendered.row_of_pose(k + 1)))
                     terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
                     disp, status = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth, next_depth[1])
                     out["flow_terrain"][i], out["displacement_terrain"][i] = terrain_flow, disp.astype(np.float32)

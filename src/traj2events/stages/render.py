@@ -1,6 +1,8 @@
 """Stages 4-5: render the lunar surface from every pose of a trajectory (linear radiance
 and depth, frames.h5) and the videos made from the same frames (lossless FFV1 of the 8-bit
-display frames, and an H.264 preview)."""
+display frames, and an H.264 preview). With adaptive timing (frame_timing), frames.h5
+also holds frames between the poses, at times picked from the motion field, for the
+emulator only; the videos keep the fixed rate."""
 
 from __future__ import annotations
 
@@ -14,7 +16,9 @@ import numpy as np
 from .. import __version__
 from ..camera import Camera
 from ..formats.frames import FramesWriter
+from ..dynamics import Dynamics
 from ..formats.trajectory import read_trajectory
+from ..frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..illumination import Sun
 from ..progress import log
 from ..reflectance import ReflectanceParams
@@ -22,13 +26,14 @@ from ..render import TerrainRenderer
 from ..state import POSE
 from ..terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
 from ..tiles import LodSettings, TileSet
+from ..upsample import ReintegratedStates
 from ..video import VideoWriter, display_frame
 
 
 @dataclass(frozen=True)
 class RenderSettings:
     """Everything one scenario's rendering depends on (the render rule's `params`):
-    camera, terrain, Sun, reflectance, level of detail, display mapping."""
+    camera, terrain, Sun, reflectance, level of detail, display mapping, frame timing."""
 
     scenario: str
     width: int
@@ -43,6 +48,7 @@ class RenderSettings:
     half_extent_m: float
     display_white_w_m2_sr: float
     display_gamma: float
+    timing: dict
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
@@ -67,6 +73,7 @@ class RenderSettings:
             float(reach + horizon),
             float(r["display_white_w_m2_sr"]),
             float(r["display_gamma"]),
+            dict(r["timing"]),
         )
 
     def to_json(self) -> str:
@@ -108,8 +115,33 @@ class RenderSettings:
             "terrain_half_extent_m": self.half_extent_m,
             "display_white_w_m2_sr": self.display_white_w_m2_sr,
             "display_gamma": self.display_gamma,
+            "timing": self.timing,
             **camera.intrinsics_attrs(),
         }
+
+
+def render_between(
+    renderer: TerrainRenderer,
+    camera: Camera,
+    states: ReintegratedStates,
+    frame,
+    state: np.ndarray,
+    t_s: float,
+    t_next_s: float,
+    timing: FrameTiming,
+    white_w_m2_sr: float,
+) -> list[tuple[float, object]]:
+    """The adaptive frames in (t_s, t_next_s) after `frame`, rendered from `state` at t_s:
+    [(t, frame)], each interval set by the motion of the frame before it (frame_timing)."""
+    extra = []
+    while True:
+        motion = frame_motion(frame.radiance, frame.depth_m, camera, state, white_w_m2_sr)
+        t_s = next_render_time(t_s, t_next_s, next_interval_s(*motion, timing), 1.0 / timing.max_fps)
+        if t_s >= t_next_s:
+            return extra
+        state = states.states([t_s])[0]
+        frame = renderer.render(camera.pose(state))
+        extra.append((t_s, frame))
 
 
 def render_trajectory(
@@ -124,6 +156,7 @@ def render_trajectory(
     tr = read_trajectory(trajectory)
     if tr.t is None or len(tr.t) < 1:
         raise ValueError(f"{trajectory}: expected poses/t with at least one pose")
+    timing = FrameTiming(**s.timing)
     camera, tiles, sun, reflectance = s.build()
     fps = float(tr.attrs["fps"])
     n = len(tr.t)
@@ -137,13 +170,17 @@ def render_trajectory(
     attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
     log(
         f"{trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {sun.azimuth_deg} deg, "
-        f"el {sun.elevation_deg} deg, {s.reflectance['model']})"
+        f"el {sun.elevation_deg} deg, {s.reflectance['model']}; {timing.mode} timing)"
     )
+    # Adaptive frames need poses between the fixed ones: the same re-integration, kept dense.
+    states = None
+    if timing.mode == "adaptive":
+        states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
     start = time.perf_counter()
-    triangles = reused = 0
+    triangles = reused = added = 0
     with (
         TerrainRenderer(tiles, camera, sun, reflectance) as renderer,
-        FramesWriter(frames, tr.t, np.arange(n), s.height, s.width, attrs) as out,
+        FramesWriter(frames, s.height, s.width, attrs) as out,
         VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
         VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview,
     ):
@@ -155,17 +192,25 @@ def render_trajectory(
                 triangles += frame.n_triangles
             else:
                 reused += 1
-            out.write(k, frame.radiance, frame.depth_m)
+            out.append(tr.t[k], k, frame.radiance, frame.depth_m)
             shown = display_frame(frame.radiance, s.display_white_w_m2_sr, s.display_gamma)
             lossless.write(shown)
             shown_preview.write(shown)
+            if states is not None and k + 1 < n:
+                between = render_between(
+                    renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing, s.display_white_w_m2_sr
+                )
+                for t_extra, extra in between:
+                    out.append(t_extra, -1, extra.radiance, extra.depth_m)
+                    triangles += extra.n_triangles
+                added += len(between)
             if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
                 elapsed = time.perf_counter() - start
                 log(
-                    f"  {k + 1}/{n} frames, {elapsed / (k + 1) * 1e3:.1f} ms/frame, "
-                    f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 - reused, 1):.0f} triangles/frame"
+                    f"  {k + 1}/{n} frames (+{added} adaptive), {elapsed / (k + 1 + added) * 1e3:.1f} ms/frame, "
+                    f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 + added - reused, 1):.0f} triangles/frame"
                 )
-    log(f"{n} frames in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
+    log(f"{n} frames and {added} adaptive ones in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
 
 
 # frames.h5's attribute order (kept, so the same scene gives the same bytes).
@@ -186,6 +231,7 @@ FRAME_ATTR_ORDER = (
     "terrain_half_extent_m",
     "display_white_w_m2_sr",
     "display_gamma",
+    "timing",
     "scenario",
     "id",
     "traj2events_version",

@@ -1,0 +1,213 @@
+"""Benchmark: event timing accuracy against render cost, fixed and adaptive frame timing.
+
+  python bench/frame_timing.py results/braking/0000/trajectory.h5 results/descent/0000/trajectory.h5 \\
+      [--size 512] [--reference-fps 2000] [--fps 50]
+
+Clips of 1 s of each trajectory: mid-flight (from t_f / 2) and the last second before
+touchdown. For each clip, events of the clean preset (no noise, so noise does not hide
+timing) from the linear radiance of:
+  - a dense reference rendered at --reference-fps;
+  - fixed 50, 100, 200 and 400 fps (every n-th frame of the reference: the same renders);
+  - adaptive timing (traj2events.frame_timing) with several bounds, the fixed --fps frames
+    included, rendered at the times it picks.
+Per variant: frames, render seconds (fixed: frames x the reference's mean seconds per
+frame; adaptive: measured, with the motion-field prediction), emulation seconds, events
+against the reference, and per-event timing error: events of the same pixel and polarity
+matched in order, median and 90th percentile |dt|. Also the worst interval's measured
+log change (largest over pixels of |L1 - L0|) and what was predicted for it.
+Poses at every time come from the re-integrated dynamics (upsample.ReintegratedStates).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+os.environ.setdefault("LP_NUM_THREADS", "1")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+import numpy as np  # noqa: E402
+
+from traj2events.config import resolve_config  # noqa: E402
+from traj2events.dynamics import Dynamics  # noqa: E402
+from traj2events.emulator import PRESETS, EventEmulator, radiance_to_dn  # noqa: E402
+from traj2events.formats.trajectory import read_trajectory  # noqa: E402
+from traj2events.frame_timing import (  # noqa: E402
+    FrameTiming,
+    emulator_log,
+    frame_motion,
+    next_interval_s,
+    next_render_time,
+)
+from traj2events.render import TerrainRenderer  # noqa: E402
+from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.upsample import ReintegratedStates  # noqa: E402
+
+FIXED_FPS = (50, 100, 200, 400)
+ADAPTIVE = {
+    "adaptive, log 0.5 (ESIM)": FrameTiming("adaptive", max_log_change=0.5),
+    "adaptive, log 0.2": FrameTiming("adaptive", max_log_change=0.2),
+    "adaptive, log 0.1": FrameTiming("adaptive", max_log_change=0.1),
+    "adaptive, log 0.05": FrameTiming("adaptive", max_log_change=0.05),
+    "adaptive, 1 px": FrameTiming("adaptive", max_log_change=None, max_displacement_px=1.0),
+    "adaptive, 0.5 px": FrameTiming("adaptive", max_log_change=None, max_displacement_px=0.5),
+}
+
+
+class Stream:
+    """One variant's emulator, fed frame by frame, with its costs and worst interval."""
+
+    def __init__(self, width: int, height: int):
+        self.emulator = EventEmulator(width, height, PRESETS["clean"], seed=1)
+        self.events, self.frames, self.emulate_s = [], 0, 0.0
+        self.last_log = None
+        self.worst = (0.0, 0.0)  # (measured max |dL|, predicted) of the worst interval
+        self.predicted_next = 0.0
+
+    def feed(self, dn: np.ndarray, log_l: np.ndarray, t: float, predicted_change: float) -> None:
+        start = time.perf_counter()
+        self.events.append(self.emulator.process(dn[None], np.array([t])))
+        self.emulate_s += time.perf_counter() - start
+        if self.last_log is not None:
+            measured = float(np.abs(log_l - self.last_log).max())
+            if measured > self.worst[0]:
+                self.worst = (measured, self.predicted_next)
+        self.last_log, self.frames = log_l, self.frames + 1
+        self.predicted_next = predicted_change
+
+    def all_events(self) -> np.ndarray:
+        return np.concatenate(self.events)
+
+
+def matched_timing_errors_us(events: np.ndarray, reference: np.ndarray, width: int) -> np.ndarray:
+    """|t - t_ref| (us) of events matched to the reference's: per pixel and polarity, the
+    i-th event with the i-th (as many as both have)."""
+
+    def keyed(ev):
+        group = (ev["y"].astype(np.int64) * width + ev["x"]) * 2 + ev["p"]
+        order = np.lexsort((ev["t"], group))
+        g, t = group[order], ev["t"][order]
+        first = np.r_[0, np.flatnonzero(np.diff(g)) + 1]
+        rank = np.arange(len(g)) - np.repeat(first, np.diff(np.r_[first, len(g)]))
+        return g, rank, t
+
+    ga, ra, ta = keyed(events)
+    gb, rb, tb = keyed(reference)
+    span = int(max(ra.max(initial=0), rb.max(initial=0))) + 1
+    _, ia, ib = np.intersect1d(ga * span + ra, gb * span + rb, assume_unique=True, return_indices=True)
+    return np.abs(ta[ia] - tb[ib]).astype(float)
+
+
+def run_clip(renderer, camera, states, white, t0: float, t1: float, ref_fps: int, fps: int) -> list[dict]:
+    w, h = camera.width, camera.height
+
+    def render(t):
+        start = time.perf_counter()
+        state = states.states([min(t, states.t_nodes[-1])])[0]
+        frame = renderer.render(camera.pose(state))
+        radiance, depth = frame.radiance.copy(), frame.depth_m.copy()
+        return radiance, depth, state, time.perf_counter() - start
+
+    n_ref = int(round((t1 - t0) * ref_fps))
+    reference = Stream(w, h)
+    fixed = {rate: Stream(w, h) for rate in FIXED_FPS}
+    render_s = []
+    for i in range(n_ref + 1):
+        t = t0 + i / ref_fps
+        radiance, depth, state, seconds = render(t)
+        render_s.append(seconds)
+        dn, log_l = radiance_to_dn(radiance, white), emulator_log(radiance, white)
+        reference.feed(dn, log_l, t, 0.0)
+        for rate, stream in fixed.items():
+            if i % (ref_fps // rate) == 0:
+                max_rate, _ = frame_motion(radiance, depth, camera, state, white)
+                stream.feed(dn, log_l, t, max_rate / rate)
+        if (i + 1) % 200 == 0:
+            print(f"#   reference {i + 1}/{n_ref + 1} frames", file=sys.stderr, flush=True)
+    per_frame_s = float(np.mean(render_s))
+    ref_events = reference.all_events()
+    rows = [{"timing": f"reference {ref_fps} fps", "stream": reference, "render_s": sum(render_s)}]
+    rows += [
+        {"timing": f"fixed {rate} fps", "stream": s, "render_s": s.frames * per_frame_s} for rate, s in fixed.items()
+    ]
+    fixed_times = t0 + np.arange(int(round((t1 - t0) * fps)) + 1) / fps
+    for name, timing in ADAPTIVE.items():
+        stream, start = Stream(w, h), time.perf_counter()
+        for k, t in enumerate(fixed_times):
+            tau = t
+            radiance, depth, state, _ = render(tau)
+            while True:
+                max_rate, max_speed = frame_motion(radiance, depth, camera, state, white)
+                dt = next_interval_s(max_rate, max_speed, timing)
+                stream.feed(radiance_to_dn(radiance, white), emulator_log(radiance, white), tau, 0.0)
+                if k + 1 == len(fixed_times):
+                    break
+                tau_next = next_render_time(tau, fixed_times[k + 1], dt, 1.0 / timing.max_fps)
+                stream.predicted_next = max_rate * (tau_next - tau)
+                if tau_next == fixed_times[k + 1]:
+                    break
+                tau = tau_next
+                radiance, depth, state, _ = render(tau)
+        rows.append({"timing": name, "stream": stream, "render_s": time.perf_counter() - start - stream.emulate_s})
+    for row in rows:
+        events = row["stream"].all_events()
+        dt = matched_timing_errors_us(events, ref_events, w)
+        row |= {
+            "events": len(events),
+            "count_error": len(events) / max(len(ref_events), 1) - 1,
+            "median_us": float(np.median(dt)) if len(dt) else float("nan"),
+            "p90_us": float(np.percentile(dt, 90)) if len(dt) else float("nan"),
+        }
+    return rows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("trajectories", type=Path, nargs="+", help="trajectory.h5 files (results/SCENARIO/ID/)")
+    parser.add_argument("--size", type=int, default=512, help="image width and height, px")
+    parser.add_argument("--reference-fps", type=int, default=2000)
+    parser.add_argument("--fps", type=int, default=50, help="the fixed rate adaptive timing starts from")
+    parser.add_argument("--duration", type=float, default=1.0, help="clip length, s")
+    args = parser.parse_args()
+    if any(args.reference_fps % rate for rate in FIXED_FPS):
+        parser.error(f"--reference-fps must be a multiple of {FIXED_FPS}")
+    print(
+        f"# frame timing: {args.size}^2, clean preset, reference {args.reference_fps} fps, adaptive from "
+        f"{args.fps} fps; {platform.node()} ({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}"
+    )
+    print(
+        "| clip | timing | frames | render s | emulate s | events | vs reference | median abs dt, us "
+        "| p90 abs dt, us | worst interval: measured max abs dL (predicted) |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for path in args.trajectories:
+        tr = read_trajectory(path)
+        scenario = str(tr.attrs["scenario"])
+        config = resolve_config({"camera": {"width": args.size, "height": args.size, "fps": args.fps}})
+        settings = RenderSettings.from_config(config, scenario)
+        camera, tiles, sun, reflectance = settings.build()
+        states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+        tf = float(tr.t_nodes[-1])
+        clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
+        with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
+            for clip, (t0, t1) in clips.items():
+                rows = run_clip(
+                    renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps
+                )
+                for r in rows:
+                    s = r["stream"]
+                    print(
+                        f"| {scenario} {clip} | {r['timing']} | {s.frames} | {r['render_s']:.1f} | "
+                        f"{s.emulate_s:.2f} | {r['events']} | {r['count_error']:+.1%} | {r['median_us']:.0f} | "
+                        f"{r['p90_us']:.0f} | {s.worst[0]:.2f} ({s.worst[1]:.2f}) |",
+                        flush=True,
+                    )
+
+
+if __name__ == "__main__":
+    main()
