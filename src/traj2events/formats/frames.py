@@ -1,9 +1,10 @@
 """frames.h5: the rendered linear radiance and depth of every frame of a trajectory.
 
-`t` (n,) s increasing, `frame_index` (n,) the pose's index in trajectory.h5 (-1: an
-adaptive frame between two poses, for the emulator only; render.timing), `radiance` (n, H, W) float32 W m^-2 sr^-1 and `depth_m`
-(n, H, W) float32 along the boresight (0 = sky), both rounded to 16 significant bits and
-compressed one frame per chunk; attributes: camera, Sun, terrain, reflectance, display."""
+`t` (n,) s increasing; `frame_index` (n,) the pose's index in trajectory.h5 (-1: an
+adaptive frame between two poses, for the emulator only; render.timing); `radiance`
+(n, H, W) float32 W m^-2 sr^-1 and `depth_m` (n, H, W) float32 along the boresight
+(0 = sky), both rounded to 16 significant bits and compressed one frame per chunk;
+attributes: camera, Sun, terrain, reflectance, display, timing."""
 
 from __future__ import annotations
 

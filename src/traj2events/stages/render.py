@@ -15,8 +15,8 @@ import numpy as np
 
 from .. import __version__
 from ..camera import Camera
-from ..formats.frames import FramesWriter
 from ..dynamics import Dynamics
+from ..formats.frames import FramesWriter
 from ..formats.trajectory import read_trajectory
 from ..frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..illumination import Sun
