@@ -2,6 +2,12 @@
 
   python bench/frame_timing.py results/braking/0000/trajectory.h5 results/descent/0000/trajectory.h5 \\
       [--size 512] [--reference-fps 2000] [--fps 50]
+  python bench/frame_timing.py --whole TRAJECTORY.h5 ... [--size 128]
+
+--whole: the render stage itself (`stages.render.render_trajectory`) over whole
+trajectories with fixed timing and with each adaptive bound: frames rendered, seconds,
+and the share of the flight where adaptive frames were added; what fixed rate meeting the
+same bound everywhere would take (the shortest adaptive interval's rate).
 
 Clips of 1 s of each trajectory: mid-flight (from t_f / 2) and the last second before
 touchdown. For each clip, events of the clean preset (no noise, so noise does not hide
@@ -55,8 +61,10 @@ ADAPTIVE = {
     "adaptive, log 0.1": FrameTiming("adaptive", max_log_change=0.1),
     "adaptive, log 0.05": FrameTiming("adaptive", max_log_change=0.05),
     "adaptive, 1 px": FrameTiming("adaptive", max_log_change=None, max_displacement_px=1.0),
-    "adaptive, 0.5 px": FrameTiming("adaptive", max_log_change=None, max_displacement_px=0.5),
 }
+
+# --whole renders every adaptive frame of whole flights: the bounds that stay affordable.
+WHOLE = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "adaptive, 1 px")
 
 
 class Stream:
@@ -158,12 +166,54 @@ def run_clip(renderer, camera, states, white, t0: float, t1: float, ref_fps: int
         events = row["stream"].all_events()
         dt = matched_timing_errors_us(events, ref_events, w)
         row |= {
+            "dt_us": dt,
+            "n_reference": len(ref_events),
             "events": len(events),
             "count_error": len(events) / max(len(ref_events), 1) - 1,
             "median_us": float(np.median(dt)) if len(dt) else float("nan"),
             "p90_us": float(np.percentile(dt, 90)) if len(dt) else float("nan"),
         }
     return rows
+
+
+def whole_trajectories(paths: list[Path], size: int, fps: int) -> None:
+    import tempfile
+
+    import h5py
+
+    from traj2events.stages.render import render_trajectory
+
+    print(f"# whole trajectories, {size}^2 at {fps} fps; {platform.node()}, {time.strftime('%Y-%m-%d')}")
+    print("| trajectory | timing | frames rendered | x fixed | render s | flight with added frames "
+          "| fixed rate for the same bound |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    variants = {"fixed": FrameTiming()} | {k: v for k, v in ADAPTIVE.items() if k in WHOLE}
+    for path in paths:
+        tr = read_trajectory(path)
+        scenario = str(tr.attrs["scenario"])
+        n_fixed = None
+        for name, timing in variants.items():
+            timing_config = {
+                k: getattr(timing, k) for k in ("mode", "max_log_change", "max_displacement_px", "max_fps")
+            }
+            config = resolve_config({"camera": {"width": size, "height": size}, "render": {"timing": timing_config}})
+            settings = RenderSettings.from_config(config, scenario)
+            with tempfile.TemporaryDirectory() as tmp:
+                out = Path(tmp)
+                start = time.perf_counter()
+                render_trajectory(path, settings, out / "f.h5", out / "v.mkv", out / "p.mp4")
+                seconds = time.perf_counter() - start
+                with h5py.File(out / "f.h5") as f:
+                    t, index = f["t"][()], f["frame_index"][()]
+            n_fixed = n_fixed or len(t)
+            # Fixed intervals that got adaptive frames, and the shortest interval used.
+            pose_rows = np.flatnonzero(index >= 0)
+            busy = np.diff(pose_rows) > 1
+            print(
+                f"| {scenario} {int(tr.attrs['id']):04d} ({tr.t[-1]:.0f} s) | {name} | {len(t)} | "
+                f"{len(t) / n_fixed:.2f} | {seconds:.0f} | {busy.mean():.0%} | {1 / np.diff(t).min():.0f} fps |",
+                flush=True,
+            )
 
 
 def main() -> None:
@@ -173,7 +223,11 @@ def main() -> None:
     parser.add_argument("--reference-fps", type=int, default=2000)
     parser.add_argument("--fps", type=int, default=50, help="the fixed rate adaptive timing starts from")
     parser.add_argument("--duration", type=float, default=1.0, help="clip length, s")
+    parser.add_argument("--whole", action="store_true", help="whole trajectories through the render stage")
     args = parser.parse_args()
+    if args.whole:
+        whole_trajectories(args.trajectories, args.size, args.fps)
+        return
     if any(args.reference_fps % rate for rate in FIXED_FPS):
         parser.error(f"--reference-fps must be a multiple of {FIXED_FPS}")
     print(
@@ -185,6 +239,7 @@ def main() -> None:
         "| p90 abs dt, us | worst interval: measured max abs dL (predicted) |"
     )
     print("|---|---|---|---|---|---|---|---|---|---|")
+    pooled: dict[str, list[dict]] = {}
     for path in args.trajectories:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
@@ -200,6 +255,7 @@ def main() -> None:
                     renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps
                 )
                 for r in rows:
+                    pooled.setdefault(r["timing"], []).append(r)
                     s = r["stream"]
                     print(
                         f"| {scenario} {clip} | {r['timing']} | {s.frames} | {r['render_s']:.1f} | "
@@ -207,6 +263,21 @@ def main() -> None:
                         f"{r['p90_us']:.0f} | {s.worst[0]:.2f} ({s.worst[1]:.2f}) |",
                         flush=True,
                     )
+    print_pooled(pooled)
+
+
+def print_pooled(pooled: dict[str, list[dict]]) -> None:
+    """All clips together: frames rendered over all of them, and every matched event's
+    timing error in one distribution (fast and slow clips weighted by their events)."""
+    print("\n| all clips | frames | x fixed 100 fps | events vs reference | median abs dt, us | p90 abs dt, us |")
+    print("|---|---|---|---|---|---|")
+    base = sum(r["stream"].frames for r in pooled["fixed 100 fps"])
+    for name, rows in pooled.items():
+        frames = sum(r["stream"].frames for r in rows)
+        dt = np.concatenate([r["dt_us"] for r in rows])
+        events = sum(r["events"] for r in rows) / sum(r["n_reference"] for r in rows) - 1
+        print(f"| {name} | {frames} | {frames / base:.2f} | {events:+.1%} | {np.median(dt):.0f} | "
+              f"{np.percentile(dt, 90):.0f} |")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -43,7 +43,7 @@ class FrameSource:
 
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
 SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_convention", "camera_mount_height_m",
-               "camera_position", "fps", "sun_range_m",
+               "camera_position", "fps", "timing", "sun_range_m",
                "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "reflectance", "terrain",
                "moon_radius_m", "scenario", "id")  # fmt: skip
 
