@@ -96,8 +96,8 @@ def test_frame_motion_of_a_camera_sliding_over_a_ramp():
     pose = camera.pose(state)
     v_c = pose.rotation.T @ state[3:6]
     speed = camera.focal_px * np.hypot(v_c[0], v_c[1]) / 100.0
-    assert max_speed == pytest.approx(speed, rel=1e-5)
+    assert max_speed == pytest.approx(speed, rel=1e-5)  # float32 log: the rate to ~1e-4
     # d ln L / dcolumn = 0.01 exactly: the rate is 0.01 times the flow along columns.
-    assert max_rate == pytest.approx(0.01 * camera.focal_px * abs(v_c[0]) / 100.0, rel=1e-5)
+    assert max_rate == pytest.approx(0.01 * camera.focal_px * abs(v_c[0]) / 100.0, rel=2e-4)
     sky = np.zeros_like(depth)  # no terrain: nothing moves a terrain pixel
     assert frame_motion(radiance, sky, camera, state, white)[1] == 0.0

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .camera import Camera
-from .emulator import log_intensity_8bit, radiance_to_dn
+from .emulator import KNEE_DN
 from .motion_field import depth_flow
 
 MODES = ("fixed", "adaptive")
@@ -59,14 +59,17 @@ class FrameTiming:
 def log_change_rate(log_intensity: np.ndarray, flow_px_s: np.ndarray) -> np.ndarray:
     """|grad L . flow| per pixel (1/s): the rate at which each pixel's log intensity
     changes as the image moves with the flow (H, W, 2) px/s, to first order. Central
-    differences inside the image, one-sided at its border."""
-    grad_row, grad_col = np.gradient(np.asarray(log_intensity, dtype=np.float64))
+    differences inside the image, one-sided at its border; in the input's float type."""
+    grad_row, grad_col = np.gradient(np.asarray(log_intensity))
     return np.abs(grad_col * flow_px_s[..., 0] + grad_row * flow_px_s[..., 1])
 
 
 def emulator_log(radiance: np.ndarray, white_w_m2_sr: float) -> np.ndarray:
-    """The log intensity the emulator computes from a linear-radiance frame (emulator.py)."""
-    return log_intensity_8bit(radiance_to_dn(radiance, white_w_m2_sr))
+    """The log intensity the emulator computes from a linear-radiance frame (emulator.py:
+    DN = 255 L / white, linear below the knee, ln above), in float32: it only predicts."""
+    dn = np.asarray(radiance, np.float32) * np.float32(255.0 / white_w_m2_sr)
+    knee = np.float32(KNEE_DN)
+    return np.where(dn <= knee, dn * np.float32(np.log(KNEE_DN) / KNEE_DN), np.log(np.maximum(dn, knee)))
 
 
 def next_interval_s(max_log_rate: float, max_speed_px_s: float, timing: FrameTiming) -> float:
@@ -100,7 +103,7 @@ def frame_motion(
 ) -> tuple[float, float]:
     """(fastest log change, 1/s; fastest terrain pixel, px/s) of one rendered frame, from
     its radiance and depth and the 13-state it was rendered from."""
-    flow, terrain = depth_flow(camera, state, depth_m)
+    flow, terrain = depth_flow(camera, np.asarray(state), np.asarray(depth_m, np.float32))
     rate = log_change_rate(emulator_log(radiance, white_w_m2_sr), flow)
-    speed = np.hypot(flow[..., 0], flow[..., 1])[terrain]
-    return float(rate.max()), float(speed.max()) if speed.size else 0.0
+    speed_squared = np.where(terrain, flow[..., 0] ** 2 + flow[..., 1] ** 2, 0.0)
+    return float(rate.max()), float(np.sqrt(speed_squared.max()))
