@@ -42,3 +42,16 @@ def test_the_paper_config_is_allowed_and_a_far_larger_one_is_refused():
     with pytest.raises(ConfigError, match="allow_large_dataset: true"):
         resolve_config(huge)
     assert resolve_config({**huge, "allow_large_dataset": True})["allow_large_dataset"] is True
+
+
+def test_adaptive_timing_plans_the_measured_extra_frames():
+    fixed = dataset_plan(resolve_config(ONE))
+    timing = {"mode": "adaptive", "max_log_change": 0.5, "max_displacement_px": None, "max_fps": 2000.0}
+    adaptive = dataset_plan(resolve_config({**ONE, "render": {"timing": timing}}))
+    # The default dataset's braking flight at 128^2 rendered 1.72x its camera frames at 0.5.
+    assert adaptive.core_hours["render"] / fixed.core_hours["render"] == pytest.approx(1.72, rel=0.05)
+    assert adaptive.disk_bytes["video.mkv"] == fixed.disk_bytes["video.mkv"]  # the video keeps the fixed rate
+    capped = {**timing, "max_log_change": 0.001, "max_fps": 100.0}  # never past max_fps / fps (50)
+    assert dataset_plan(resolve_config({**ONE, "render": {"timing": capped}})).core_hours["render"] == pytest.approx(
+        2.0 * fixed.core_hours["render"]
+    )

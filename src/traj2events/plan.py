@@ -32,6 +32,14 @@ MEMORY_MB = {
     "events": (300.0, 3.2e-3),  # 0.28 GB at 128^2, 1.06 GB at 512^2 (64-frame chunks)
     "sample_trajectories": (500.0, 0.0),  # plus 500 MB per process
 }
+# Adaptive timing (render.timing) renders extra frames for the emulator where the scene
+# moves: over the default dataset's whole braking flight at 128^2, 1.72x the camera's
+# frames at max_log_change 0.5 and 3.65x at 0.2 (descent: 1.50x, 2.81x; bench/frame_timing.py
+# --whole), and the adaptive rate of a clip doubled with the image width (256^2 to 512^2).
+# Estimate: 1 + a (width / 128) max_log_change^-p, or with a displacement bound alone,
+# 1 + a (width / 128) (2 max_displacement_px)^-p (1 px was about 0.5 in log change there);
+# never more than max_fps / fps.
+ADAPTIVE_EXTRA = (0.27, 1.42)  # (a, p)
 RUNTIME_MARGIN = 3.0  # requested run time / estimate: t_f may exceed its guess, nodes vary
 # Beyond these, `allow_large_dataset: true` must say the user means it.
 MAX_CORE_HOURS = 10_000.0
@@ -84,6 +92,16 @@ def _fields(frames: int, every_n_frames: int) -> int:
     return -(-(frames - 1) // every_n_frames)
 
 
+def rendered_per_frame(config: dict) -> float:
+    """Frames rendered per camera frame: 1 with fixed timing, the estimate above with adaptive."""
+    timing, camera = config["render"]["timing"], config["camera"]
+    if timing["mode"] != "adaptive":
+        return 1.0
+    a, p = ADAPTIVE_EXTRA
+    bound = timing["max_log_change"] or 2.0 * timing["max_displacement_px"]
+    return min(1.0 + a * (camera["width"] / 128.0) * bound**-p, timing["max_fps"] / camera["fps"])
+
+
 def dataset_plan(config: dict) -> Plan:
     """The planned size of the (validated) config's dataset."""
     camera, every = config["camera"], config["motion_field"]["every_n_frames"]
@@ -93,6 +111,7 @@ def dataset_plan(config: dict) -> Plan:
     frames = sum(n * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
     fields = sum(_fields(n, every) * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
     px_frames, px_fields = float(pixels) * frames, float(pixels) * fields
+    rendered = rendered_per_frame(config)  # frames.h5 and the emulator get the adaptive frames too
     disk = {
         "video.mkv": BYTES_PER_PX["video.mkv"] * px_frames,
         "preview.mp4": BYTES_PER_PX["preview.mp4"] * px_frames,
@@ -103,14 +122,14 @@ def dataset_plan(config: dict) -> Plan:
     for name in config["events"]["exports"]:
         disk[f"events {name}"] = EXPORT_BYTES_PER_EVENTS_BYTE[name] * disk["events.h5"]
     if config["render"]["keep_frames"]:
-        disk["frames.h5"] = BYTES_PER_PX["frames.h5"] * px_frames
+        disk["frames.h5"] = BYTES_PER_PX["frames.h5"] * px_frames * rendered
     hours = {
-        "render": frames * (RENDER_S[0] + RENDER_S[1] * pixels) / 3600,
-        "events": frames * (EVENTS_S[0] + EVENTS_S[1] * pixels) / 3600,
+        "render": rendered * frames * (RENDER_S[0] + RENDER_S[1] * pixels) / 3600,
+        "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels) / 3600,
         "motion field": px_fields * FIELD_S_PER_PX / 3600,
     }
     return Plan(trajectories, frames, max(per_trajectory.values()), fields, disk,
-                BYTES_PER_PX["frames.h5"] * pixels * max(per_trajectory.values()), hours)  # fmt: skip
+                BYTES_PER_PX["frames.h5"] * pixels * max(per_trajectory.values()) * rendered, hours)  # fmt: skip
 
 
 def too_large(plan: Plan) -> str | None:
@@ -134,9 +153,10 @@ def job_resources(config: dict, stage: str, scenario: str | None, threads: int =
         tf = config["scenarios"][scenario]["tf_guess_s"]
     frames = _frames(tf, camera["fps"])
     fields = _fields(frames, config["motion_field"]["every_n_frames"])
+    rendered = rendered_per_frame(config)
     seconds = {
-        "render": frames * (RENDER_S[0] + RENDER_S[1] * pixels),
-        "events": frames * (EVENTS_S[0] + EVENTS_S[1] * pixels),
+        "render": rendered * frames * (RENDER_S[0] + RENDER_S[1] * pixels),
+        "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels),
         "motion_field": pixels * fields * FIELD_S_PER_PX,
     }.get(stage, 60.0)
     if stage == "sample_trajectories":
