@@ -28,7 +28,7 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 from traj2events.camera import Camera, camera_pose  # noqa: E402
-from traj2events.formats.flow import field_compression  # noqa: E402
+from traj2events.formats.hdf5 import blosc  # noqa: E402
 from traj2events.motion_field import (  # noqa: E402
     inverse_depth_sphere,
     inverse_depth_sphere_textbook,
@@ -60,7 +60,7 @@ def median_ms(fn, repeat: int) -> float:
 def stored_bytes(field: np.ndarray) -> int:
     buffer = io.BytesIO()
     with h5py.File(buffer, "w") as f:
-        f.create_dataset("x", data=field[None], chunks=(1, *field.shape), **field_compression())
+        f.create_dataset("x", data=field[None], chunks=(1, *field.shape), **blosc())
     return buffer.getbuffer().nbytes
 
 

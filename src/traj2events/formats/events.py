@@ -8,19 +8,13 @@ import os
 import numpy as np
 
 from .atomic import atomic_output, ensure_free_space
-from .hdf5 import Attributes, create, open_file, set_attrs
+from .hdf5 import Attributes, blosc, create, open_file, set_attrs
 
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
 
 # An event's cause (the optional `events/label` dataset): its value is the index here.
 EVENT_LABELS = ("signal", "shot_noise", "leak", "hot_pixel")
 SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL = range(len(EVENT_LABELS))
-
-
-def _blosc_zstd():
-    import hdf5plugin  # registers the Blosc filter with HDF5
-
-    return hdf5plugin.Blosc(cname="zstd", clevel=5, shuffle=hdf5plugin.Blosc.SHUFFLE)
 
 
 class EventsWriter:
@@ -41,16 +35,14 @@ class EventsWriter:
         chunk: int = 1 << 18,
         labels: bool = False,
     ):
-        compression = _blosc_zstd()
+        compression = blosc("zstd", 5, bitshuffle=False)
         self._path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
         group = self._file.create_group("events")
         self._sets = {
-            name: group.create_dataset(
-                name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), track_times=False, **compression
-            )
+            name: group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), **compression)
             for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")) + (("label", "u1"),) * labels
         }
         if labels:
@@ -101,7 +93,6 @@ class EventsWriter:
 
 def read_events(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
     """events.h5 -> (structured array x, y, t (absolute us), p; attributes)."""
-    _blosc_zstd()
     with open_file(path, "events.h5 (DSEC layout)") as f:
         g = f["events"]
         out = np.empty(len(g["t"]), EVENT_DTYPE)
@@ -127,7 +118,6 @@ def read_labelled_window(path: str | os.PathLike, t_start_us: int, t_end_us: int
 
 
 def _read_window(path, t_start_us: int, t_end_us: int, labels: bool) -> tuple[np.ndarray, np.ndarray | None]:
-    _blosc_zstd()
     with open_file(path, "events.h5 (DSEC layout)") as f:
         if labels and "events/label" not in f:
             raise ValueError(f"{path}: no events/label dataset (emulated without labels; see events.labels)")

@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import create, write_dataset
+from .hdf5 import blosc, create, write_dataset
 
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
@@ -45,15 +45,6 @@ def read_flo(path: str | os.PathLike) -> np.ndarray:
     return np.frombuffer(data[12:], dtype="<f4").reshape(height, width, 2).copy()
 
 
-def field_compression() -> dict:
-    """motion_field.h5's datasets: one field per chunk, Blosc/zstd level 1 with bit shuffle
-    (hdf5plugin, as events.h5). A 1024^2 field's four datasets write in ~55 ms at the size
-    gzip-4 gives in ~480 ms (docs/benchmarks.md)."""
-    import hdf5plugin  # registers the Blosc filter with HDF5
-
-    return {**hdf5plugin.Blosc(cname="zstd", clevel=1, shuffle=hdf5plugin.Blosc.BITSHUFFLE), "track_times": False}
-
-
 @contextlib.contextmanager
 def motion_field_file(
     path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, tuple[tuple, np.dtype]]
@@ -64,7 +55,7 @@ def motion_field_file(
     `f[name][i]` for every field i and may add small datasets and attributes. The file
     appears under `path` only if the block completes, so memory stays one field whatever K."""
     n = len(t)
-    compression = field_compression()
+    compression = blosc()  # a 1024^2 field's datasets: ~55 ms against ~480 ms with gzip-4
     with atomic_output(path) as tmp, create(tmp) as f:
         write_dataset(f, "t", t)
         write_dataset(f, "frame_index", frame_index)

@@ -3,7 +3,8 @@
 `t` (n,) s increasing; `frame_index` (n,) the pose's index in trajectory.h5 (-1: an
 adaptive frame between two poses, for the emulator only; render.timing); `radiance`
 (n, H, W) float32 W m^-2 sr^-1 and `depth_m` (n, H, W) float32 along the boresight
-(0 = sky), both rounded to 16 significant bits and compressed one frame per chunk;
+(0 = sky), both rounded to 16 significant bits and compressed one frame per chunk
+(Blosc/zstd-1 with bit shuffle: `import hdf5plugin` to read them with h5py);
 attributes: camera, Sun, terrain, reflectance, display, timing."""
 
 from __future__ import annotations
@@ -15,7 +16,16 @@ from typing import Iterator
 import numpy as np
 
 from .atomic import atomic_output, ensure_free_space
-from .hdf5 import Attributes, FileFormatError, create, open_for_reading, set_attrs, write_dataset, write_errors_named
+from .hdf5 import (
+    Attributes,
+    FileFormatError,
+    blosc,
+    create,
+    open_for_reading,
+    set_attrs,
+    write_dataset,
+    write_errors_named,
+)
 
 
 def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
@@ -48,10 +58,7 @@ class FramesWriter:
                 maxshape=(None, height, width),
                 dtype=np.float32,
                 chunks=(1, height, width),
-                compression="gzip",
-                compression_opts=1,
-                shuffle=True,
-                track_times=False,
+                **blosc(),
             )
             for name in ("radiance", "depth_m")
         }

@@ -18,6 +18,16 @@ def create(path: Path) -> h5py.File:
     return h5py.File(path, "w", libver=("v110", "v110"), track_order=True)
 
 
+def blosc(cname: str = "zstd", clevel: int = 1, bitshuffle: bool = True) -> dict:
+    """create_dataset keywords for a Blosc filter (hdf5plugin: readers `import hdf5plugin`).
+    zstd-1 + bit shuffle, the default, writes float32 images ~3x faster than gzip-1 and
+    reads them ~1.7x faster, ~17 % larger (docs/benchmarks.md)."""
+    import hdf5plugin  # registers the Blosc filter with HDF5
+
+    shuffle = hdf5plugin.Blosc.BITSHUFFLE if bitshuffle else hdf5plugin.Blosc.SHUFFLE
+    return {**hdf5plugin.Blosc(cname=cname, clevel=clevel, shuffle=shuffle), "track_times": False}
+
+
 def write_dataset(group: h5py.Group, name: str, data: np.ndarray) -> None:
     """A dataset, gzip-4 + shuffle when larger than 1024 values."""
     data = np.asarray(data)
