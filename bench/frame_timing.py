@@ -41,7 +41,7 @@ import numpy as np  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
-from traj2events.emulator import PRESETS, EventEmulator, radiance_to_dn  # noqa: E402
+from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.frame_timing import (  # noqa: E402
     FrameTiming,
@@ -50,6 +50,7 @@ from traj2events.frame_timing import (  # noqa: E402
     next_interval_s,
     next_render_time,
 )
+from traj2events.log_response import radiance_to_dn  # noqa: E402
 from traj2events.render import TerrainRenderer  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 from traj2events.upsample import ReintegratedStates  # noqa: E402

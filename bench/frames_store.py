@@ -36,8 +36,8 @@ import hdf5plugin  # noqa: E402
 import numpy as np  # noqa: E402
 
 from traj2events.camera import Camera  # noqa: E402
-from traj2events.emulator import log_intensity_8bit, radiance_to_dn  # noqa: E402
 from traj2events.formats.frames import round_mantissa  # noqa: E402
+from traj2events.log_response import log_intensity_8bit, radiance_to_dn  # noqa: E402
 from traj2events.reflectance import ReflectanceParams  # noqa: E402
 from traj2events.render import TerrainRenderer  # noqa: E402
 from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402

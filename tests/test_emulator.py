@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from traj2events.emulator import PRESETS, EmulatorParams, EventEmulator, log_intensity_8bit, lowpass_gain
+from traj2events.emulator import PRESETS, EmulatorParams, EventEmulator, lowpass_gain
+from traj2events.log_response import log_intensity_8bit
 
 CLEAN = PRESETS["clean"]
 FPS = 100.0
@@ -203,7 +204,7 @@ def test_deferred_refractory_moves_events_to_the_end_of_the_period():
 def test_linear_radiance_input_keeps_the_model_in_dn():
     # 255 L / white: a radiance ramp in log space gives the same events as the same
     # ramp in DN, and values above white (HDR) are fine.
-    from traj2events.emulator import radiance_to_dn
+    from traj2events.log_response import radiance_to_dn
 
     t = np.arange(51) / FPS
     radiance = 40.0 * np.exp(2.0 * t) * 1.5  # up to 1.5 x 40 x e (beyond white = 40)

@@ -19,7 +19,9 @@ def short(names):
 def test_closures_follow_the_imports():
     render = short(import_closure("traj2events.stages.render"))
     assert {"render", "tiles", "terrain", "illumination", "reflectance", "camera", "state", "video"} <= render
-    assert not {"ocp", "dynamics", "emulator", "figures", "cli", "motion_field"} & render  # the solver is not in it
+    assert not {"ocp", "emulator", "figures", "cli"} & render  # the solver and the emulator are not in it
+    # Adaptive frame timing: poses from the dynamics, the motion field, the pixel's log response.
+    assert {"frame_timing", "dynamics", "upsample", "motion_field", "log_response"} <= render
     events = short(import_closure("traj2events.stages.events"))
     assert "emulator" in events and not {"render", "figures", "ocp"} & events
     pictures = short(import_closure("traj2events.stages.pictures"))
@@ -61,7 +63,7 @@ def all_fingerprints():
 
 def test_comments_docstrings_and_formatting_change_nothing(package_copy):
     before = all_fingerprints()
-    package_copy("emulator.py", "KNEE_DN = 20.0  #", "KNEE_DN = 20.0  # (edited) ")
+    package_copy("log_response.py", "KNEE_DN = 20.0  #", "KNEE_DN = 20.0  # (edited) ")
     package_copy("emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;')
     package_copy("render.py", "\nimport os\n", "\n\nimport os  # formatting\n\n")
     package_copy(
@@ -72,8 +74,12 @@ def test_comments_docstrings_and_formatting_change_nothing(package_copy):
 
 def test_a_code_change_changes_the_stages_that_import_it(package_copy):
     before = all_fingerprints()
-    package_copy("emulator.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0")
+    package_copy("emulator.py", "-np.expm1(-2.0 * np.pi * f_c", "-np.expm1(-6.3 * f_c")
     after = all_fingerprints()
     assert {s for s in STAGES if after[s] != before[s]} == {"events"}
+    # The log response is the emulator's and adaptive timing's: both stages rerun.
+    package_copy("log_response.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0")
+    again = all_fingerprints()
+    assert {s for s in STAGES if again[s] != after[s]} == {"events", "render"}
     package_copy("shaders/terrain.frag", "void main", "// a shader comment is text, and counts\nvoid main")
     assert code_fingerprint("traj2events.stages.render") != before["render"]

@@ -299,7 +299,9 @@ def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
 
 
 def test_emulator_change_reruns_events_and_their_dependants_only(edited_source):
-    jobs = edited_source("emulator.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0")
+    jobs = edited_source(
+        "emulator.py", "return -np.expm1(-2.0 * np.pi * f_c * dt_s)", "return -np.expm1(-6.3 * f_c * dt_s)"
+    )
     assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
 
 

@@ -49,8 +49,7 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from .formats.events import EVENT_DTYPE, HOT_PIXEL, LEAK, SHOT_NOISE, SIGNAL
-
-KNEE_DN = 20.0  # lin-log knee of the 8-bit mapping
+from .log_response import KNEE_DN, log_intensity_8bit
 
 
 @dataclass(frozen=True)
@@ -90,26 +89,12 @@ PRESETS = {
 }
 
 
-def log_intensity_8bit(frame_dn: np.ndarray) -> np.ndarray:
-    """8-bit DN -> log intensity: I ln(20)/20 up to the 20 DN knee, ln(I) above (float64)."""
-    i = np.asarray(frame_dn, dtype=np.float64)
-    return np.where(i <= KNEE_DN, i * (np.log(KNEE_DN) / KNEE_DN), np.log(np.maximum(i, KNEE_DN)))
-
-
 def lowpass_gain(intensity_dn: np.ndarray, cutoff_hz: float, dt_s: float) -> np.ndarray:
     """Exact first-order step gain eps = 1 - exp(-2 pi f_c dt), f_c = cutoff (I + 20) / 275."""
     if cutoff_hz <= 0:
         return np.ones_like(intensity_dn, dtype=np.float64)
     f_c = cutoff_hz * (np.asarray(intensity_dn, dtype=np.float64) + 20.0) / 275.0
     return -np.expm1(-2.0 * np.pi * f_c * dt_s)
-
-
-def radiance_to_dn(radiance: np.ndarray, white: float) -> np.ndarray:
-    """Linear radiance -> linear 8-bit-equivalent DN, 255 L / white, neither clipped nor
-    quantised: the HDR input path. The model's DN-based constants (the 20 DN lin-log knee,
-    the bandwidth and noise laws) then keep their meaning, with `white` the radiance at
-    full scale (the renderer's display white)."""
-    return np.asarray(radiance, dtype=np.float64) * (255.0 / white)
 
 
 def _rng(seed: int, *key: int) -> np.random.Generator:

@@ -27,13 +27,10 @@ import numpy as np
 
 from .defaults import section
 from .dynamics import N_STATE, Vehicle, split_control_dynamics
+from .state import MASS_KG, STATE_SCALE, TIME_S
 
 TRANSCRIPTIONS = ("hermite-simpson", "trapezoidal")
 
-# Nondimensionalisation: length, speed, time (= length / speed), mass.
-LENGTH_M, SPEED_M_S, MASS_KG = 1000.0, 100.0, 1.0e4
-TIME_S = LENGTH_M / SPEED_M_S
-STATE_SCALE = np.array([LENGTH_M] * 3 + [SPEED_M_S] * 3 + [1.0] * 3 + [1.0 / TIME_S] * 3 + [MASS_KG])
 COST_SCALE = 1000.0  # J is divided by this so that it is O(1)
 
 # Final state: position, velocity, roll, pitch and body rates are fixed (pinpoint,

@@ -38,6 +38,12 @@ BODY_RATES = slice(9, 12)  # rad/s: p, q, r
 MASS = 12  # kg
 POSE = slice(0, 9)  # position, velocity, attitude: what the camera sees
 
+# Nondimensionalisation (the solver's and the integrators' scales): length, speed, time
+# (= length / speed), mass.
+LENGTH_M, SPEED_M_S, MASS_KG = 1000.0, 100.0, 1.0e4
+TIME_S = LENGTH_M / SPEED_M_S
+STATE_SCALE = np.array([LENGTH_M] * 3 + [SPEED_M_S] * 3 + [1.0] * 3 + [1.0 / TIME_S] * 3 + [MASS_KG])
+
 
 def rotation_body_to_inertial(phi, theta, psi, lib=np):
     """R_iv = Rz(psi) Ry(theta) Rx(phi) as a nested list (works for numpy and CasADi)."""

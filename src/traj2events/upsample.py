@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import CubicSpline
 
 from .dynamics import N_CONTROL, N_STATE, Dynamics
-from .ocp import STATE_SCALE
+from .state import STATE_SCALE
 
 METHODS = ("reintegrate", "spline")
 RTOL = 1e-10

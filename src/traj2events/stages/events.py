@@ -18,11 +18,12 @@ from typing import Iterator
 import numpy as np
 
 from .. import __version__
-from ..emulator import PRESETS, EmulatorParams, EventEmulator, radiance_to_dn
+from ..emulator import PRESETS, EmulatorParams, EventEmulator
 from ..formats.events import EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
+from ..log_response import radiance_to_dn
 from ..progress import log
 from ..state import BODY_RATES
 from ..video import iter_video, video_info
