@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .camera import Camera
-from .log_response import KNEE_DN
+from .log_response import log_intensity_8bit, radiance_to_dn
 from .motion_field import depth_flow
 
 MODES = ("fixed", "adaptive")
@@ -65,11 +65,9 @@ def log_change_rate(log_intensity: np.ndarray, flow_px_s: np.ndarray) -> np.ndar
 
 
 def emulator_log(radiance: np.ndarray, white_w_m2_sr: float) -> np.ndarray:
-    """The log intensity the emulator computes from a linear-radiance frame (log_response.py:
-    DN = 255 L / white, linear below the knee, ln above), in float32: it only predicts."""
-    dn = np.asarray(radiance, np.float32) * np.float32(255.0 / white_w_m2_sr)
-    knee = np.float32(KNEE_DN)
-    return np.where(dn <= knee, dn * np.float32(np.log(KNEE_DN) / KNEE_DN), np.log(np.maximum(dn, knee)))
+    """The log intensity the emulator computes from a linear-radiance frame (log_response),
+    in float32: it only predicts."""
+    return log_intensity_8bit(radiance_to_dn(radiance, white_w_m2_sr, np.float32), np.float32)
 
 
 def next_interval_s(max_log_rate: float, max_speed_px_s: float, timing: FrameTiming) -> float:

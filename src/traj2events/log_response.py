@@ -12,15 +12,17 @@ import numpy as np
 KNEE_DN = 20.0  # lin-log knee of the 8-bit mapping
 
 
-def log_intensity_8bit(frame_dn: np.ndarray) -> np.ndarray:
-    """8-bit DN -> log intensity: I ln(20)/20 up to the 20 DN knee, ln(I) above (float64)."""
-    i = np.asarray(frame_dn, dtype=np.float64)
-    return np.where(i <= KNEE_DN, i * (np.log(KNEE_DN) / KNEE_DN), np.log(np.maximum(i, KNEE_DN)))
+def log_intensity_8bit(frame_dn: np.ndarray, dtype=np.float64) -> np.ndarray:
+    """8-bit DN -> log intensity: I ln(20)/20 up to the 20 DN knee, ln(I) above, in `dtype`
+    (float64 for the emulator; float32 where it only predicts, frame_timing)."""
+    i = np.asarray(frame_dn, dtype=dtype)
+    slope = i.dtype.type(np.log(KNEE_DN) / KNEE_DN)  # a float64 scalar would promote float32
+    return np.where(i <= KNEE_DN, i * slope, np.log(np.maximum(i, KNEE_DN)))
 
 
-def radiance_to_dn(radiance: np.ndarray, white: float) -> np.ndarray:
+def radiance_to_dn(radiance: np.ndarray, white: float, dtype=np.float64) -> np.ndarray:
     """Linear radiance -> linear 8-bit-equivalent DN, 255 L / white, neither clipped nor
     quantised: the HDR input path. The model's DN-based constants (the 20 DN lin-log knee,
     the bandwidth and noise laws) then keep their meaning, with `white` the radiance at
     full scale (the renderer's display white)."""
-    return np.asarray(radiance, dtype=np.float64) * (255.0 / white)
+    return np.asarray(radiance, dtype=dtype) * (255.0 / white)
