@@ -50,30 +50,16 @@ def reintegrate(
     t_eval = np.empty(0) if t_eval is None else np.asarray(t_eval, dtype=float)
     if len(t_eval) and (t_eval.min() < t_nodes[0] or t_eval.max() > t_nodes[-1] or np.any(np.diff(t_eval) < 0)):
         raise ValueError("t_eval: expected sorted times within the node span [t_0, t_f]")
-    out = np.empty((len(t_eval), len(state0)))
-    state = np.asarray(state0, dtype=float).copy()
-    out[t_eval == t_nodes[0]] = state
-    f = dynamics.casadi
-    for k in range(len(t_nodes) - 1):
-        t_a, t_b = t_nodes[k], t_nodes[k + 1]
-        u_a, du = control_nodes[k], (control_nodes[k + 1] - control_nodes[k]) / (t_b - t_a)
-        inside = (t_eval > t_a) & (t_eval <= t_b)  # frames this interval reaches
-
-        def rhs(t, x, u_a=u_a, du=du, t_a=t_a):
-            return np.asarray(f(x, u_a + (t - t_a) * du)).ravel()
-
-        stops = np.union1d(t_eval[inside], [t_b])  # sorted; always ends at the next node
-        sol = solve_ivp(rhs, (t_a, t_b), state, method="DOP853", rtol=rtol, atol=atol, t_eval=stops)
-        out[inside] = sol.y.T[np.searchsorted(stops, t_eval[inside])]
-        state = sol.y[:, -1]
-    return out, state
+    trajectory = ReintegratedStates(dynamics, t_nodes, state0, control_nodes, rtol, atol)
+    return trajectory.states(t_eval), trajectory.final_state
 
 
 class ReintegratedStates:
-    """The re-integrated dynamics at any time in [t_0, t_f]: the same DOP853 integration as
-    `reintegrate` (same steps, interval by interval), kept with its dense output, so a
-    state at any time (an adaptive frame's pose) is as exact as one at a frame time.
-    `states(t)` for sorted or unsorted t within the node span: (len(t), 13)."""
+    """The re-integrated dynamics at any time in [t_0, t_f]: DOP853 interval by interval
+    (controls linear within one, so no step crosses a kink), kept with its dense output,
+    so a state at any time (a frame's pose, an adaptive frame's) comes from the same
+    integration. `states(t)` for sorted or unsorted t within the node span: (len(t), 13);
+    `final_state` at the last node."""
 
     def __init__(
         self,
@@ -99,12 +85,13 @@ class ReintegratedStates:
             sol = solve_ivp(rhs, (t_a, t_b), state, method="DOP853", rtol=rtol, atol=atol, dense_output=True)
             self._pieces.append(sol.sol)
             state = sol.y[:, -1]
+        self.final_state = state
 
     def states(self, t: np.ndarray) -> np.ndarray:
         t = np.atleast_1d(np.asarray(t, dtype=float))
         if len(t) and (t.min() < self.t_nodes[0] or t.max() > self.t_nodes[-1]):
             raise ValueError(f"t: expected times within the node span [{self.t_nodes[0]}, {self.t_nodes[-1]}] s")
-        # Interval k holds (t_k, t_k+1], as in `reintegrate`; t_0 is the initial state.
+        # Interval k holds (t_k, t_k+1]; t_0 is the initial state.
         piece = np.clip(np.searchsorted(self.t_nodes, t, side="left") - 1, 0, len(self._pieces) - 1)
         out = np.empty((len(t), len(self._state0)))
         for k in np.unique(piece):
