@@ -43,16 +43,10 @@ from traj2events.config import resolve_config  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.frame_timing import (  # noqa: E402
-    FrameTiming,
-    emulator_log,
-    frame_motion,
-    next_interval_s,
-    next_render_time,
-)
+from traj2events.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
 from traj2events.log_response import radiance_to_dn  # noqa: E402
 from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.stages.render import RenderSettings, render_between  # noqa: E402
 from traj2events.upsample import ReintegratedStates  # noqa: E402
 
 FIXED_FPS = (50, 100, 200, 400)
@@ -145,24 +139,24 @@ def run_clip(renderer, camera, states, white, t0: float, t1: float, ref_fps: int
         {"timing": f"fixed {rate} fps", "stream": s, "render_s": s.frames * per_frame_s} for rate, s in fixed.items()
     ]
     fixed_times = t0 + np.arange(int(round((t1 - t0) * fps)) + 1) / fps
+    tf = float(states.t_nodes[-1])
     for name, timing in ADAPTIVE.items():
-        stream, start = Stream(w, h), time.perf_counter()
+        # The render stage's own schedule (stages.render.render_between), timed with its prediction.
+        stream, render_adaptive_s = Stream(w, h), 0.0
         for k, t in enumerate(fixed_times):
-            tau = t
-            radiance, depth, state, _ = render(tau)
-            while True:
-                max_rate, max_speed = frame_motion(radiance, depth, camera, state, white)
-                dt = next_interval_s(max_rate, max_speed, timing)
-                stream.feed(radiance_to_dn(radiance, white), emulator_log(radiance, white), tau, 0.0)
-                if k + 1 == len(fixed_times):
-                    break
-                tau_next = next_render_time(tau, fixed_times[k + 1], dt, 1.0 / timing.max_fps)
-                stream.predicted_next = max_rate * (tau_next - tau)
-                if tau_next == fixed_times[k + 1]:
-                    break
-                tau = tau_next
-                radiance, depth, state, _ = render(tau)
-        rows.append({"timing": name, "stream": stream, "render_s": time.perf_counter() - start - stream.emulate_s})
+            start = time.perf_counter()
+            state = states.states([min(t, tf)])[0]
+            rendered = [(t, state, renderer.render(camera.pose(state)))]
+            if k + 1 < len(fixed_times):
+                t_next = fixed_times[k + 1]
+                rendered += render_between(renderer, camera, states, rendered[0][2], state, t, t_next, timing, white)
+            render_adaptive_s += time.perf_counter() - start
+            ends = [tau for tau, _, _ in rendered[1:]] + [fixed_times[min(k + 1, len(fixed_times) - 1)]]
+            for (tau, st, frame), t_end in zip(rendered, ends):
+                max_rate, _ = frame_motion(frame.radiance, frame.depth_m, camera, st, white)
+                dn, log_l = radiance_to_dn(frame.radiance, white), emulator_log(frame.radiance, white)
+                stream.feed(dn, log_l, tau, max_rate * (t_end - tau))
+        rows.append({"timing": name, "stream": stream, "render_s": render_adaptive_s})
     for row in rows:
         events = row["stream"].all_events()
         dt = matched_timing_errors_us(events, ref_events, w)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import os
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -130,18 +131,18 @@ def render_between(
     t_next_s: float,
     timing: FrameTiming,
     white_w_m2_sr: float,
-) -> list[tuple[float, object]]:
-    """The adaptive frames in (t_s, t_next_s) after `frame`, rendered from `state` at t_s:
-    [(t, frame)], each interval set by the motion of the frame before it (frame_timing)."""
-    extra = []
+) -> Iterator[tuple[float, np.ndarray, object]]:
+    """The adaptive frames in (t_s, t_next_s) after `frame`, rendered from `state` at t_s,
+    one at a time: (t, state, frame), each interval set by the motion of the frame before
+    it (frame_timing)."""
     while True:
         motion = frame_motion(frame.radiance, frame.depth_m, camera, state, white_w_m2_sr)
         t_s = next_render_time(t_s, t_next_s, next_interval_s(*motion, timing), 1.0 / timing.max_fps)
         if t_s >= t_next_s:
-            return extra
+            return
         state = states.states([t_s])[0]
         frame = renderer.render(camera.pose(state))
-        extra.append((t_s, frame))
+        yield t_s, state, frame
 
 
 def render_trajectory(
@@ -200,10 +201,10 @@ def render_trajectory(
                 between = render_between(
                     renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing, s.display_white_w_m2_sr
                 )
-                for t_extra, extra in between:
+                for t_extra, _, extra in between:  # written as rendered: memory stays one frame
                     out.append(t_extra, -1, extra.radiance, extra.depth_m)
                     triangles += extra.n_triangles
-                added += len(between)
+                    added += 1
             if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
                 elapsed = time.perf_counter() - start
                 log(
