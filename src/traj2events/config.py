@@ -149,10 +149,7 @@ def _semantic_errors(config: dict) -> list[str]:
     if config["events"]["hot_pixel_fraction"] > 0 and not config["events"]["hot_pixel_hz"] > 0:
         errors.append("config key 'events.hot_pixel_hz': expected > 0 when events.hot_pixel_fraction > 0")
     timing = config["render"]["timing"]
-    if timing["mode"] == "adaptive" and timing["max_log_change"] is None and timing["max_displacement_px"] is None:
-        errors.append(
-            "config key 'render.timing': adaptive needs max_log_change or max_displacement_px (both are null)"
-        )
+    errors += _timing_errors(timing)
     if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
@@ -160,6 +157,18 @@ def _semantic_errors(config: dict) -> list[str]:
     for name, sc in config["scenarios"].items():
         errors += _scenario_errors(config, name, sc)
     return errors or _elevation_grid_error(terrain)
+
+
+def _timing_errors(timing: dict) -> list[str]:
+    """FrameTiming's own checks (the render job would fail on them), before any job starts."""
+    from .frame_timing import FrameTiming
+
+    try:
+        FrameTiming(**timing)
+    except ValueError as error:
+        key, _, problem = str(error).partition(": ")  # "render.timing.x: expected ..."
+        return [f"config key '{key}': {problem}"]
+    return []
 
 
 def _display_errors(config: dict) -> list[str]:
