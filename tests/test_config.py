@@ -338,3 +338,10 @@ def test_config_readme_lists_every_key_with_its_default():
 def test_adaptive_timing_without_a_bound_or_room_is_refused(timing, fragment):
     with pytest.raises(ConfigError, match=fragment.replace(".", r"\.")):
         resolve_config({"camera": {"fps": 50.0}, "render": {"timing": timing}})
+
+
+def test_a_reversed_sensor_band_is_refused_before_any_job():
+    with pytest.raises(ConfigError, match=r"events.sensor.band_m': expected \[low, high\] with low < high"):
+        resolve_config({"events": {"sensor": {"band_m": [7.0e-7, 4.0e-7]}}})
+    with pytest.raises(ConfigError, match="events.sensor.quantum_efficiency"):
+        resolve_config({"events": {"sensor": {"quantum_efficiency": 1.2}}})

@@ -239,3 +239,23 @@ def test_rendered_regolith_backscatters():
                           reflectance=reflectance)  # fmt: skip
         centre[name] = frame.radiance[6:10, 6:10].mean()
     assert centre["opposition"] > 1.3 * centre["g = 120 deg"] > 0
+
+
+def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
+    from traj2events.stars import StarField
+
+    camera = Camera(64, 64, 45.0)
+    pose = camera_pose(state(x=-5000.0, altitude=2000.0, pitch=80.0))  # horizon across the image
+    terrain = ProceduralTerrain(TerrainParams(seed=4))
+    tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, LodSettings())
+    stars = StarField.draw(5.0, seed=1)  # ~ 1400 over the sky: ~60 in a 45 deg view
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), stars=stars) as renderer:
+        starry = renderer.render(pose)
+    plain, _ = render(terrain, camera, pose)
+    ground = plain.depth_m > 0
+    assert np.array_equal(starry.depth_m, plain.depth_m)
+    assert np.array_equal(starry.radiance[ground], plain.radiance[ground])
+    sky = starry.radiance[~ground]
+    assert 0 < np.count_nonzero(sky) < 0.2 * sky.size  # points, not a glow
+    # Each star's radiance x pixel solid angle sums to at most its irradiance (part may be hidden).
+    assert sky.max() * np.cos(np.radians(32)) ** 3 / camera.focal_px**2 <= stars.irradiance_w_m2.max()

@@ -85,3 +85,34 @@ def test_labels_through_the_command_same_events_and_reproducible(tmp_path):
         labels = labelled["events/label"][()]
         assert len(labels) == len(plain["events/t"]) > 100
     assert set(np.unique(labels)) <= {0, 1, 2, 3} and (labels == 0).any() and (labels == 1).any()
+
+
+def test_frames_h5_through_the_sensor_is_the_display_path_at_the_sensor_s_scale(tmp_path, capsys):
+    from traj2events.cli import main
+    from traj2events.defaults import section
+    from traj2events.sensor import SensorParams, sensor_dn
+
+    sensor = SensorParams.from_config(section("events")["sensor"])
+    dn_per_radiance = float(sensor_dn(np.array([1.0]), sensor)[0])
+    frames = ramp_frames().astype(np.float32) / 255.0 * 3.0 / dn_per_radiance  # 0 .. ~3 dark currents: the knee
+    with h5py.File(tmp_path / "frames.h5", "w") as f:
+        f["t"] = np.arange(len(frames)) / 50.0
+        f["radiance"] = frames
+        f.attrs["display_white_w_m2_sr"] = 40.0
+    through_sensor = frame_source(tmp_path / "frames.h5", sensor=sensor)
+    emulate(through_sensor, emulator_params("clean"), 0, tmp_path / "s.h5", "clean", "frames.h5")
+    same_scale = frame_source(tmp_path / "frames.h5", white=255.0 / dn_per_radiance)
+    emulate(same_scale, emulator_params("clean"), 0, tmp_path / "d.h5", "clean", "frames.h5")
+    (s, s_attrs), (d, _) = read_events(tmp_path / "s.h5"), read_events(tmp_path / "d.h5")
+    assert len(s) > 50 and s.tobytes() == d.tobytes()
+    assert s_attrs["sensor_f_number"] == sensor.f_number and "photocurrent" in s_attrs["input_kind"]
+    for bad, message in (
+        (["--white", "40"], "--white: only with --input-scale display"),
+        (["--sensor", '{"quantum_efficiency": 2}'], "events.sensor.quantum_efficiency: expected in (0, 1]"),
+    ):
+        assert main(["events", str(tmp_path / "frames.h5"), "-o", str(tmp_path / "x.h5"), *bad]) == 2
+        assert message in capsys.readouterr().err
+    assert not (tmp_path / "x.h5").exists()
+    assert main(["events", str(tmp_path / "frames.h5"), "-o", str(tmp_path / "c.h5"), "--preset", "clean",
+                 "--no-labels", "--sensor", f'{{"f_number": {sensor.f_number}}}']) == 0  # fmt: skip
+    assert read_events(tmp_path / "c.h5")[0].tobytes() == s.tobytes()

@@ -9,6 +9,7 @@ import os
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # one process per core is faster than BLAS threads
 
 import argparse
+import json
 import sys
 from pathlib import Path
 
@@ -86,6 +87,23 @@ def cmd_motion_field(args) -> int:
     return 0
 
 
+def _sensor(overrides: str | None):
+    """events.sensor's defaults with --sensor's JSON keys (inline or @file) on top."""
+    from .defaults import section
+    from .sensor import SensorParams
+
+    given = {}
+    if overrides:
+        text = Path(overrides[1:]).read_text() if overrides.startswith("@") else overrides
+        try:
+            given = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"--sensor: expected a JSON object of events.sensor keys: {exc}") from None
+        if not isinstance(given, dict):
+            raise ValueError(f"--sensor: expected a JSON object of events.sensor keys, got {text!r}")
+    return SensorParams.from_config({**section("events")["sensor"], **given})
+
+
 def _positive(option: str, value: float | None) -> None:
     if value is not None and not value > 0:
         raise ValueError(f"{option}: expected a value > 0, got {value}")
@@ -110,7 +128,10 @@ def cmd_events(args) -> int:
         from .formats.trajectory import read_trajectory
 
         read_trajectory(args.trajectory)  # refused now, not after the emulation
-    source = frame_source(args.input, args.chunk, args.fps, args.white)
+    if args.white is not None and args.input_scale != "display":
+        raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
+    sensor = _sensor(args.sensor) if args.input_scale == "sensor" else None
+    source = frame_source(args.input, args.chunk, args.fps, args.white, sensor)
     from .progress import log
 
     log(
@@ -309,7 +330,24 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
-    p.add_argument("--white", type=float, help="radiance at full scale for frames.h5 (default: its display white)")
+    p.add_argument(
+        "--input-scale",
+        choices=("sensor", "display"),
+        default=events["input"],
+        help="frames.h5's radiance as the sensor's photocurrent (--sensor; docs/events.md 'Sensor model') or as "
+        "255 L / white, the videos' scale (default %(default)s)",
+    )
+    p.add_argument(
+        "--sensor",
+        help="events.sensor keys to change, as JSON (inline or @file), e.g. '{\"f_number\": 4}' (defaults: "
+        + ", ".join(f"{k} {v}" for k, v in events["sensor"].items())
+        + ")",
+    )
+    p.add_argument(
+        "--white",
+        type=float,
+        help="with --input-scale display: radiance at full scale (default: frames.h5's display white)",
+    )
     p.add_argument(
         "--refractory-s", type=float, default=events["refractory_s"], help="refractory period, s (default %(default)s)"
     )

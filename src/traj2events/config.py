@@ -148,6 +148,9 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append("config key 'terrain.crater_diameter_min_m': expected at most terrain.crater_diameter_max_m")
     if config["events"]["hot_pixel_fraction"] > 0 and not config["events"]["hot_pixel_hz"] > 0:
         errors.append("config key 'events.hot_pixel_hz': expected > 0 when events.hot_pixel_fraction > 0")
+    band = config["events"]["sensor"]["band_m"]
+    if not band[0] < band[1]:
+        errors.append(f"config key 'events.sensor.band_m': expected [low, high] with low < high, got {band}")
     timing = config["render"]["timing"]
     errors += _timing_errors(timing)
     if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:

@@ -24,6 +24,7 @@ import numpy as np
 from .camera import Camera, CameraPose, opengl_camera_to_world
 from .illumination import Sun
 from .reflectance import ReflectanceParams, max_radiance_factor
+from .stars import StarField, add_stars
 from .tiles import TileKey, TileSet, depth_range
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
@@ -167,15 +168,22 @@ class TerrainRenderer:
     and kept while they are in use."""
 
     def __init__(
-        self, tiles: TileSet, camera: Camera, sun: Sun, reflectance: ReflectanceParams, max_cached_tiles: int = 4000
+        self,
+        tiles: TileSet,
+        camera: Camera,
+        sun: Sun,
+        reflectance: ReflectanceParams,
+        max_cached_tiles: int = 4000,
+        stars: StarField | None = None,
     ):
+        """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black sky."""
         pyrender = _import_pyrender()
         from pyrender.platforms.osmesa import OSMesaPlatform
         from pyrender.shader_program import ShaderProgramCache
 
         self._pyrender = pyrender
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
-        self.max_cached_tiles = max_cached_tiles
+        self.max_cached_tiles, self.stars = max_cached_tiles, stars
         self._radiance_max = float(max_radiance_factor(reflectance) * sun.irradiance_w_m2 / np.pi)
         self._platform = OSMesaPlatform(camera.width, camera.height)
         self._platform.init_context()
@@ -240,7 +248,10 @@ class TerrainRenderer:
         self._platform.make_current()
         image = self._renderer.render(self._scene, self._pyrender.RenderFlags.OFFSCREEN)
         n_tri = sum(len(self.tiles.tile(k).faces) for k in keys)
-        return Frame(image[..., 0], image[..., 1], len(keys), n_tri)
+        radiance, depth = image[..., 0], image[..., 1]
+        if self.stars is not None:
+            radiance = add_stars(radiance, depth, self.stars, self.camera, pose)
+        return Frame(radiance, depth, len(keys), n_tri)
 
     def _evict(self) -> None:
         """Drop the least recently drawn tiles beyond the cap (never this frame's)."""

@@ -3,6 +3,7 @@
 # its stage module's imports, so a change in the science reruns the rules it affects and
 # nothing else), and the list of everything the config asks for.
 import hashlib
+import json
 import shlex
 import sys
 from pathlib import Path
@@ -102,7 +103,7 @@ def event_options(wildcards):
     return (
         f"--preset {e['preset']} --refractory-s {e['refractory_s']} --refractory-mode {e['refractory_mode']} "
         f"--hot-pixel-fraction {e['hot_pixel_fraction']} --hot-pixel-hz {e['hot_pixel_hz']} "
-        f"--{'' if e['labels'] else 'no-'}labels"
+        f"--{'' if e['labels'] else 'no-'}labels --input-scale {e['input']} --sensor {shlex.quote(json.dumps(e['sensor']))}"
     )
 
 

@@ -2,13 +2,15 @@
 images) and write events.h5, plus the exports the config asks for.
 
 Inputs, each read in chunks so memory stays bounded:
-    frames.h5        linear radiance scaled to 8-bit-equivalent DN (the HDR path)
+    frames.h5        linear radiance as photocurrent through the sensor model (the HDR path;
+                     src/traj2events/sensor.py), or on the videos' display scale
     a video          8-bit grey, as v2e reads it
     a folder         8-bit grey images, sorted by name (needs the frame rate)
 """
 
 from __future__ import annotations
 
+import functools
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -25,6 +27,7 @@ from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
 from ..log_response import radiance_to_dn
 from ..progress import log
+from ..sensor import SensorParams, sensor_dn
 from ..state import BODY_RATES
 from ..video import iter_video, video_info
 
@@ -44,7 +47,7 @@ class FrameSource:
 
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
 SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_convention", "camera_mount_height_m",
-               "camera_position", "fps", "timing", "sun_range_m",
+               "camera_position", "fps", "timing", "stars", "sun_range_m",
                "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "reflectance", "terrain",
                "moon_radius_m", "scenario", "id")  # fmt: skip
 
@@ -70,21 +73,30 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
     return FrameSource(width, height, "images (8-bit)", images())
 
 
-def frames_source(path: Path, white: float | None, chunk: int) -> FrameSource:
+def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorParams | None = None) -> FrameSource:
+    """frames.h5's radiance as photocurrent through `sensor`, or (no sensor) on the display
+    scale 255 L / white (`white` or the file's display white)."""
     frames = FramesFile(path)
-    white = white or float(frames.attrs.get("display_white_w_m2_sr", 0) or 0)
-    if not white > 0:
-        frames.close()
-        raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
     _, height, width = frames.shape
+    scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
+    if sensor is not None:
+        to_dn = functools.partial(sensor_dn, sensor=sensor)
+        kind = "linear radiance as photocurrent (events.sensor)"
+        scene = {**scene, **{f"sensor_{k}": v for k, v in sensor.to_config().items()}}
+    else:
+        white = white or float(frames.attrs.get("display_white_w_m2_sr", 0) or 0)
+        if not white > 0:
+            frames.close()
+            raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
+        to_dn = functools.partial(radiance_to_dn, white=white)
+        kind = f"linear radiance (white {white:g} W m^-2 sr^-1)"
 
     def radiance():
         with frames:
             for chunk_radiance, times in frames.radiance_chunks(chunk):
-                yield radiance_to_dn(chunk_radiance, white), times
+                yield to_dn(chunk_radiance), times
 
-    scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
-    return FrameSource(width, height, f"linear radiance (white {white:g} W m^-2 sr^-1)", radiance(), scene)
+    return FrameSource(width, height, kind, radiance(), scene)
 
 
 def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
@@ -103,9 +115,14 @@ def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
 
 
 def frame_source(
-    path: str | os.PathLike, chunk: int = 64, fps: float | None = None, white: float | None = None
+    path: str | os.PathLike,
+    chunk: int = 64,
+    fps: float | None = None,
+    white: float | None = None,
+    sensor: SensorParams | None = None,
 ) -> FrameSource:
-    """The frames of frames.h5, a video or a folder of images (by what `path` is)."""
+    """The frames of frames.h5 (through `sensor`, or on the display scale without one), a
+    video or a folder of images (by what `path` is)."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"events INPUT: {path} does not exist")
@@ -114,7 +131,7 @@ def frame_source(
     if path.is_dir():
         return image_folder_source(path, fps, chunk)
     if path.suffix.lower() in (".h5", ".hdf5"):
-        return frames_source(path, white, chunk)
+        return frames_source(path, white, chunk, sensor)
     return video_source(path, fps, chunk)
 
 

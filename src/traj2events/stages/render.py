@@ -24,6 +24,7 @@ from ..illumination import Sun
 from ..progress import log
 from ..reflectance import ReflectanceParams
 from ..render import TerrainRenderer
+from ..stars import StarField
 from ..state import POSE
 from ..terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
 from ..tiles import LodSettings, TileSet
@@ -50,6 +51,7 @@ class RenderSettings:
     display_white_w_m2_sr: float
     display_gamma: float
     timing: dict
+    stars: dict
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
@@ -75,6 +77,7 @@ class RenderSettings:
             float(r["display_white_w_m2_sr"]),
             float(r["display_gamma"]),
             dict(r["timing"]),
+            dict(r["stars"]),
         )
 
     def to_json(self) -> str:
@@ -98,6 +101,12 @@ class RenderSettings:
             ReflectanceParams(**self.reflectance),
         )
 
+    def star_field(self) -> StarField | None:
+        """The sky's stars (render.stars), or None where they are off."""
+        if not self.stars["enabled"]:
+            return None
+        return StarField.draw(float(self.stars["magnitude_limit"]), int(self.stars["seed"]))
+
     def frame_attrs(self, camera: Camera, sun: Sun) -> dict:
         """The scene's description, stored with the frames."""
         return {
@@ -117,6 +126,7 @@ class RenderSettings:
             "display_white_w_m2_sr": self.display_white_w_m2_sr,
             "display_gamma": self.display_gamma,
             "timing": self.timing,
+            "stars": self.stars,
             **camera.intrinsics_attrs(),
         }
 
@@ -180,7 +190,7 @@ def render_trajectory(
     start = time.perf_counter()
     triangles = reused = added = 0
     with (
-        TerrainRenderer(tiles, camera, sun, reflectance) as renderer,
+        TerrainRenderer(tiles, camera, sun, reflectance, stars=s.star_field()) as renderer,
         FramesWriter(frames, s.height, s.width, attrs) as out,
         VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
         VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview,
@@ -233,6 +243,7 @@ FRAME_ATTR_ORDER = (
     "display_white_w_m2_sr",
     "display_gamma",
     "timing",
+    "stars",
     "scenario",
     "id",
     "traj2events_version",

@@ -1,0 +1,113 @@
+"""The event sensor behind its lens: rendered radiance -> photocurrent per pixel, and the
+emulator's input in units tied to that photocurrent (docs/events.md "Sensor model").
+
+    E_image = pi tau L_band / (4 N^2)               camera equation, object at infinity
+    Phi     = E_image p^2 / E_photon                 photons per second on the pixel
+    I_ph    = q QE Phi                               photocurrent, A
+
+L_band is the rendered radiance's share inside the sensor's band: the renderer's radiance
+is of the whole solar spectrum (1361 W/m^2 at 1 AU), the Sun is taken as a 5772 K black
+body and the regolith as grey, so the share and the mean photon energy come from Planck's
+law over the band. Off-axis fall-off (cos^4) is left out: a lens is usually corrected for it.
+
+The emulator's input is the photocurrent in units of the dark current times the 20 DN
+knee of its lin-log law, x = 20 I_ph / I_dark: the log response ln(I_ph + I_dark) of a
+real photoreceptor is linear below the dark current and logarithmic above it, which is
+what the emulator's knee does at x = 20. Its bandwidth law (proportional to x + 20, so to
+I_ph + I_dark) and its shot-noise law (falling with x) then refer to the photocurrent too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from .log_response import KNEE_DN
+
+ELEMENTARY_CHARGE_C = 1.602176634e-19
+PLANCK_J_S = 6.62607015e-34
+LIGHT_SPEED_M_S = 299792458.0
+BOLTZMANN_J_K = 1.380649e-23
+SUN_TEMPERATURE_K = 5772.0  # IAU 2015 nominal effective temperature
+
+
+@dataclass(frozen=True)
+class SensorParams:
+    """Optics and pixel of the event camera; defaults in defaults.yaml (events.sensor)."""
+
+    f_number: float
+    optics_transmittance: float
+    pixel_pitch_m: float
+    quantum_efficiency: float  # electrons per photon over the pixel's whole area (fill factor included)
+    band_m: tuple[float, float]  # the sensor's spectral band, m
+    dark_current_a: float
+
+    def __post_init__(self) -> None:
+        for key in ("f_number", "pixel_pitch_m", "dark_current_a"):
+            if not getattr(self, key) > 0:
+                raise ValueError(f"events.sensor.{key}: expected > 0, got {getattr(self, key)}")
+        for key in ("optics_transmittance", "quantum_efficiency"):
+            if not 0 < getattr(self, key) <= 1:
+                raise ValueError(f"events.sensor.{key}: expected in (0, 1], got {getattr(self, key)}")
+        low, high = self.band_m
+        if not 0 < low < high:
+            raise ValueError(f"events.sensor.band_m: expected [low, high] with 0 < low < high, got {list(self.band_m)}")
+
+    @classmethod
+    def from_config(cls, sensor: dict) -> SensorParams:
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(sensor) - known)
+        if unknown:
+            raise ValueError(f"events.sensor: unknown keys {unknown}; expected {sorted(known)}")
+        return cls(**{**sensor, "band_m": tuple(sensor["band_m"])})
+
+    def to_config(self) -> dict:
+        return {**asdict(self), "band_m": list(self.band_m)}
+
+
+def planck_spectral_radiance(wavelength_m: np.ndarray, temperature_k: float) -> np.ndarray:
+    """Black body B_lambda(T), W m^-2 sr^-1 m^-1."""
+    lam = np.asarray(wavelength_m, dtype=np.float64)
+    x = PLANCK_J_S * LIGHT_SPEED_M_S / (lam * BOLTZMANN_J_K * temperature_k)
+    return 2.0 * PLANCK_J_S * LIGHT_SPEED_M_S**2 / lam**5 / np.expm1(x)
+
+
+def _integrate(values: np.ndarray, grid: np.ndarray) -> float:
+    return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(grid)))
+
+
+def solar_band(band_m: tuple[float, float], temperature_k: float = SUN_TEMPERATURE_K) -> tuple[float, float]:
+    """(share of the Sun's power inside the band, photons per joule inside it) for a black
+    body at `temperature_k`: trapezoids on a fine log grid (the total from Stefan-Boltzmann)."""
+    grid = np.geomspace(band_m[0], band_m[1], 4001)  # log-spaced: wide bands too
+    spectrum = planck_spectral_radiance(grid, temperature_k)
+    in_band = _integrate(spectrum, grid)
+    total = 5.670374419e-8 * temperature_k**4 / np.pi  # sigma T^4 / pi, W m^-2 sr^-1
+    photons = _integrate(spectrum * grid / (PLANCK_J_S * LIGHT_SPEED_M_S), grid)
+    return in_band / total, photons / in_band
+
+
+def photocurrent_a(radiance_w_m2_sr: np.ndarray, sensor: SensorParams, dtype=np.float64) -> np.ndarray:
+    """Photocurrent per pixel (A) from the rendered (whole-spectrum) radiance."""
+    share, photons_per_j = solar_band(sensor.band_m)
+    amps_per_radiance = (
+        np.pi * sensor.optics_transmittance / (4.0 * sensor.f_number**2)  # radiance -> image irradiance
+        * sensor.pixel_pitch_m**2
+        * share
+        * photons_per_j
+        * sensor.quantum_efficiency
+        * ELEMENTARY_CHARGE_C
+    )  # fmt: skip
+    return np.asarray(radiance_w_m2_sr, dtype=dtype) * dtype(amps_per_radiance)
+
+
+def photocurrent_to_dn(photocurrent: np.ndarray, dark_current_a: float) -> np.ndarray:
+    """The emulator's input: the photocurrent in dark currents, times the 20 DN knee (so
+    the knee of its lin-log law sits at the dark current)."""
+    return photocurrent * photocurrent.dtype.type(KNEE_DN / dark_current_a)
+
+
+def sensor_dn(radiance_w_m2_sr: np.ndarray, sensor: SensorParams, dtype=np.float64) -> np.ndarray:
+    """Rendered radiance -> the emulator's input through the sensor model."""
+    return photocurrent_to_dn(photocurrent_a(radiance_w_m2_sr, sensor, dtype), sensor.dark_current_a)

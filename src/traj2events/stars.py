@@ -1,0 +1,100 @@
+"""Stars in the black sky, in physical radiance (docs/rendering.md "Stars").
+
+A seeded star field: directions uniform over the sphere (fixed in the inertial frame: the
+Moon turns by 0.5 deg/h, nothing over a landing), V magnitudes drawn from the whole sky's
+cumulative star counts
+
+    log10 N(< V) = 0.74 + 0.48 V        (stars brighter than V; Allen's Astrophysical
+                                          Quantities' counts, within ~15 % for 1 < V < 10)
+
+down to a limiting magnitude. Each star is taken as Sun-like, so its irradiance at the
+camera, over the whole spectrum like the renderer's sunlight, is
+
+    E = 1361 W/m^2 10^(-0.4 (V - V_sun)),     V_sun = -26.76 (Willmer 2018)
+
+and it lands on the image split bilinearly over the four pixels around its projection
+(sub-pixel motion then changes the pixels smoothly, as a blurred point would), as radiance
+E w / Omega_px with Omega_px = cos^3(theta) / f^2 the solid angle of a pixel theta off
+the boresight: the power through the aperture is E times its area whatever the pixels.
+Only sky pixels (depth 0) receive it: terrain hides the stars behind it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .camera import Camera, CameraPose
+from .illumination import SOLAR_CONSTANT_W_M2
+
+COUNT_LOG10_AT_V0 = 0.74  # log10 N(< V) = COUNT_LOG10_AT_V0 + COUNT_SLOPE V, whole sky
+COUNT_SLOPE = 0.48
+SUN_V_MAG = -26.76  # apparent V magnitude of the Sun (Willmer 2018, ApJS 236, 47)
+BRIGHTEST_V_MAG = -1.46  # Sirius: no star is drawn brighter
+
+
+def stars_brighter_than(v_mag: float | np.ndarray) -> float | np.ndarray:
+    """Expected number of stars brighter than V over the whole sky."""
+    return 10.0 ** (COUNT_LOG10_AT_V0 + COUNT_SLOPE * np.asarray(v_mag, dtype=float))
+
+
+def star_irradiance_w_m2(v_mag: np.ndarray) -> np.ndarray:
+    """Whole-spectrum irradiance of a Sun-like star of magnitude V at the Moon, W/m^2."""
+    return SOLAR_CONSTANT_W_M2 * 10.0 ** (-0.4 * (np.asarray(v_mag, dtype=float) - SUN_V_MAG))
+
+
+@dataclass(frozen=True)
+class StarField:
+    """Unit directions (n, 3) in the inertial frame and irradiances (n,) W/m^2."""
+
+    directions: np.ndarray
+    irradiance_w_m2: np.ndarray
+
+    @classmethod
+    def draw(cls, magnitude_limit: float, seed: int) -> StarField:
+        """The stars brighter than `magnitude_limit`, as many as the counts law expects."""
+        rng = np.random.default_rng(np.random.SeedSequence([seed, 0x57A125]))
+        n = int(round(float(stars_brighter_than(magnitude_limit))))
+        # Inverse of the cumulative count: the k-th brightest of n has N(< V) = u n, u uniform.
+        u = rng.uniform(0.0, 1.0, n)
+        v_mag = (np.log10(np.maximum(u * n, 1e-300)) - COUNT_LOG10_AT_V0) / COUNT_SLOPE
+        v_mag = np.maximum(v_mag, BRIGHTEST_V_MAG)
+        z = rng.uniform(-1.0, 1.0, n)
+        phi = rng.uniform(0.0, 2.0 * np.pi, n)
+        s = np.sqrt(1.0 - z**2)
+        directions = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
+        return cls(directions, star_irradiance_w_m2(v_mag))
+
+
+def star_radiance(stars: StarField, camera: Camera, pose: CameraPose) -> np.ndarray | None:
+    """(H, W) float32 radiance of the stars in view (W m^-2 sr^-1), before any masking;
+    None when none is in view."""
+    d_cam = stars.directions @ pose.rotation  # inertial -> camera (rotation is camera -> inertial)
+    ahead = d_cam[:, 2] > 1e-6
+    xy = camera.project(d_cam[ahead])
+    col_row = camera.to_pixel_index(xy)
+    inside = (
+        (col_row[:, 0] > -1) & (col_row[:, 0] < camera.width) & (col_row[:, 1] > -1) & (col_row[:, 1] < camera.height)
+    )
+    if not inside.any():
+        return None
+    col_row, irradiance, d = col_row[inside], stars.irradiance_w_m2[ahead][inside], d_cam[ahead][inside]
+    cos_theta = d[:, 2] / np.linalg.norm(d, axis=1)
+    radiance = irradiance * camera.focal_px**2 / cos_theta**3  # E / Omega_px
+    j0, i0 = np.floor(col_row[:, 0]).astype(np.int64), np.floor(col_row[:, 1]).astype(np.int64)
+    fx, fy = col_row[:, 0] - j0, col_row[:, 1] - i0
+    image = np.zeros((camera.height, camera.width), np.float64)
+    for dj, di, weight in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)), (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
+        j, i = j0 + dj, i0 + di
+        keep = (j >= 0) & (j < camera.width) & (i >= 0) & (i < camera.height)
+        np.add.at(image, (i[keep], j[keep]), radiance[keep] * weight[keep])
+    return image.astype(np.float32)
+
+
+def add_stars(radiance: np.ndarray, depth_m: np.ndarray, stars: StarField, camera: Camera, pose: CameraPose):
+    """The frame's radiance with the stars added on its sky pixels (depth 0)."""
+    image = star_radiance(stars, camera, pose)
+    if image is None:
+        return radiance
+    return radiance + np.where(depth_m == 0, image, np.float32(0))

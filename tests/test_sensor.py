@@ -1,0 +1,75 @@
+"""The sensor model against the camera equation and black-body facts worked out by hand."""
+
+import numpy as np
+import pytest
+
+from traj2events.defaults import section
+from traj2events.log_response import KNEE_DN
+from traj2events.sensor import SensorParams, photocurrent_a, sensor_dn, solar_band
+
+Q, H, C, K = 1.602176634e-19, 6.62607015e-34, 299792458.0, 1.380649e-23
+
+
+def _sensor(**changes) -> SensorParams:
+    return SensorParams.from_config({**section("events")["sensor"], **changes})
+
+
+def test_whole_spectrum_share_is_one_and_mean_photon_energy_is_2_701_kT():
+    # sigma T^4 (Stefan-Boltzmann) and <E> = pi^4 / (30 zeta(3)) k T for a black body
+    share, photons_per_j = solar_band((5e-8, 1e-3), 5772.0)
+    assert share == pytest.approx(1.0, abs=1e-3)
+    assert 1.0 / photons_per_j == pytest.approx(np.pi**4 / (30 * 1.2020569031595942) * K * 5772.0, rel=1e-3)
+
+
+def test_visible_band_holds_about_37_percent_of_the_sun():
+    # 400-700 nm of a 5772 K black body: 36.6 % (the measured AM0 spectrum: ~38 %)
+    share, _ = solar_band((4e-7, 7e-7), 5772.0)
+    assert share == pytest.approx(0.366, abs=0.003)
+
+
+def test_camera_equation_by_hand_in_a_narrow_band():
+    # White Lambertian surface under the Sun at normal incidence: L = E / pi, so the image
+    # irradiance is tau E / (4 N^2); in a 0.2 nm band at 550 nm each photon has h c / lambda.
+    lam, width = 550e-9, 0.2e-9
+    sensor = _sensor(f_number=2.8, optics_transmittance=0.8, pixel_pitch_m=10e-6, quantum_efficiency=0.6,
+                     band_m=[lam - width / 2, lam + width / 2])  # fmt: skip
+    e_sun = 1361.0
+    b = 2 * H * C**2 / lam**5 / np.expm1(H * C / (lam * K * 5772.0))  # Planck, W m^-2 sr^-1 m^-1
+    share = b * width / (5.670374419e-8 * 5772.0**4 / np.pi)
+    watts_on_pixel = 0.8 * e_sun * share / (4 * 2.8**2) * (10e-6) ** 2
+    expected = watts_on_pixel / (H * C / lam) * 0.6 * Q
+    assert photocurrent_a(np.array([e_sun / np.pi]), sensor)[0] == pytest.approx(expected, rel=1e-4)
+
+
+def test_knee_sits_at_the_dark_current_and_the_input_is_linear():
+    sensor = _sensor()
+    one_dark = sensor.dark_current_a / photocurrent_a(np.array([1.0]), sensor)[0]  # radiance giving I_dark
+    dn = sensor_dn(np.array([0.0, one_dark, 2 * one_dark, 1e3 * one_dark]), sensor)
+    assert dn == pytest.approx([0.0, KNEE_DN, 2 * KNEE_DN, 1e3 * KNEE_DN], rel=1e-12)
+    assert sensor_dn(np.array([1.0], np.float32), sensor, np.float32).dtype == np.float32
+
+
+def test_lunar_daylight_is_far_above_the_dark_current():
+    # A sunlit regolith patch (I/F ~ 0.1 under 1361 W/m^2: L ~ 43 W/m^2/sr) gives pA, i.e.
+    # thousands of dark currents: the knee only matters in shadows and the sky.
+    current = photocurrent_a(np.array([0.1 * 1361 / np.pi]), _sensor())[0]
+    assert 1e-12 < current < 1e-10
+
+
+@pytest.mark.parametrize(
+    "key, value, message",
+    [
+        ("quantum_efficiency", 1.5, "events.sensor.quantum_efficiency: expected in (0, 1]"),
+        ("f_number", 0.0, "events.sensor.f_number: expected > 0"),
+        ("band_m", [7e-7, 4e-7], "events.sensor.band_m: expected [low, high]"),
+        ("dark_current_a", -1e-15, "events.sensor.dark_current_a: expected > 0"),
+    ],
+)
+def test_bad_sensor_values_name_the_key(key, value, message):
+    with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("(", r"\(").replace("]", r"\]")):
+        _sensor(**{key: value})
+
+
+def test_unknown_sensor_key_is_named():
+    with pytest.raises(ValueError, match="events.sensor: unknown keys \\['aperture'\\]"):
+        _sensor(aperture=2.0)
