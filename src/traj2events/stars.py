@@ -67,34 +67,46 @@ class StarField:
         return cls(directions, star_irradiance_w_m2(v_mag))
 
 
-def star_radiance(stars: StarField, camera: Camera, pose: CameraPose) -> np.ndarray | None:
-    """(H, W) float32 radiance of the stars in view (W m^-2 sr^-1), before any masking;
-    None when none is in view."""
+def star_splat(stars: StarField, camera: Camera, pose: CameraPose) -> tuple[np.ndarray, np.ndarray]:
+    """The stars in view as (flat pixel indices, radiance W m^-2 sr^-1) pairs, four per
+    star (bilinear), before any masking; an index may repeat."""
     d_cam = stars.directions @ pose.rotation  # inertial -> camera (rotation is camera -> inertial)
-    ahead = d_cam[:, 2] > 1e-6
-    xy = camera.project(d_cam[ahead])
-    col_row = camera.to_pixel_index(xy)
+    d_cam = d_cam[d_cam[:, 2] > 1e-6]
+    irradiance = stars.irradiance_w_m2[stars.directions @ pose.rotation[:, 2] > 1e-6]
+    col_row = camera.to_pixel_index(camera.project(d_cam))
     inside = (
         (col_row[:, 0] > -1) & (col_row[:, 0] < camera.width) & (col_row[:, 1] > -1) & (col_row[:, 1] < camera.height)
     )
-    if not inside.any():
-        return None
-    col_row, irradiance, d = col_row[inside], stars.irradiance_w_m2[ahead][inside], d_cam[ahead][inside]
+    col_row, irradiance, d = col_row[inside], irradiance[inside], d_cam[inside]
     cos_theta = d[:, 2] / np.linalg.norm(d, axis=1)
     radiance = irradiance * camera.focal_px**2 / cos_theta**3  # E / Omega_px
     j0, i0 = np.floor(col_row[:, 0]).astype(np.int64), np.floor(col_row[:, 1]).astype(np.int64)
     fx, fy = col_row[:, 0] - j0, col_row[:, 1] - i0
-    image = np.zeros((camera.height, camera.width), np.float64)
+    index, value = [], []
     for dj, di, weight in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)), (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
         j, i = j0 + dj, i0 + di
         keep = (j >= 0) & (j < camera.width) & (i >= 0) & (i < camera.height)
-        np.add.at(image, (i[keep], j[keep]), radiance[keep] * weight[keep])
-    return image.astype(np.float32)
+        index.append(i[keep] * camera.width + j[keep])
+        value.append(radiance[keep] * weight[keep])
+    return np.concatenate(index), np.concatenate(value)
+
+
+def star_radiance(stars: StarField, camera: Camera, pose: CameraPose) -> np.ndarray | None:
+    """(H, W) float32 radiance of the stars in view, before any masking; None when none is."""
+    index, value = star_splat(stars, camera, pose)
+    if not index.size:
+        return None
+    image = np.bincount(index, value, minlength=camera.width * camera.height)
+    return image.reshape(camera.height, camera.width).astype(np.float32)
 
 
 def add_stars(radiance: np.ndarray, depth_m: np.ndarray, stars: StarField, camera: Camera, pose: CameraPose):
-    """The frame's radiance with the stars added on its sky pixels (depth 0)."""
-    image = star_radiance(stars, camera, pose)
-    if image is None:
+    """The frame's radiance with the stars added on its sky pixels (depth 0); the input
+    array itself where no star falls on the sky."""
+    index, value = star_splat(stars, camera, pose)
+    sky = depth_m.reshape(-1)[index] == 0
+    if not sky.any():
         return radiance
-    return radiance + np.where(depth_m == 0, image, np.float32(0))
+    out = radiance.copy()
+    np.add.at(out.reshape(-1), index[sky], value[sky].astype(np.float32))
+    return out
