@@ -73,3 +73,13 @@ def test_bad_sensor_values_name_the_key(key, value, message):
 def test_unknown_sensor_key_is_named():
     with pytest.raises(ValueError, match="events.sensor: unknown keys \\['aperture'\\]"):
         _sensor(aperture=2.0)
+
+
+def test_the_emulator_white_is_the_radiance_at_255_dn_on_either_scale():
+    from traj2events.sensor import emulator_white_w_m2_sr
+
+    events = section("events")
+    assert emulator_white_w_m2_sr({**events, "input": "display"}, 40.0) == 40.0
+    white = emulator_white_w_m2_sr({**events, "input": "sensor"}, 40.0)
+    assert sensor_dn(np.array([white]), _sensor())[0] == pytest.approx(255.0)
+    assert white == pytest.approx(12.75 * 1e-15 / photocurrent_a(np.array([1.0]), _sensor())[0])  # 12.75 dark currents

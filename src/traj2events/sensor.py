@@ -111,3 +111,12 @@ def photocurrent_to_dn(photocurrent: np.ndarray, dark_current_a: float) -> np.nd
 def sensor_dn(radiance_w_m2_sr: np.ndarray, sensor: SensorParams, dtype=np.float64) -> np.ndarray:
     """Rendered radiance -> the emulator's input through the sensor model."""
     return photocurrent_to_dn(photocurrent_a(radiance_w_m2_sr, sensor, dtype), sensor.dark_current_a)
+
+
+def emulator_white_w_m2_sr(events: dict, display_white_w_m2_sr: float) -> float:
+    """The radiance the emulator's input puts at 255 DN for the config's `events` section:
+    the display white (input: display) or the radiance of 12.75 dark currents (sensor).
+    Both inputs are radiance times a constant; this is the constant's inverse, times 255."""
+    if events["input"] == "display":
+        return display_white_w_m2_sr
+    return 255.0 / float(sensor_dn(np.array([1.0]), SensorParams.from_config(events["sensor"]))[0])

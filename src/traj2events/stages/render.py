@@ -24,6 +24,7 @@ from ..illumination import Sun
 from ..progress import log
 from ..reflectance import ReflectanceParams
 from ..render import TerrainRenderer
+from ..sensor import emulator_white_w_m2_sr
 from ..stars import StarField
 from ..state import POSE
 from ..terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
@@ -52,6 +53,7 @@ class RenderSettings:
     display_gamma: float
     timing: dict
     stars: dict
+    emulator_white_w_m2_sr: float | None  # adaptive timing: the emulator's 255 DN (its log response's scale)
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
@@ -78,6 +80,11 @@ class RenderSettings:
             float(r["display_gamma"]),
             dict(r["timing"]),
             dict(r["stars"]),
+            # Only adaptive frames depend on the emulator's input scale (None: fixed renders
+            # do not rerun when the sensor settings change).
+            emulator_white_w_m2_sr(config["events"], float(r["display_white_w_m2_sr"]))
+            if r["timing"]["mode"] == "adaptive"
+            else None,
         )
 
     def to_json(self) -> str:
@@ -209,7 +216,7 @@ def render_trajectory(
             shown_preview.write(shown)
             if states is not None and k + 1 < n:
                 between = render_between(
-                    renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing, s.display_white_w_m2_sr
+                    renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing, s.emulator_white_w_m2_sr
                 )
                 for t_extra, _, extra in between:  # written as rendered: memory stays one frame
                     out.append(t_extra, -1, extra.radiance, extra.depth_m)
