@@ -340,3 +340,18 @@ def test_sphere_displacement_marks_sky_out_of_view_and_beyond_the_limb():
     x_next, y_next = x_s + disp[..., 0], y_s + disp[..., 1]
     outside = (np.abs(x_next) > CAM.width / 2) | (np.abs(y_next) > CAM.height / 2)
     np.testing.assert_array_equal(status[within] == OUT_OF_VIEW, outside[within])
+
+
+def test_field_difference_by_hand():
+    from traj2events.motion_field import field_difference
+
+    a = np.zeros((4, 5, 2), np.float32)
+    b = a.copy()
+    b[..., 0], b[..., 1] = -3.0, 4.0  # a - b = (3, -4) everywhere: RMS length 5
+    b[0, 0] = (100.0, 100.0)  # outside the mask: ignored
+    mask = np.ones((4, 5), bool)
+    mask[0, 0] = False
+    mean, rms = field_difference(a, b, mask)
+    assert mean.tolist() == [3.0, -4.0] and rms == 5.0
+    mean, rms = field_difference(a, b, np.zeros((4, 5), bool))
+    assert np.isnan(mean).all() and np.isnan(rms)

@@ -22,6 +22,7 @@ from ..motion_field import (
     STATUS_NAMES,
     depth_displacement,
     depth_flow,
+    field_difference,
     sphere_displacement,
     sphere_flow,
 )
@@ -115,11 +116,7 @@ def motion_field(
                     out["flow_terrain"][i], out["displacement_terrain"][i] = terrain_flow, disp.astype(np.float32)
                     out["status_terrain"][i] = status
                     out["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
-                    both = seen & on_sphere
-                    if both.any():
-                        diff = (flow - terrain_flow)[both]
-                        offset_mean[i] = diff.mean(axis=0)
-                        offset_rms[i] = np.sqrt(np.mean(np.sum(diff**2, axis=1)))
+                    offset_mean[i], offset_rms[i] = field_difference(flow, terrain_flow, seen & on_sphere)
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
             if rendered is not None:
