@@ -7,7 +7,10 @@ Input: a 1 s clip from the middle of the trajectory, rendered by the render stag
 --size and --fps: frames.h5 (linear radiance, the workflow's events input) and video.mkv
 (8-bit lossless, the paper's input). Commands, each run whole (start-up, decoding,
 emulation, writing), on one core (OMP/MKL/NUMBA/torch threads 1), alternated A B C A B C:
-  A  traj2events events frames.h5 --preset paper --no-labels
+  A  traj2events events frames.h5 --preset paper --no-labels (the workflow's input: the
+     photocurrent of events.sensor)
+  A' the same on the display scale (--input-scale display: fewer events, the input of
+     sessions before the sensor model)
   B  traj2events events video.mkv --preset paper --no-labels
   C  v2e.py on video.mkv with the paper's Table 2 parameters, no SuperSloMo, events to
      HDF5 (--dvs_h5), no video outputs. --v2e: a checkout of github.com/SensorsINI/v2e
@@ -93,11 +96,15 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         frames, video = clip_inputs(args.trajectory, args.size, args.fps, folder)
+        paper = ["--preset", "paper", "--no-labels"]
         commands = {
-            "A ours, frames.h5": [*ours, str(frames), "-o", str(folder / "a.h5"), "--preset", "paper", "--no-labels"],
-            "B ours, video.mkv": [*ours, str(video), "-o", str(folder / "b.h5"), "--preset", "paper", "--no-labels"],
-        }
-        outputs = {"A ours, frames.h5": folder / "a.h5", "B ours, video.mkv": folder / "b.h5"}
+            "A ours, frames.h5": [*ours, str(frames), "-o", str(folder / "a.h5"), *paper],
+            "A' ours, frames.h5, display scale": [
+                *ours, str(frames), "-o", str(folder / "a2.h5"), *paper, "--input-scale", "display"
+            ],
+            "B ours, video.mkv": [*ours, str(video), "-o", str(folder / "b.h5"), *paper],
+        }  # fmt: skip
+        outputs = {name: Path(command[command.index("-o") + 1]) for name, command in commands.items()}
         if args.v2e:
             out = folder / "v2e"
             commands["C v2e, video.mkv"] = [
@@ -126,7 +133,7 @@ def main() -> None:
         print("\nv2e: not run (no --v2e checkout given)")
         return
     v2e = statistics.median(seconds["C v2e, video.mkv"])
-    for name in ("A ours, frames.h5", "B ours, video.mkv"):
+    for name in (n for n in seconds if n.startswith(("A", "B"))):
         print(f"\nv2e / {name}: {v2e / statistics.median(seconds[name]):.1f}x")
 
 

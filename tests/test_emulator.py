@@ -141,7 +141,7 @@ def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
     pix, t, on = np.empty(n, np.int64), np.empty(n), np.empty(n, np.bool_)
     g_max = 1.0 - 0.75 * 20.0 / 275.0
     k = _noise_candidates(
-        n, np.uint64(12345), _alias_table(weights), np.zeros(len(weights), np.uint8), g_max, 2.0, 0.01, pix, t, on
+        n, np.uint64(12345), _alias_table(weights), np.zeros(len(weights), np.uint8), 1.0, g_max, 2.0, 0.01, pix, t, on
     )
     assert k == n
     expected = n * weights / weights.sum()
@@ -152,7 +152,7 @@ def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
     assert on.mean() == pytest.approx(0.5, abs=5 * 0.5 / np.sqrt(n))
     # Bright pixels keep only g(I) / g_max of their candidates.
     bright = np.full(len(weights), 255, np.uint8)
-    kept = _noise_candidates(n, np.uint64(7), _alias_table(weights), bright, g_max, 0.0, 0.01, pix, t, on)
+    kept = _noise_candidates(n, np.uint64(7), _alias_table(weights), bright, 1.0, g_max, 0.0, 0.01, pix, t, on)
     g = 1 - 0.75 * (255 + 20) / 275
     assert kept == pytest.approx(n * g / g_max, abs=5 * np.sqrt(n * 0.25))
 
@@ -361,3 +361,31 @@ def test_shot_noise_and_hot_pixel_events_are_labelled_as_such():
     # Shot noise at R g(I) per pixel, g = 1 - 0.75 (I + 20) / 275 (a static scene: nothing else fires).
     g = 1 - 0.75 * (90 + 20) / 275
     assert (labels == SHOT_NOISE).sum() == pytest.approx(20.0 * g * 900 * 1.0, rel=0.1)
+
+
+def test_input_scale_on_float32_frames_is_the_float64_product_byte_for_byte():
+    """Scaling inside the kernels (no float64 copy of the frames) gives the events of the
+    frames multiplied in float64 beforehand: same noise, labels and chunking invariance."""
+    rng = np.random.default_rng(4)
+    radiance = (rng.uniform(0.0, 3.0, (12, 20, 24)) * np.linspace(0.2, 2.0, 12)[:, None, None]).astype(np.float32)
+    radiance[:, :3] = 0.0  # a dark band: knee, slow bandwidth and shot noise
+    times = np.arange(12) * 0.01
+    scale = 37.3
+    outputs = []
+    for frames, input_scale, chunks in (
+        (radiance.astype(np.float64) * scale, 1.0, [12]),
+        (radiance, scale, [12]),
+        (radiance, scale, [5, 7]),
+    ):
+        emulator = EventEmulator(24, 20, PRESETS["paper"], seed=3, labels=True, input_scale=input_scale)
+        start, parts = 0, []
+        for n in chunks:
+            parts.append(emulator.process_with_labels(frames[start : start + n], times[start : start + n]))
+            start += n
+        outputs.append((np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])))
+    reference = outputs[0]
+    assert len(reference[0]) > 100 and (reference[1] == 1).any()  # shot noise in the dark band
+    for events, labels in outputs[1:]:
+        assert events.tobytes() == reference[0].tobytes() and labels.tobytes() == reference[1].tobytes()
+    with pytest.raises(ValueError, match="input_scale: expected a finite value > 0"):
+        EventEmulator(4, 4, input_scale=0.0)

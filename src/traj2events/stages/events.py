@@ -10,7 +10,6 @@ Inputs, each read in chunks so memory stays bounded:
 
 from __future__ import annotations
 
-import functools
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -25,9 +24,8 @@ from ..formats.events import EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
-from ..log_response import radiance_to_dn
 from ..progress import log
-from ..sensor import SensorParams, sensor_dn
+from ..sensor import SensorParams, dn_per_radiance
 from ..state import BODY_RATES
 from ..video import iter_video, video_info
 
@@ -43,6 +41,7 @@ class FrameSource:
     kind: str
     chunks: Iterator[tuple[np.ndarray, np.ndarray]]
     scene: dict = field(default_factory=dict)  # what frames.h5 says of the camera and the scene
+    input_scale: float = 1.0  # the chunks' values times this are the emulator's DN
 
 
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
@@ -80,7 +79,7 @@ def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorPar
     _, height, width = frames.shape
     scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
     if sensor is not None:
-        to_dn = functools.partial(sensor_dn, sensor=sensor)
+        scale = dn_per_radiance(sensor)
         kind = "linear radiance as photocurrent (events.sensor)"
         scene = {**scene, **{f"sensor_{k}": v for k, v in sensor.to_config().items()}}
     else:
@@ -88,15 +87,14 @@ def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorPar
         if not white > 0:
             frames.close()
             raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
-        to_dn = functools.partial(radiance_to_dn, white=white)
+        scale = 255.0 / white  # radiance_to_dn's factor
         kind = f"linear radiance (white {white:g} W m^-2 sr^-1)"
 
-    def radiance():
+    def radiance():  # float32 as stored: the emulator scales it per pixel (no float64 copy)
         with frames:
-            for chunk_radiance, times in frames.radiance_chunks(chunk):
-                yield to_dn(chunk_radiance), times
+            yield from frames.radiance_chunks(chunk)
 
-    return FrameSource(width, height, kind, radiance(), scene)
+    return FrameSource(width, height, kind, radiance(), scene, scale)
 
 
 def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
@@ -157,7 +155,9 @@ def emulate(
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
     `input_name` are recorded in its attributes; with `labels`, each event's cause too).
     Returns (frames, events, time of the last frame in s)."""
-    emulator = EventEmulator(source.width, source.height, params, seed=seed, labels=labels)
+    emulator = EventEmulator(
+        source.width, source.height, params, seed=seed, labels=labels, input_scale=source.input_scale
+    )
     attrs = {
         "preset": preset,
         "seed": seed,
