@@ -1,0 +1,158 @@
+"""Benchmark: what the paper's dataset costs, from the stages' own commands at its size.
+
+  python bench/workflow_cost.py results/braking/0000/trajectory.h5 results/descent/0000/trajectory.h5 \\
+      [--config config/paper.yaml] [--seconds 0.5 1.0]
+
+For each trajectory, clips from mid-flight of each length in --seconds (poses from the
+re-integrated dynamics at the config's fps) go through the commands the workflow runs,
+each whole and on one core (OMP/LP threads 1): `traj2events render` (with its two ffmpeg
+encoders), `traj2events motion-field --frames` (every n-th frame as the config says) and
+`traj2events events` (the config's preset, input and labels). Each command's CPU time,
+its children's included (the encoders), is fitted as a + b frames over the clip lengths:
+b is the cost per frame, a the cost per job (start-up, tile building). Disk per frame of
+each output comes from the longest clip. Then the config's dataset (`traj2events.plan`'s
+frame, field and trajectory counts, t_f = tf_guess_s) at those rates: CPU core-hours per
+stage and in all, and disk per output kind. Rates are averaged over the trajectories
+given. The trajectory solves are left out (~0.02 core-hours for 500, docs/benchmarks.md).
+GPU-hours are not measured here (no GPU on this machine).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+
+import numpy as np  # noqa: E402
+
+from traj2events.config import load_config  # noqa: E402
+from traj2events.dynamics import Dynamics  # noqa: E402
+from traj2events.formats.trajectory import read_trajectory, write_trajectory  # noqa: E402
+from traj2events.plan import dataset_plan  # noqa: E402
+from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
+
+ONE_CORE = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1", "LP_NUM_THREADS": "1"}
+STAGES = ("render", "motion field", "events")
+
+
+def clip_trajectory(trajectory: Path, t0_s: float, seconds: float, fps: float, output: Path) -> int:
+    """A trajectory.h5 of `seconds` from t0_s (poses from the re-integrated dynamics); its frames."""
+    tr = read_trajectory(trajectory)
+    t = t0_s + np.arange(int(round(seconds * fps)) + 1) / fps
+    states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes).states(t)
+    poses = (t, states, interpolate_controls(tr.t_nodes, tr.control_nodes, t))
+    write_trajectory(output, (tr.t_nodes, tr.state_nodes, tr.control_nodes), poses, {**tr.attrs, "fps": fps})
+    return len(t)
+
+
+def cpu_seconds(command: list[str]) -> float:
+    """CPU seconds (user + system) of a command and the children it waited for."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    done = subprocess.run(command, env={**os.environ, **ONE_CORE}, capture_output=True, text=True)
+    if done.returncode:
+        raise RuntimeError(f"{' '.join(command)} failed:\n{done.stderr[-3000:]}")
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def stage_commands(config: dict, scenario: str, clip: Path, folder: Path) -> dict[str, list[str]]:
+    cli = [str(Path(sys.executable).parent / "traj2events")]
+    camera, events = config["camera"], config["events"]
+    settings = RenderSettings.from_config(config, scenario).to_json()
+    frames = folder / "frames.h5"
+    return {
+        "render": [*cli, "render", str(clip), "--settings", settings, "--frames", str(frames),
+                   "--video", str(folder / "video.mkv"), "--preview", str(folder / "preview.mp4")],
+        "motion field": [*cli, "motion-field", str(clip), "--width", str(camera["width"]),
+                         "--height", str(camera["height"]), "--fov-deg", str(camera["fov_deg"]),
+                         "--mount-height-m", str(camera["mount_height_m"]),
+                         "--every", str(config["motion_field"]["every_n_frames"]), "--frames", str(frames),
+                         "-o", str(folder / "motion_field.h5"), "--flo-dir", str(folder / "flow")],
+        "events": [*cli, "events", str(frames), "-o", str(folder / "events.h5"), "--seed", "1",
+                   "--preset", events["preset"], "--input-scale", events["input"],
+                   "--sensor", json.dumps(events["sensor"]), "--labels" if events["labels"] else "--no-labels"],
+    }  # fmt: skip
+
+
+def output_bytes(folder: Path) -> dict[str, int]:
+    sizes = {name: (folder / name).stat().st_size for name in ("frames.h5", "video.mkv", "preview.mp4", "events.h5")}
+    sizes["motion_field.h5"] = (folder / "motion_field.h5").stat().st_size
+    sizes["flow/*.flo"] = sum(p.stat().st_size for p in (folder / "flow").iterdir())
+    return sizes
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("trajectories", type=Path, nargs="+", help="trajectory.h5 files (results/SCENARIO/ID/)")
+    parser.add_argument("--config", type=Path, default=ROOT / "config" / "paper.yaml")
+    parser.add_argument("--seconds", type=float, nargs="+", default=[0.5, 1.0], help="clip lengths, s")
+    args = parser.parse_args()
+    config = load_config(args.config)
+    fps, every = config["camera"]["fps"], config["motion_field"]["every_n_frames"]
+    per_frame = {stage: [] for stage in STAGES}  # b: CPU s per frame (per field for the motion field)
+    per_job = {stage: [] for stage in STAGES}  # a: CPU s per job
+    disk_per_frame: dict[str, list[float]] = {}
+    print(
+        f"# workflow cost: {args.config}, {config['camera']['width']}^2 at {fps:g} fps, clips of {args.seconds} s; "
+        f"{platform.node()} ({os.cpu_count()} cores, 1 per command), {time.strftime('%Y-%m-%d')}"
+    )
+    print("| trajectory | stage | CPU s per job (a) | CPU s per frame (b) | runs: frames -> CPU s |")
+    print("|---|---|---|---|---|")
+    for path in args.trajectories:
+        tr = read_trajectory(path)
+        scenario, t0 = str(tr.attrs["scenario"]), float(tr.t_nodes[-1]) / 2
+        runs = {stage: [] for stage in STAGES}
+        for seconds in sorted(args.seconds):
+            with tempfile.TemporaryDirectory() as tmp:
+                folder = Path(tmp)
+                n = clip_trajectory(path, t0, seconds, fps, folder / "clip.h5")
+                fields = len(range(0, n - 1, every))
+                for stage, command in stage_commands(config, scenario, folder / "clip.h5", folder).items():
+                    runs[stage].append((fields if stage == "motion field" else n, cpu_seconds(command)))
+                sizes = output_bytes(folder)
+            for name, size in sizes.items():
+                count = fields if name in ("motion_field.h5", "flow/*.flo") else n
+                disk_per_frame.setdefault(name, []).append(size / count)
+        for stage, points in runs.items():
+            x, y = np.array(points, dtype=float).T
+            b, a = np.polyfit(x, y, 1) if len(set(x)) > 1 else (y[0] / x[0], 0.0)
+            per_frame[stage].append(b)
+            per_job[stage].append(a)
+            shown = ", ".join(f"{int(f)} -> {s:.1f}" for f, s in points)
+            print(f"| {scenario} | {stage} | {a:.1f} | {b:.4f} | {shown} |", flush=True)
+    plan = dataset_plan(config)
+    hours = {
+        "render": (np.mean(per_frame["render"]) * plan.frames + np.mean(per_job["render"]) * plan.trajectories),
+        "motion field": np.mean(per_frame["motion field"]) * plan.fields
+        + np.mean(per_job["motion field"]) * plan.trajectories,
+        "events": np.mean(per_frame["events"]) * plan.frames + np.mean(per_job["events"]) * plan.trajectories,
+    }
+    print(f"\n{args.config}: {plan.trajectories} trajectories, {plan.frames:,} frames, {plan.fields:,} fields")
+    print("| stage | CPU core-hours |")
+    print("|---|---|")
+    for stage, seconds in hours.items():
+        print(f"| {stage} | {seconds / 3600:.3g} |")
+    print(f"| **all** | **{sum(hours.values()) / 3600:.3g}** |")
+    print("\n| output | bytes per frame (field) | the config's dataset |")
+    print("|---|---|---|")
+    for name, sizes in disk_per_frame.items():
+        count = plan.fields if name in ("motion_field.h5", "flow/*.flo") else plan.frames
+        kept = name != "frames.h5" or config["render"]["keep_frames"]
+        total = np.mean(sizes) * count / 1e12
+        print(f"| {name} | {np.mean(sizes) / 1e6:.2f} MB | {total:.3g} TB{'' if kept else ' (not kept)'} |")
+
+
+if __name__ == "__main__":
+    main()
