@@ -6,7 +6,8 @@
 For each trajectory, clips from mid-flight of each length in --seconds (poses from the
 re-integrated dynamics at the config's fps) go through the commands the workflow runs,
 each whole and on one core (OMP/LP threads 1): `traj2events render` (with its two ffmpeg
-encoders), `traj2events motion-field --frames` (every n-th frame as the config says) and
+encoders), `traj2events motion-field --frames` (every --field-every-th frame: a field costs the
+same at any cadence, and a clip then has enough of them to fit) and
 `traj2events events` (the config's preset, input and labels). Each command's CPU time,
 its children's included (the encoders), is fitted as a + b frames over the clip lengths:
 b is the cost per frame, a the cost per job (start-up, tile building). Disk per frame of
@@ -67,7 +68,7 @@ def cpu_seconds(command: list[str]) -> float:
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
-def stage_commands(config: dict, scenario: str, clip: Path, folder: Path) -> dict[str, list[str]]:
+def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_every: int) -> dict[str, list[str]]:
     cli = [str(Path(sys.executable).parent / "traj2events")]
     camera, events = config["camera"], config["events"]
     settings = RenderSettings.from_config(config, scenario).to_json()
@@ -78,7 +79,7 @@ def stage_commands(config: dict, scenario: str, clip: Path, folder: Path) -> dic
         "motion field": [*cli, "motion-field", str(clip), "--width", str(camera["width"]),
                          "--height", str(camera["height"]), "--fov-deg", str(camera["fov_deg"]),
                          "--mount-height-m", str(camera["mount_height_m"]),
-                         "--every", str(config["motion_field"]["every_n_frames"]), "--frames", str(frames),
+                         "--every", str(field_every), "--frames", str(frames),
                          "-o", str(folder / "motion_field.h5"), "--flo-dir", str(folder / "flow")],
         "events": [*cli, "events", str(frames), "-o", str(folder / "events.h5"), "--seed", "1",
                    "--preset", events["preset"], "--input-scale", events["input"],
@@ -98,9 +99,12 @@ def main() -> None:
     parser.add_argument("trajectories", type=Path, nargs="+", help="trajectory.h5 files (results/SCENARIO/ID/)")
     parser.add_argument("--config", type=Path, default=ROOT / "config" / "paper.yaml")
     parser.add_argument("--seconds", type=float, nargs="+", default=[0.5, 1.0], help="clip lengths, s")
+    parser.add_argument(
+        "--field-every", type=int, default=5, help="motion fields every n frames in the clips (cost per field)"
+    )
     args = parser.parse_args()
     config = load_config(args.config)
-    fps, every = config["camera"]["fps"], config["motion_field"]["every_n_frames"]
+    fps, every = config["camera"]["fps"], args.field_every
     per_frame = {stage: [] for stage in STAGES}  # b: CPU s per frame (per field for the motion field)
     per_job = {stage: [] for stage in STAGES}  # a: CPU s per job
     disk_per_frame: dict[str, list[float]] = {}
@@ -119,7 +123,7 @@ def main() -> None:
                 folder = Path(tmp)
                 n = clip_trajectory(path, t0, seconds, fps, folder / "clip.h5")
                 fields = len(range(0, n - 1, every))
-                for stage, command in stage_commands(config, scenario, folder / "clip.h5", folder).items():
+                for stage, command in stage_commands(config, scenario, folder / "clip.h5", folder, every).items():
                     runs[stage].append((fields if stage == "motion field" else n, cpu_seconds(command)))
                 sizes = output_bytes(folder)
             for name, size in sizes.items():
