@@ -27,7 +27,6 @@ a low-pass version of the fine one, not a different surface).
 from __future__ import annotations
 
 import math
-
 import os
 from dataclasses import dataclass
 from pathlib import Path
