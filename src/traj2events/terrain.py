@@ -141,9 +141,26 @@ def _hash_uniform(seed: int, stream: int, i: np.ndarray, j: np.ndarray) -> np.nd
     """Uniform [0, 1) numbers keyed by (seed, stream, i, j), for integer lattice indices."""
     with np.errstate(over="ignore"):
         key = _mix64(np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream))
-        h = _mix64(key ^ (np.asarray(i).astype(np.int64).astype(np.uint64) * np.uint64(0xD1B54A32D192ED03)))
-        h = _mix64(h ^ (np.asarray(j).astype(np.int64).astype(np.uint64) * np.uint64(0x8CB92BA72F3D8DD7)))
-    return (h >> np.uint64(11)).astype(np.float64) * 2.0**-53
+    i, j = np.broadcast_arrays(np.asarray(i).astype(np.int64), np.asarray(j).astype(np.int64))
+    out = np.empty(i.shape)
+    _hash_pairs(key, i.ravel(), j.ravel(), out.reshape(-1))  # compiled: tiles make ~50 000 small calls
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _mix64_one(z):
+    """`_mix64` of one uint64 (wrapping arithmetic, as numpy's)."""
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True, nogil=True)
+def _hash_pairs(key, i, j, out):
+    for k in range(i.size):
+        h = _mix64_one(key ^ (np.uint64(i[k]) * np.uint64(0xD1B54A32D192ED03)))
+        h = _mix64_one(h ^ (np.uint64(j[k]) * np.uint64(0x8CB92BA72F3D8DD7)))
+        out[k] = np.float64(h >> np.uint64(11)) * 2.0**-53
 
 
 # --- procedural terrain --------------------------------------------------------------------
