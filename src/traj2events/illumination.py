@@ -27,6 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from .terrain import bilinear
 
@@ -73,6 +74,44 @@ Boundary = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 def no_obstruction(x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
     return np.full(np.shape(x_m), -np.inf)
+
+
+@njit(cache=True, nogil=True)
+def _sweep_rows(heights, tan_el, o_next, lateral, outside, edge, step_m, s_out, o_out):
+    """The sweep's recurrence, row by row from the Sun's side (compiled: a tile has ~100
+    rows): S = O(next row, interpolated at `lateral`) - step tan(e), DARK_M where the Sun is
+    set; O = max(h, S). The interpolation is np.interp's on the grid 0 .. n1-1, operation
+    for operation; `edge[i]` replaces the samples beyond the last column."""
+    n0, n1 = heights.shape
+    for i in range(n0 - 1, -1, -1):
+        for m in range(n1):
+            t = tan_el[i, m]
+            s = o_next[m] - step_m * t if np.isfinite(t) else DARK_M  # Sun below the local horizon: dark
+            s_out[i, m] = s
+            h = heights[i, m]
+            o_out[i, m] = h if h > s or np.isnan(h) else s  # np.maximum (s is never NaN)
+        if i:
+            n_out = 0
+            for m in range(n1):
+                if outside[m]:
+                    o_next[m] = edge[i, n_out]
+                    n_out += 1
+                    continue
+                x = lateral[m]
+                if x >= n1 - 1:
+                    o_next[m] = o_out[i, n1 - 1]
+                    continue
+                k = int(np.floor(x))
+                if x == k:
+                    o_next[m] = o_out[i, k]
+                    continue
+                slope = (o_out[i, k + 1] - o_out[i, k]) / 1.0
+                value = slope * (x - k) + o_out[i, k]
+                if np.isnan(value):
+                    value = slope * (x - (k + 1)) + o_out[i, k + 1]
+                    if np.isnan(value) and o_out[i, k] == o_out[i, k + 1]:
+                        value = o_out[i, k]
+                o_next[m] = value
 
 
 @dataclass(frozen=True)
@@ -140,18 +179,9 @@ def shadow_field(
     lateral = j + lateral_cells
     outside = lateral > n1 - 1  # lateral_cells <= 1: at most the last column leaves the grid
     # Boundary values, fetched once: the row beyond the first, and the out-of-grid samples of every row.
-    o_next = beyond_sweep(xa[-1] + sign_a * spacing, lateral)
-    edge = beyond_sweep(xa[:, None], lateral[outside][None, :]) if outside.any() else None
-    for i in range(n0 - 1, -1, -1):
-        with np.errstate(invalid="ignore"):  # -inf - (-inf) where the Sun is set; overwritten next
-            s_row = o_next - step_m * ta[i]
-        s_row[~np.isfinite(ta[i])] = DARK_M  # Sun below the local horizon: dark
-        s_out[i] = s_row
-        o_out[i] = np.maximum(ha[i], s_row)
-        if i:
-            o_next = np.interp(lateral, j, o_out[i])
-            if edge is not None:
-                o_next[outside] = edge[i]
+    o_next = np.asarray(beyond_sweep(xa[-1] + sign_a * spacing, lateral), dtype=float)
+    edge = beyond_sweep(xa[:, None], lateral[outside][None, :]) if outside.any() else np.empty((n0, 0))
+    _sweep_rows(ha, ta, o_next.copy(), lateral, outside, np.asarray(edge, dtype=float), step_m, s_out, o_out)
     with np.errstate(invalid="ignore"):
         lit = np.clip(0.5 + (ha - s_out) / (step_m * np.maximum(ta, 1e-12)), 0.0, 1.0)
     lit[~np.isfinite(ta)] = 0.0
