@@ -37,13 +37,11 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import h5py  # noqa: E402
-import numpy as np  # noqa: E402
+from workflow_cost import clip_trajectory  # noqa: E402  (bench/, beside this script)
 
 from traj2events.config import resolve_config  # noqa: E402
-from traj2events.dynamics import Dynamics  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory, write_trajectory  # noqa: E402
+from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.stages.render import RenderSettings, render_trajectory  # noqa: E402
-from traj2events.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
 
 ONE_CORE = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1", "LP_NUM_THREADS": "1"}
 PAPER = ["--pos_thres", "0.25", "--neg_thres", "0.25", "--sigma_thres", "0.03", "--cutoff_hz", "3",
@@ -53,12 +51,8 @@ PAPER = ["--pos_thres", "0.25", "--neg_thres", "0.25", "--sigma_thres", "0.03", 
 def clip_inputs(trajectory: Path, size: int, fps: float, folder: Path) -> tuple[Path, Path]:
     """frames.h5 and video.mkv of 1 s from the middle of the trajectory."""
     tr = read_trajectory(trajectory)
-    t0 = float(tr.t_nodes[-1]) / 2
-    t = t0 + np.arange(int(fps) + 1) / fps
-    states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes).states(t)
     clip = folder / "clip.h5"
-    poses = (t, states, interpolate_controls(tr.t_nodes, tr.control_nodes, t))
-    write_trajectory(clip, (tr.t_nodes, tr.state_nodes, tr.control_nodes), poses, {**tr.attrs, "fps": fps})
+    clip_trajectory(trajectory, float(tr.t_nodes[-1]) / 2, 1.0, fps, clip)
     config = resolve_config({"camera": {"width": size, "height": size, "fps": fps}})
     settings = RenderSettings.from_config(config, str(tr.attrs["scenario"]))
     frames, video = folder / "frames.h5", folder / "video.mkv"

@@ -99,7 +99,7 @@ def main() -> None:
         times = ", ".join(f"{x:.3f}" for x in runs)
         print(f"| {name} | {times} | {on_sky} | {on_sky / duration:.0f} |")
     print(
-        f"\nstars in view (mean over frames, sky or not): {n_in_view:.0f}; brightest sky pixel: "
+        f"\nstars in view (mean over frames, sky or not; lit pixels / 4): ~{n_in_view:.0f}; brightest sky pixel: "
         f"{brightest:.3g} W m^-2 sr^-1 = {dark_currents:.1f} dark currents"
     )
 

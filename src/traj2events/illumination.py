@@ -179,9 +179,9 @@ def shadow_field(
     lateral = j + lateral_cells
     outside = lateral > n1 - 1  # lateral_cells <= 1: at most the last column leaves the grid
     # Boundary values, fetched once: the row beyond the first, and the out-of-grid samples of every row.
-    o_next = np.asarray(beyond_sweep(xa[-1] + sign_a * spacing, lateral), dtype=float)
+    o_next = np.array(beyond_sweep(xa[-1] + sign_a * spacing, lateral), dtype=float)  # a copy: the sweep writes it
     edge = beyond_sweep(xa[:, None], lateral[outside][None, :]) if outside.any() else np.empty((n0, 0))
-    _sweep_rows(ha, ta, o_next.copy(), lateral, outside, np.asarray(edge, dtype=float), step_m, s_out, o_out)
+    _sweep_rows(ha, ta, o_next, lateral, outside, np.asarray(edge, dtype=float), step_m, s_out, o_out)
     with np.errstate(invalid="ignore"):
         lit = np.clip(0.5 + (ha - s_out) / (step_m * np.maximum(ta, 1e-12)), 0.0, 1.0)
     lit[~np.isfinite(ta)] = 0.0

@@ -29,6 +29,7 @@ ELEMENTARY_CHARGE_C = 1.602176634e-19
 PLANCK_J_S = 6.62607015e-34
 LIGHT_SPEED_M_S = 299792458.0
 BOLTZMANN_J_K = 1.380649e-23
+STEFAN_BOLTZMANN_W_M2_K4 = 5.670374419e-8
 SUN_TEMPERATURE_K = 5772.0  # IAU 2015 nominal effective temperature
 
 
@@ -73,18 +74,14 @@ def planck_spectral_radiance(wavelength_m: np.ndarray, temperature_k: float) -> 
     return 2.0 * PLANCK_J_S * LIGHT_SPEED_M_S**2 / lam**5 / np.expm1(x)
 
 
-def _integrate(values: np.ndarray, grid: np.ndarray) -> float:
-    return float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(grid)))
-
-
 def solar_band(band_m: tuple[float, float], temperature_k: float = SUN_TEMPERATURE_K) -> tuple[float, float]:
     """(share of the Sun's power inside the band, photons per joule inside it) for a black
     body at `temperature_k`: trapezoids on a fine log grid (the total from Stefan-Boltzmann)."""
     grid = np.geomspace(band_m[0], band_m[1], 4001)  # log-spaced: wide bands too
     spectrum = planck_spectral_radiance(grid, temperature_k)
-    in_band = _integrate(spectrum, grid)
-    total = 5.670374419e-8 * temperature_k**4 / np.pi  # sigma T^4 / pi, W m^-2 sr^-1
-    photons = _integrate(spectrum * grid / (PLANCK_J_S * LIGHT_SPEED_M_S), grid)
+    in_band = float(np.trapezoid(spectrum, grid))
+    total = STEFAN_BOLTZMANN_W_M2_K4 * temperature_k**4 / np.pi  # W m^-2 sr^-1
+    photons = float(np.trapezoid(spectrum * grid / (PLANCK_J_S * LIGHT_SPEED_M_S), grid))
     return in_band / total, photons / in_band
 
 
@@ -98,7 +95,7 @@ def amps_per_radiance(sensor: SensorParams) -> float:
         * share
         * photons_per_j
         * sensor.quantum_efficiency
-        * (ELEMENTARY_CHARGE_C)
+        * ELEMENTARY_CHARGE_C
     )
 
 

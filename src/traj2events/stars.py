@@ -104,7 +104,7 @@ def add_stars(radiance: np.ndarray, depth_m: np.ndarray, stars: StarField, camer
     """The frame's radiance with the stars added on its sky pixels (depth 0); the input
     array itself where no star falls on the sky."""
     index, value = star_splat(stars, camera, pose)
-    sky = depth_m.reshape(-1)[index] == 0
+    sky = depth_m[index // camera.width, index % camera.width] == 0  # a gather: depth_m may be a strided view
     if not sky.any():
         return radiance
     out = radiance.copy()

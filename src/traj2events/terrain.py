@@ -126,21 +126,19 @@ def degraded_crater_profile(rho: np.ndarray, depth_m: float) -> np.ndarray:
 
 # --- deterministic hashing (counter-based, so any patch is evaluated on its own) -----------
 
-_MASK64 = np.uint64(0xFFFFFFFFFFFFFFFF)
 
-
-def _mix64(z: np.ndarray) -> np.ndarray:
-    """splitmix64 finaliser: a bijective, well-mixed map of uint64."""
-    with np.errstate(over="ignore"):
-        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-        return z ^ (z >> np.uint64(31))
+@njit(cache=True, nogil=True)
+def _mix64(z):
+    """splitmix64 finaliser of one uint64: a bijective, well-mixed map (wrapping arithmetic)."""
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
 
 
 def _hash_uniform(seed: int, stream: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """Uniform [0, 1) numbers keyed by (seed, stream, i, j), for integer lattice indices."""
     with np.errstate(over="ignore"):
-        key = _mix64(np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream))
+        key = np.uint64(_mix64(np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream)))
     i, j = np.broadcast_arrays(np.asarray(i).astype(np.int64), np.asarray(j).astype(np.int64))
     out = np.empty(i.shape)
     _hash_pairs(key, i.ravel(), j.ravel(), out.reshape(-1))  # compiled: tiles make ~50 000 small calls
@@ -148,18 +146,10 @@ def _hash_uniform(seed: int, stream: int, i: np.ndarray, j: np.ndarray) -> np.nd
 
 
 @njit(cache=True, nogil=True)
-def _mix64_one(z):
-    """`_mix64` of one uint64 (wrapping arithmetic, as numpy's)."""
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    return z ^ (z >> np.uint64(31))
-
-
-@njit(cache=True, nogil=True)
 def _hash_pairs(key, i, j, out):
     for k in range(i.size):
-        h = _mix64_one(key ^ (np.uint64(i[k]) * np.uint64(0xD1B54A32D192ED03)))
-        h = _mix64_one(h ^ (np.uint64(j[k]) * np.uint64(0x8CB92BA72F3D8DD7)))
+        h = _mix64(key ^ (np.uint64(i[k]) * np.uint64(0xD1B54A32D192ED03)))
+        h = _mix64(h ^ (np.uint64(j[k]) * np.uint64(0x8CB92BA72F3D8DD7)))
         out[k] = np.float64(h >> np.uint64(11)) * 2.0**-53
 
 
