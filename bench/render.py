@@ -1,6 +1,7 @@
 """Benchmark: rendering, seconds per frame against triangle budget and image error.
 
   LP_NUM_THREADS=1 python bench/render.py [--size 1024] [--frames 20] [--budgets 2 4 8] [--reference 1]
+                                          [--backend auto|egl|osmesa]
 
 One core (Mesa llvmpipe with LP_NUM_THREADS=1). For a braking-like pose (2 km up, pitched
 55 deg, Sun at 7 deg) and a descent-like one (150 m, near nadir, Sun at 2 deg), Hapke and
@@ -64,18 +65,19 @@ def poses(state: np.ndarray, n: int, fps: float = 100.0) -> list:
     return out
 
 
-def run_case(name, state, sun, extent, size, n_frames, budgets, reference):
+def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backend):
     camera = Camera(size, size, 45.0)
     terrain = ProceduralTerrain(TerrainParams(seed=1))
     path = poses(state, n_frames)
     results = {}
     for budget in [reference, *budgets]:
         tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
-        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000) as renderer:
+        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as renderer:
             start = time.perf_counter()
             for pose in path:  # build every tile the stretch needs
                 tiles.select(pose, camera)
             build_s = time.perf_counter() - start
+            drawn_by = f"{renderer.backend}: {renderer.gl_renderer}"
             renderer.render(path[0])  # upload
             times, frame = [], None
             for pose in path:
@@ -96,7 +98,7 @@ def run_case(name, state, sun, extent, size, n_frames, budgets, reference):
         )
     ref = results[reference]["frame"]
     ground = ref.depth_m > 0
-    print(f"\n{name}, {size} x {size}, Hapke + shadows, one core ({n_frames} frames)")
+    print(f"\n{name}, {size} x {size}, Hapke + shadows, one core ({n_frames} frames; {drawn_by})")
     print(
         f"{'px/cell':>8} {'s/frame':>8} {'triangles':>10} {'tiles':>6} {'LOD saves':>10} {'build s':>8} "
         f"{'radiance err':>13} {'depth err':>10}"
@@ -142,6 +144,7 @@ def main() -> None:
     parser.add_argument("--frames", type=int, default=20)
     parser.add_argument("--budgets", type=float, nargs="+", default=[2.0, 4.0, 8.0])
     parser.add_argument("--reference", type=float, default=1.0, help="budget of the high-detail reference")
+    parser.add_argument("--backend", default="auto", help="OpenGL backend: auto, egl or osmesa (render.backend)")
     args = parser.parse_args()
     print(
         f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, Python "
@@ -149,7 +152,7 @@ def main() -> None:
     )
     per_frame = []
     for name, (state, sun, extent) in CASES.items():
-        results = run_case(name, state, sun, extent, args.size, args.frames, args.budgets, args.reference)
+        results = run_case(name, state, sun, extent, args.size, args.frames, args.budgets, args.reference, args.backend)
         per_frame.append(results)
     default = 2.0 if 2.0 in per_frame[0] else args.budgets[0]
     s = statistics.mean(r[default]["seconds"] for r in per_frame)

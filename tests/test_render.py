@@ -1,13 +1,18 @@
-"""Rendering on OSMesa: depth against a ray cast on the mesh, a landmark where the camera
-model puts it, radiance on a flat plane against the reflectance law, determinism, sky."""
+"""Rendering on OSMesa (and EGL on Mesa's software device, in a subprocess): depth against
+a ray cast on the mesh, a landmark where the camera model puts it, radiance on a flat plane
+against the reflectance law, determinism, sky, the backends and the tile slots."""
+
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
+from traj2events import render as render_module
 from traj2events.camera import Camera, CameraPose, camera_pose
 from traj2events.illumination import Sun
 from traj2events.reflectance import ReflectanceParams, angles, radiance_factor
-from traj2events.render import TerrainRenderer, _check_pyopengl  # noqa: E402  (sets PYOPENGL_PLATFORM first)
+from traj2events.render import TerrainRenderer, _check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
 from traj2events.terrain import GridTerrain, ProceduralTerrain, TerrainParams, fresh_crater_profile, surface_points
 from traj2events.tiles import LodSettings, TileSet
 
@@ -27,7 +32,7 @@ def render(
     terrain, camera, pose, radius=R_MOON, half_extent=140e3, sun=SUN, reflectance=ReflectanceParams(), lod=LodSettings()
 ):
     tiles = TileSet(terrain, sun.direction, radius, half_extent, lod)
-    with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
+    with TerrainRenderer(tiles, camera, sun, reflectance, backend="osmesa") as renderer:
         return renderer.render(pose), tiles
 
 
@@ -52,16 +57,76 @@ def ray_cast(origin, directions, triangles):
 
 
 def test_pyrender_workarounds_are_in_place(monkeypatch):
-    import os
-
     import OpenGL
 
-    assert os.environ["PYOPENGL_PLATFORM"] == "osmesa"
     assert np.infty == np.inf
     _check_pyopengl()
     monkeypatch.setattr(OpenGL, "__version__", "3.1.0")
     with pytest.raises(RuntimeError, match="PyOpenGL>=3.1.5"):
         _check_pyopengl()
+
+
+def test_auto_backend_takes_the_first_egl_device_that_is_not_software():
+    software = b"EGL_MESA_device_software EGL_EXT_device_drm_render_node"
+    gpu = b"EGL_NV_device_cuda EGL_EXT_device_drm EGL_EXT_device_persistent_id"
+    assert hardware_egl_device([]) is None
+    assert hardware_egl_device([software]) is None
+    assert hardware_egl_device([software, gpu]) == 1
+    assert resolve_backend("osmesa") == "osmesa" and resolve_backend("egl") == "egl"
+    assert resolve_backend("auto") in ("egl", "osmesa")
+    with pytest.raises(ValueError, match="render.backend: expected one of auto, egl, osmesa, got 'gpu'"):
+        resolve_backend("gpu")
+
+
+def test_a_process_bound_to_osmesa_refuses_egl():
+    render(ProceduralTerrain(TerrainParams(seed=1)), Camera(16, 16, 45.0), camera_pose(state()))  # binds OSMesa
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=1)), SUN.direction, R_MOON, 140e3)
+    with pytest.raises(RuntimeError, match="already bound to OSMesaPlatform"):
+        TerrainRenderer(tiles, Camera(16, 16, 45.0), SUN, ReflectanceParams(), backend="egl")
+
+
+_EGL_SCENE = """
+import sys
+import numpy as np
+from traj2events.camera import Camera, camera_pose
+from traj2events.illumination import Sun
+from traj2events.reflectance import ReflectanceParams
+from traj2events.render import TerrainRenderer
+from traj2events.terrain import ProceduralTerrain, TerrainParams
+from traj2events.tiles import TileSet
+sun = Sun(1.496e11, 105.0, 7.0)
+s = np.zeros(13); s[:3] = 0, 0, -800.0; s[6:9] = np.radians([0, 40.0, 10.0]); s[12] = 1e4
+tiles = TileSet(ProceduralTerrain(TerrainParams(seed=3)), sun.direction, 1737400.0, 140e3)
+with TerrainRenderer(tiles, Camera(96, 64, 45.0), sun, ReflectanceParams(), backend=sys.argv[1]) as r:
+    f = r.render(camera_pose(s))
+    print(r.backend, r.gl_renderer, file=sys.stderr)
+np.save(sys.argv[2], np.stack([f.radiance, f.depth_m]))
+"""
+
+
+@pytest.mark.skipif(not egl_devices(), reason="no EGL device (libegl1 + libegl-mesa0)")
+def test_egl_and_osmesa_draw_the_same_pixels(tmp_path):
+    # A process binds one OpenGL platform: each backend in its own.
+    images = {}
+    for backend in ("egl", "osmesa"):
+        out = tmp_path / f"{backend}.npy"
+        subprocess.run([sys.executable, "-c", _EGL_SCENE, backend, str(out)], check=True, capture_output=True)
+        images[backend] = np.load(out)
+    assert (images["osmesa"][1] > 0).mean() > 0.5  # mostly terrain
+    if hardware_egl_device(egl_devices()) is None:  # both are llvmpipe: the very same pixels
+        assert np.array_equal(images["egl"], images["osmesa"])
+    else:  # a GPU: within float rounding, except at a few edge pixels
+        assert np.mean(~np.isclose(images["egl"], images["osmesa"], rtol=1e-4, atol=1e-6)) < 1e-3
+
+
+def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch):
+    camera = Camera(48, 48, 45.0)
+    pose = camera_pose(state(altitude=400.0, pitch=50.0))
+    reference, tiles = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose)
+    assert reference.n_tiles > 8
+    monkeypatch.setattr(render_module, "_INITIAL_SLOTS", 2)  # grows (copying its slots) three times or more
+    grown, _ = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose)
+    assert np.array_equal(grown.radiance, reference.radiance) and np.array_equal(grown.depth_m, reference.depth_m)
 
 
 def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
@@ -188,11 +253,17 @@ def test_horizon_at_the_tilt_limit_splits_sky_and_ground():
 def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
     camera = Camera(32, 32, 45.0)
     tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, LodSettings())
-    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20) as renderer:
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend="osmesa") as renderer:
         for x in (-3000.0, -1500.0, 0.0):
             frame = renderer.render(camera_pose(state(x=x, altitude=300.0, pitch=30.0)))
             assert frame.n_tiles > 0
-            assert len(renderer._nodes) <= max(20, frame.n_tiles)
+            assert renderer.n_uploaded <= max(20, frame.n_tiles)
+        # Slots freed and filled again: the first view is drawn as a fresh renderer draws it.
+        again = renderer.render(camera_pose(state(x=-3000.0, altitude=300.0, pitch=30.0)))
+    first, _ = render(
+        ProceduralTerrain(TerrainParams(seed=6)), camera, camera_pose(state(x=-3000.0, altitude=300.0, pitch=30.0))
+    )
+    assert np.array_equal(again.radiance, first.radiance)
 
 
 def test_rendered_crater_shadow_has_the_analytic_length():
@@ -249,7 +320,7 @@ def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
     terrain = ProceduralTerrain(TerrainParams(seed=4))
     tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, LodSettings())
     stars = StarField.draw(5.0, seed=1)  # ~ 1400 over the sky: ~60 in a 45 deg view
-    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), stars=stars) as renderer:
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend="osmesa") as renderer:
         starry = renderer.render(pose)
     plain, _ = render(terrain, camera, pose)
     ground = plain.depth_m > 0

@@ -67,7 +67,9 @@ def cmd_upsample(args) -> int:
 def cmd_render(args) -> int:
     from .stages.render import RenderSettings, render_trajectory
 
-    render_trajectory(args.trajectory, _settings(RenderSettings, args.settings), args.frames, args.video, args.preview)
+    render_trajectory(
+        args.trajectory, _settings(RenderSettings, args.settings), args.frames, args.video, args.preview, args.backend
+    )
     return 0
 
 
@@ -293,6 +295,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
     p.add_argument("--preview", required=True, help="preview.mp4: H.264 of the same, to look at")
+    p.add_argument(
+        "--backend",
+        default=section("render")["backend"],
+        help="OpenGL backend: egl (a GPU, headless), osmesa (the CPU, Mesa llvmpipe) or auto (EGL when a GPU's "
+        "EGL device exists, else OSMesa); default: %(default)s",
+    )
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser(

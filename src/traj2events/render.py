@@ -1,21 +1,30 @@
 """Headless rendering of the lunar surface: linear radiance and depth per camera pose.
 
-pyrender draws on the CPU through Mesa's OSMesa (llvmpipe). This module is the one place
-that adapts pyrender 0.1.45 to that setting (tested in tests/test_render.py):
-  - `PYOPENGL_PLATFORM=osmesa` is set before OpenGL is imported (unless the user chose);
-  - pyrender pins PyOpenGL==3.1.0, whose OSMesa binding is broken; setup.sh installs
-    PyOpenGL 3.1.10 over it and `_check_pyopengl` refuses the old one with a clear message;
-  - pyrender uses `np.infty`, gone in NumPy 2: the alias is restored before import;
-  - pyrender's main framebuffer is 8-bit RGBA with 4x multisampling; the renderer here
-    replaces it with a single-sample float32 one and its own forward pass (one program,
-    uniforms set once per frame, tiles drawn relative to the camera), reading back
-    radiance (W m^-2 sr^-1) and depth along the boresight (m, computed in the shader,
-    0 for sky) as float32 (a two-channel buffer: half the bytes of RGBA).
+Two OpenGL backends draw the same scene (`render.backend`):
+  - `egl`: through EGL, headless (no X server): a GPU's driver, or Mesa's software device;
+  - `osmesa`: Mesa's OSMesa on the CPU (llvmpipe);
+  - `auto`: EGL when an EGL device other than Mesa's software rasteriser exists, else OSMesa.
+PyOpenGL binds one platform per process, when OpenGL is first imported: the backend is
+chosen before that (`PYOPENGL_PLATFORM`), and a process already bound to the other one is
+refused with a clear message. pyrender provides the two contexts; its scene graph is not
+used. pyrender pins PyOpenGL==3.1.0, whose OSMesa binding is broken (setup.sh installs
+3.1.10; `_check_pyopengl` refuses the old one), and uses NumPy 1's `np.infty` (restored).
+
+The frame loop has no per-tile Python. Every tile has the same topology (grid + skirts),
+so one index buffer serves all; each cached tile's vertices sit in a slot of one large
+buffer. A frame is one instanced draw: an instance per tile, nearest first (the depth test
+then rejects hidden fragments early, and which of two coincident surfaces wins is fixed),
+carrying its origin's offset from the camera (float64 on the CPU, small float32 numbers on
+the GPU) and its slot, from which the vertex shader fetches the vertices. The output is a
+single-sample float32 two-channel framebuffer: radiance (W m^-2 sr^-1) and depth along the
+boresight (m, computed in the shader; 0 for sky).
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
+import sys
 from dataclasses import dataclass
 from importlib import resources
 
@@ -27,9 +36,12 @@ from .reflectance import ReflectanceParams, max_radiance_factor
 from .stars import StarField, add_stars
 from .tiles import TileKey, TileSet, depth_range
 
-os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 if not hasattr(np, "infty"):
     np.infty = np.inf  # pyrender 0.1.45 still uses the NumPy 1 alias
+
+BACKENDS = ("auto", "egl", "osmesa")
+_EGL_EXTENSIONS = 0x3055
+_INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
 
 
 def _check_pyopengl() -> None:
@@ -43,19 +55,85 @@ def _check_pyopengl() -> None:
         )
 
 
-def _import_pyrender():
+def egl_devices() -> list[bytes]:
+    """The extension string of each EGL device, in EGL's order ([] without libEGL or its
+    device query). Read through ctypes, so that asking does not bind PyOpenGL's platform."""
+    try:
+        egl = ctypes.CDLL("libEGL.so.1")
+    except OSError:
+        return []
+    egl.eglGetProcAddress.restype = ctypes.c_void_p
+    egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+    query_at, string_at = (
+        egl.eglGetProcAddress(b"eglQueryDevicesEXT"),
+        egl.eglGetProcAddress(b"eglQueryDeviceStringEXT"),
+    )
+    if not query_at or not string_at:
+        return []
+    query = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(ctypes.c_int))(query_at)
+    string = ctypes.CFUNCTYPE(ctypes.c_char_p, ctypes.c_void_p, ctypes.c_int)(string_at)
+    n = ctypes.c_int(0)
+    if not query(0, None, ctypes.byref(n)) or n.value < 1:
+        return []
+    devices = (ctypes.c_void_p * n.value)()
+    if not query(n.value, devices, ctypes.byref(n)):
+        return []
+    return [string(devices[k], _EGL_EXTENSIONS) or b"" for k in range(n.value)]
+
+
+def hardware_egl_device(extensions: list[bytes]) -> int | None:
+    """Index of the first EGL device that is not Mesa's software rasteriser, or None."""
+    for k, ext in enumerate(extensions):
+        if b"EGL_MESA_device_software" not in ext.split():
+            return k
+    return None
+
+
+def resolve_backend(backend: str) -> str:
+    """`egl` or `osmesa` for a `render.backend` value (`auto`: EGL on a GPU, else OSMesa)."""
+    if backend not in BACKENDS:
+        raise ValueError(f"render.backend: expected one of {', '.join(BACKENDS)}, got {backend!r}")
+    if backend == "auto":
+        return "egl" if hardware_egl_device(egl_devices()) is not None else "osmesa"
+    return backend
+
+
+def _bind_platform(backend: str) -> None:
+    """Make PyOpenGL use `backend`'s platform (before its first import), or refuse."""
+    if "OpenGL.platform" not in sys.modules:
+        os.environ["PYOPENGL_PLATFORM"] = backend
     _check_pyopengl()
     import OpenGL.platform
 
-    platform = type(OpenGL.platform.PLATFORM).__name__
-    if os.environ["PYOPENGL_PLATFORM"] == "osmesa" and "OSMesa" not in platform:
+    bound = type(OpenGL.platform.PLATFORM).__name__
+    if not bound.lower().startswith(backend):
         raise RuntimeError(
-            f"OpenGL was imported with the {platform} before traj2events.render set "
-            "PYOPENGL_PLATFORM=osmesa; set it in the environment or import traj2events.render first"
+            f"render backend {backend!r}: OpenGL in this process is already bound to {bound} "
+            "(PyOpenGL uses one platform per process); render in a fresh process, or set "
+            f"PYOPENGL_PLATFORM={backend} before anything imports OpenGL"
         )
-    import pyrender
 
-    return pyrender
+
+def _context(backend: str, width: int, height: int):
+    """A current OpenGL context of `backend` (pyrender's platform object)."""
+    _bind_platform(backend)
+    if backend == "osmesa":
+        from pyrender.platforms.osmesa import OSMesaPlatform
+
+        platform = OSMesaPlatform(width, height)
+    else:
+        from pyrender.platforms.egl import EGLPlatform, query_devices
+
+        devices = query_devices()
+        if not devices:
+            raise RuntimeError(
+                "render backend 'egl': no EGL device (install libegl1 with a driver: "
+                "libegl-mesa0 for the CPU, the GPU vendor's for a GPU)"
+            )
+        platform = EGLPlatform(width, height, device=devices[hardware_egl_device(egl_devices()) or 0])
+    platform.init_context()
+    platform.make_current()
+    return platform
 
 
 @dataclass(frozen=True)
@@ -66,106 +144,173 @@ class Frame:
     n_triangles: int
 
 
-def _make_float_renderer_class(pyrender):
-    from OpenGL import GL as gl
+def projection_matrix(camera: Camera, near_m: float, far_m: float) -> np.ndarray:
+    """OpenGL clip matrix of the pinhole camera (principal point at the image centre)."""
+    p = np.zeros((4, 4))
+    p[0, 0] = 2.0 * camera.focal_px / camera.width
+    p[1, 1] = 2.0 * camera.focal_px / camera.height
+    p[2, 2] = (far_m + near_m) / (near_m - far_m)
+    p[2, 3] = 2.0 * far_m * near_m / (near_m - far_m)
+    p[3, 2] = -1.0
+    return p
 
-    class FloatRenderer(pyrender.Renderer):
-        """pyrender.Renderer with a float32, single-sample framebuffer and a terrain pass."""
 
-        uniforms: dict = {}
-        draw_order: list = []  # mesh nodes, nearest first (a fixed order: same frame, same bytes)
+def view_rotation(pose: CameraPose) -> np.ndarray:
+    """World -> OpenGL camera, rotation only: the camera sits at the origin (tiles are
+    drawn relative to it)."""
+    v = np.eye(4)
+    v[:3, :3] = opengl_camera_to_world(pose)[:3, :3].T
+    return v
 
-        def _configure_main_framebuffer(self):
-            if self._main_fb is not None and (self.viewport_width, self.viewport_height) != self._main_fb_dims:
-                self._delete_main_framebuffer()
-            if self._main_fb is None:
-                self._main_cb, self._main_db = gl.glGenRenderbuffers(2)
-                gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self._main_cb)
-                gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RG32F, self.viewport_width, self.viewport_height)
-                gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self._main_db)
-                gl.glRenderbufferStorage(
-                    gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT32F, self.viewport_width, self.viewport_height
-                )
-                self._main_fb = gl.glGenFramebuffers(1)
-                gl.glBindFramebuffer(gl.GL_DRAW_FRAMEBUFFER, self._main_fb)
-                gl.glFramebufferRenderbuffer(
-                    gl.GL_DRAW_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER, self._main_cb
-                )
-                gl.glFramebufferRenderbuffer(
-                    gl.GL_DRAW_FRAMEBUFFER, gl.GL_DEPTH_ATTACHMENT, gl.GL_RENDERBUFFER, self._main_db
-                )
-                if gl.glCheckFramebufferStatus(gl.GL_DRAW_FRAMEBUFFER) != gl.GL_FRAMEBUFFER_COMPLETE:
-                    raise RuntimeError("OSMesa: float32 framebuffer incomplete")
-                # pyrender draws into _main_fb_ms; point it at the single-sample buffer.
-                self._main_fb_ms = self._main_fb
-                self._main_fb_dims = (self.viewport_width, self.viewport_height)
 
-        def _delete_main_framebuffer(self):
-            if self._main_fb is not None:
-                gl.glDeleteFramebuffers(1, [self._main_fb])
-                gl.glDeleteRenderbuffers(2, [self._main_cb, self._main_db])
-            self._main_fb = self._main_cb = self._main_db = None
-            self._main_fb_ms = self._main_cb_ms = self._main_db_ms = None
-            self._main_fb_dims = (None, None)
+class _GLScene:
+    """The OpenGL objects of one context: program, framebuffer, tile slots, instances."""
 
-        def _forward_pass(self, scene, flags, seg_node_map=None):
-            self._configure_forward_pass_viewport(flags)
-            gl.glClearColor(0.0, 0.0, 0.0, 0.0)
-            gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
-            gl.glDisable(gl.GL_MULTISAMPLE)
-            gl.glDisable(gl.GL_BLEND)
-            gl.glDisable(gl.GL_CULL_FACE)
-            gl.glPolygonMode(gl.GL_FRONT_AND_BACK, gl.GL_FILL)
-            V, P = self._get_camera_matrices(scene)
-            # Camera-relative rendering: the view rotation only, and per tile its offset
-            # from the camera (float64 on the CPU, small float32 numbers on the GPU).
-            V = V.copy()
-            V[:3, 3] = 0.0
-            cam_pos = self.uniforms["cam_pos"]
-            program = None
-            offset_loc = -1
-            for node in self.draw_order:
-                for primitive in node.mesh.primitives:
-                    if program is None:
-                        program = self._program_cache.get_program(
-                            vertex_shader="terrain.vert",
-                            fragment_shader="terrain.frag",
-                            defines={"NORMAL_LOC": 1, "TEXCOORD_0_LOC": 2, "INST_M_LOC": 3},
-                        )
-                        if not program._in_context():
-                            program._add_to_context()
-                        program._bind()
-                        program.set_uniform("V", V)
-                        program.set_uniform("P", P)
-                        for name, value in self.uniforms.items():
-                            if name != "cam_pos":
-                                program.set_uniform(name, value)
-                        offset_loc = gl.glGetUniformLocation(program._program_id, "tile_offset")
-                    offset = node.translation - cam_pos
-                    gl.glUniform3f(offset_loc, float(offset[0]), float(offset[1]), float(offset[2]))
-                    primitive._bind()
-                    gl.glDrawElements(primitive.mode, primitive.indices.size, gl.GL_UNSIGNED_INT, None)
-            if program is not None:
-                program._unbind()
-            gl.glFlush()
-            return self._read_main_framebuffer(scene, flags)
+    def __init__(self, width: int, height: int, faces: np.ndarray, vertices_per_tile: int):
+        from OpenGL import GL as gl
 
-        def _read_main_framebuffer(self, scene, flags):
-            from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels
+        self.gl, self.width, self.height = gl, width, height
+        self.vertices_per_tile = vertices_per_tile
+        self.n_indices = faces.size
+        self.program = _compile_program(gl)
+        self.locations = {}
+        self.vao = gl.glGenVertexArrays(1)
+        gl.glBindVertexArray(self.vao)
+        self.index_buffer = gl.glGenBuffers(1)
+        gl.glBindBuffer(gl.GL_ELEMENT_ARRAY_BUFFER, self.index_buffer)
+        gl.glBufferData(gl.GL_ELEMENT_ARRAY_BUFFER, faces.astype(np.uint32).ravel(), gl.GL_STATIC_DRAW)
+        self.instance_buffer = gl.glGenBuffers(1)
+        gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
+        gl.glEnableVertexAttribArray(0)
+        gl.glVertexAttribPointer(0, 4, gl.GL_FLOAT, gl.GL_FALSE, 16, None)
+        gl.glVertexAttribDivisor(0, 1)
+        # Per-vertex data: (position - tile origin, lit) and (normal, 0), one texel each.
+        self.capacity = 0
+        self.vertex_buffers = list(gl.glGenBuffers(2))
+        self.vertex_textures = list(gl.glGenTextures(2))
+        self._allocate(_INITIAL_SLOTS)
+        self._framebuffer()
+        gl.glUseProgram(self.program)
+        self.uniform("vertex_position_lit", 0)
+        self.uniform("vertex_normal", 1)
+        self.uniform("vertices_per_tile", vertices_per_tile)
 
-            width, height = self._main_fb_dims
-            gl.glBindFramebuffer(gl.GL_READ_FRAMEBUFFER, self._main_fb)
-            image = np.empty((height, width, 2), dtype=np.float32)
-            # The raw entry point: PyOpenGL's wrapper knows no GL_RG, and this one fills our array.
-            raw_read_pixels(0, 0, width, height, gl.GL_RG, gl.GL_FLOAT, image)
-            return image[::-1]  # OpenGL's first row is the bottom one (a view: no copy)
+    def _framebuffer(self) -> None:
+        gl = self.gl
+        self.colour, self.depth = gl.glGenRenderbuffers(2)
+        gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self.colour)
+        gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RG32F, self.width, self.height)
+        gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, self.depth)
+        gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_DEPTH_COMPONENT32F, self.width, self.height)
+        self.framebuffer = gl.glGenFramebuffers(1)
+        gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, self.framebuffer)
+        gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER, self.colour)
+        gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_DEPTH_ATTACHMENT, gl.GL_RENDERBUFFER, self.depth)
+        if gl.glCheckFramebufferStatus(gl.GL_FRAMEBUFFER) != gl.GL_FRAMEBUFFER_COMPLETE:
+            raise RuntimeError("OpenGL: float32 framebuffer incomplete")
 
-    return FloatRenderer
+    def _allocate(self, slots: int) -> None:
+        """Room for `slots` tiles, keeping the slots already filled."""
+        gl = self.gl
+        texel_bytes = 16
+        size = slots * self.vertices_per_tile * texel_bytes
+        for unit, old in enumerate(self.vertex_buffers):
+            new = gl.glGenBuffers(1)
+            gl.glBindBuffer(gl.GL_COPY_WRITE_BUFFER, new)
+            gl.glBufferData(gl.GL_COPY_WRITE_BUFFER, size, None, gl.GL_STATIC_DRAW)
+            if self.capacity:
+                gl.glBindBuffer(gl.GL_COPY_READ_BUFFER, old)
+                used = self.capacity * self.vertices_per_tile * texel_bytes
+                gl.glCopyBufferSubData(gl.GL_COPY_READ_BUFFER, gl.GL_COPY_WRITE_BUFFER, 0, 0, used)
+                gl.glDeleteBuffers(1, [old])
+            self.vertex_buffers[unit] = new
+            gl.glActiveTexture(gl.GL_TEXTURE0 + unit)
+            gl.glBindTexture(gl.GL_TEXTURE_BUFFER, self.vertex_textures[unit])
+            gl.glTexBuffer(gl.GL_TEXTURE_BUFFER, gl.GL_RGBA32F, new)
+        self.capacity = slots
+
+    def upload(self, slot: int, position_lit: np.ndarray, normal: np.ndarray) -> None:
+        gl = self.gl
+        if slot >= self.capacity:
+            self._allocate(max(2 * self.capacity, slot + 1))
+        offset = slot * self.vertices_per_tile * 16
+        for buffer, data in zip(self.vertex_buffers, (position_lit, normal)):
+            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, buffer)
+            gl.glBufferSubData(gl.GL_ARRAY_BUFFER, offset, data.nbytes, data)
+
+    def uniform(self, name: str, value) -> None:
+        gl = self.gl
+        if name not in self.locations:
+            self.locations[name] = gl.glGetUniformLocation(self.program, name)
+        loc = self.locations[name]
+        if isinstance(value, int):
+            gl.glUniform1i(loc, value)
+        elif isinstance(value, float):
+            gl.glUniform1f(loc, value)
+        elif np.shape(value) == (4, 4):
+            gl.glUniformMatrix4fv(loc, 1, gl.GL_TRUE, np.asarray(value, np.float32))
+        else:
+            gl.glUniform3f(loc, *(float(x) for x in np.asarray(value, np.float32)))
+
+    def draw(self, instances: np.ndarray, uniforms: dict) -> np.ndarray:
+        """One instanced draw of `instances` ((n, 4) float32: offset from the camera, slot);
+        returns the (H, W, 2) float32 image, top row first."""
+        from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels
+
+        gl = self.gl
+        gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, self.framebuffer)
+        gl.glViewport(0, 0, self.width, self.height)
+        gl.glEnable(gl.GL_DEPTH_TEST)
+        gl.glDepthFunc(gl.GL_LESS)
+        gl.glDisable(gl.GL_BLEND)
+        gl.glDisable(gl.GL_CULL_FACE)
+        gl.glClearColor(0.0, 0.0, 0.0, 0.0)
+        gl.glClear(gl.GL_COLOR_BUFFER_BIT | gl.GL_DEPTH_BUFFER_BIT)
+        gl.glUseProgram(self.program)
+        for name, value in uniforms.items():
+            self.uniform(name, value)
+        for unit, texture in enumerate(self.vertex_textures):
+            gl.glActiveTexture(gl.GL_TEXTURE0 + unit)
+            gl.glBindTexture(gl.GL_TEXTURE_BUFFER, texture)
+        gl.glBindVertexArray(self.vao)
+        if len(instances):
+            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
+            gl.glBufferData(gl.GL_ARRAY_BUFFER, instances.nbytes, instances, gl.GL_STREAM_DRAW)
+            gl.glDrawElementsInstanced(gl.GL_TRIANGLES, self.n_indices, gl.GL_UNSIGNED_INT, None, len(instances))
+        image = np.empty((self.height, self.width, 2), dtype=np.float32)
+        # The raw entry point: PyOpenGL's wrapper knows no GL_RG, and this one fills our array.
+        raw_read_pixels(0, 0, self.width, self.height, gl.GL_RG, gl.GL_FLOAT, image)
+        return image[::-1]  # OpenGL's first row is the bottom one (a view: no copy)
+
+    def delete(self) -> None:
+        gl = self.gl
+        gl.glDeleteFramebuffers(1, [self.framebuffer])
+        gl.glDeleteRenderbuffers(2, [self.colour, self.depth])
+        gl.glDeleteTextures(self.vertex_textures)
+        gl.glDeleteBuffers(4, [*self.vertex_buffers, self.index_buffer, self.instance_buffer])
+        gl.glDeleteVertexArrays(1, [self.vao])
+        gl.glDeleteProgram(self.program)
+
+
+def _compile_program(gl) -> int:
+    program = gl.glCreateProgram()
+    for kind, name in ((gl.GL_VERTEX_SHADER, "terrain.vert"), (gl.GL_FRAGMENT_SHADER, "terrain.frag")):
+        shader = gl.glCreateShader(kind)
+        gl.glShaderSource(shader, (resources.files("traj2events") / "shaders" / name).read_text())
+        gl.glCompileShader(shader)
+        if not gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS):
+            raise RuntimeError(f"shaders/{name}: {gl.glGetShaderInfoLog(shader).decode()}")
+        gl.glAttachShader(program, shader)
+        gl.glDeleteShader(shader)  # freed with the program
+    gl.glLinkProgram(program)
+    if not gl.glGetProgramiv(program, gl.GL_LINK_STATUS):
+        raise RuntimeError(f"shaders: {gl.glGetProgramInfoLog(program).decode()}")
+    return program
 
 
 class TerrainRenderer:
-    """Renders a TileSet from camera poses. One OSMesa context; tiles are uploaded once
-    and kept while they are in use."""
+    """Renders a TileSet from camera poses. One OpenGL context; tiles are uploaded once
+    and kept while they are in use (at most `max_cached_tiles` beyond one frame's)."""
 
     def __init__(
         self,
@@ -175,103 +320,100 @@ class TerrainRenderer:
         reflectance: ReflectanceParams,
         max_cached_tiles: int = 4000,
         stars: StarField | None = None,
+        backend: str = "auto",
     ):
-        """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black sky."""
-        pyrender = _import_pyrender()
-        from pyrender.platforms.osmesa import OSMesaPlatform
-        from pyrender.shader_program import ShaderProgramCache
-
-        self._pyrender = pyrender
+        """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black
+        sky. `backend`: auto | egl | osmesa (resolve_backend)."""
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
         self.max_cached_tiles, self.stars = max_cached_tiles, stars
-        self._radiance_max = float(max_radiance_factor(reflectance) * sun.irradiance_w_m2 / np.pi)
-        self._platform = OSMesaPlatform(camera.width, camera.height)
-        self._platform.init_context()
-        self._platform.make_current()
-        self._renderer = _make_float_renderer_class(pyrender)(camera.width, camera.height)
-        self._renderer._program_cache = ShaderProgramCache(shader_dir=str(resources.files("traj2events") / "shaders"))
-        self._scene = pyrender.Scene(bg_color=np.zeros(4))
-        f = camera.focal_px
-        self._gl_camera = pyrender.IntrinsicsCamera(f, f, camera.width / 2, camera.height / 2, znear=1.0, zfar=1e6)
-        self._camera_node = self._scene.add(self._gl_camera, pose=np.eye(4))
-        self._nodes: dict[TileKey, object] = {}
+        self.backend = resolve_backend(backend)
+        self._platform = _context(self.backend, camera.width, camera.height)
+        from OpenGL import GL as gl
+
+        self.gl_renderer = gl.glGetString(gl.GL_RENDERER).decode()
+        n_vertices = len(tiles.tile((0, 0, 0)).vertices)  # the same for every tile
+        self._gl = _GLScene(camera.width, camera.height, tiles.tile((0, 0, 0)).faces, n_vertices)
+        self._uniforms = {
+            "sun_dir": sun.direction,
+            "irradiance": float(sun.irradiance_w_m2),
+            "model": 0 if reflectance.model == "hapke" else 1,
+            "w": float(reflectance.single_scattering_albedo),
+            "b": float(reflectance.phase_b),
+            "c": float(reflectance.phase_c),
+            "b0": float(reflectance.opposition_b0),
+            "hw": float(reflectance.opposition_h),
+            "albedo": float(reflectance.albedo),
+            "radiance_max": float(max_radiance_factor(reflectance) * sun.irradiance_w_m2 / np.pi),
+        }
+        self._slots: dict[TileKey, int] = {}
+        self._free: list[int] = []
         self._last_used: dict[TileKey, int] = {}
         self._frame_count = 0
 
-    def _node(self, key: TileKey):
-        if key not in self._nodes:
+    def _slot(self, key: TileKey) -> int:
+        if key not in self._slots:
             t = self.tiles.tile(key)
-            prim = self._pyrender.Primitive(
-                positions=t.vertices.astype(np.float32),
-                normals=t.normals.astype(np.float32),
-                texcoord_0=np.stack([t.lit, np.zeros_like(t.lit)], axis=1).astype(np.float32),
-                indices=t.faces,
-                mode=self._pyrender.constants.GLTF.TRIANGLES,
-            )
-            pose = np.eye(4)
-            pose[:3, 3] = t.centre
-            self._nodes[key] = self._scene.add(self._pyrender.Mesh([prim]), pose=pose)
-        return self._nodes[key]
+            slot = self._free.pop() if self._free else len(self._slots)
+            position_lit = np.empty((len(t.vertices), 4), np.float32)
+            position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
+            normal = np.zeros((len(t.vertices), 4), np.float32)
+            normal[:, :3] = t.normals
+            self._gl.upload(slot, position_lit, normal)
+            self._slots[key] = slot
+        return self._slots[key]
 
     def render(self, pose: CameraPose) -> Frame:
         keys = self.tiles.select(pose, self.camera)
         self._frame_count += 1
-        visible = set(keys)
+        self._platform.make_current()
+        slots = [self._slot(key) for key in keys]
         for key in keys:
-            self._node(key)
             self._last_used[key] = self._frame_count
-        for key, node in self._nodes.items():
-            node.mesh.is_visible = key in visible
         self._evict()
-        # Front to back: the depth test then rejects hidden fragments early, and the order
-        # (hence which of two coincident surfaces wins) does not depend on Python's hashing.
         dists, radii = self.tiles.distances(keys, pose.position)
         order = sorted(range(len(keys)), key=lambda a: (dists[a], keys[a]))
-        self._renderer.draw_order = [self._nodes[keys[a]] for a in order]
+        instances = np.empty((len(keys), 4), np.float32)
+        for row, a in enumerate(order):
+            instances[row, :3] = self.tiles.tile(keys[a]).centre - np.asarray(pose.position, float)
+            instances[row, 3] = slots[a]
         near, far = depth_range(dists, radii, self.camera) if keys else (1.0, 10.0)
-        self._gl_camera.znear, self._gl_camera.zfar = near, far
-        self._scene.set_pose(self._camera_node, opengl_camera_to_world(pose))
-        self._renderer.uniforms = {
-            "cam_pos": np.asarray(pose.position, float),
-            "sun_dir": self.sun.direction.astype(np.float32),
-            "boresight": np.asarray(pose.rotation, float)[:, 2].astype(np.float32),
-            "irradiance": float(self.sun.irradiance_w_m2),
-            "model": 0 if self.reflectance.model == "hapke" else 1,
-            "w": self.reflectance.single_scattering_albedo,
-            "b": self.reflectance.phase_b,
-            "c": self.reflectance.phase_c,
-            "b0": self.reflectance.opposition_b0,
-            "hw": self.reflectance.opposition_h,
-            "albedo": self.reflectance.albedo,
-            "radiance_max": self._radiance_max,
+        uniforms = {
+            **self._uniforms,
+            "V": view_rotation(pose),
+            "P": projection_matrix(self.camera, near, far),
+            "boresight": np.asarray(pose.rotation, float)[:, 2],
         }
-        self._platform.make_current()
-        image = self._renderer.render(self._scene, self._pyrender.RenderFlags.OFFSCREEN)
-        n_tri = sum(len(self.tiles.tile(k).faces) for k in keys)
+        image = self._gl.draw(instances, uniforms)
+        n_tri = len(keys) * self._gl.n_indices // 3
         radiance, depth = image[..., 0], image[..., 1]
         if self.stars is not None:
             radiance = add_stars(radiance, depth, self.stars, self.camera, pose)
         return Frame(radiance, depth, len(keys), n_tri)
 
+    @property
+    def n_uploaded(self) -> int:
+        """Tiles held on the OpenGL side."""
+        return len(self._slots)
+
     def _evict(self) -> None:
-        """Drop the least recently drawn tiles beyond the cap (never this frame's)."""
-        if len(self._nodes) <= self.max_cached_tiles:
+        """Free the least recently drawn tiles beyond the cap (never this frame's)."""
+        if len(self._slots) <= self.max_cached_tiles:
             return
         old = sorted(
-            (k for k in self._nodes if self._last_used.get(k, 0) < self._frame_count),
+            (k for k in self._slots if self._last_used.get(k, 0) < self._frame_count),
             key=lambda k: (self._last_used.get(k, 0), k),
         )
-        for key in old[: len(self._nodes) - self.max_cached_tiles]:
-            self._scene.remove_node(self._nodes.pop(key))
+        for key in old[: len(self._slots) - self.max_cached_tiles]:
+            self._free.append(self._slots.pop(key))
             self._last_used.pop(key, None)
-        self.tiles.evict(set(self._nodes))
+        self.tiles.evict(set(self._slots))
 
     def close(self) -> None:
-        if self._renderer is not None:
+        if self._gl is not None:
             self._platform.make_current()
-            self._renderer.delete()
+            self._gl.delete()
             self._platform.delete_context()
-            self._renderer = None
+            self._gl = None
 
     def __enter__(self):
         return self

@@ -1,15 +1,16 @@
 #version 330 core
 // traj2events terrain, vertex stage: the reflectance law per vertex (cells are a few
 // pixels, so interpolating radiance across a triangle changes it by < 1e-3 and saves
-// evaluating Hapke for every pixel), and positions relative to the camera.
+// evaluating Hapke for every pixel), and positions relative to the camera. One instance
+// per tile: its vertices are fetched from its slot of the shared vertex buffers.
 // The laws mirror reflectance.py (the numpy reference the tests compare with).
-layout(location = 0) in vec3 position;
-layout(location = NORMAL_LOC) in vec3 normal;
-layout(location = TEXCOORD_0_LOC) in vec2 texcoord_0;   // x: lit fraction (0..1) from the horizon march
+layout(location = 0) in vec4 tile;  // per instance (tile): xyz its origin minus the camera position (m), w its slot
 
+uniform samplerBuffer vertex_position_lit;  // per vertex: position minus its tile's origin (m), lit fraction (0..1)
+uniform samplerBuffer vertex_normal;        // per vertex: unit normal, 0
+uniform int vertices_per_tile;              // a slot's vertices: every tile has the same grid and skirts
 uniform mat4 V;            // the view rotation only (camera at the origin)
 uniform mat4 P;
-uniform vec3 tile_offset;  // the tile's origin minus the camera position (m)
 
 out vec3 frag_offset;   // world position minus camera position (m), kept small for precision
 out float frag_radiance;
@@ -43,8 +44,10 @@ float hg(float b_, float cos_g)
 
 void main()
 {
-    frag_offset = position + tile_offset;   // tiles are only translated
-    vec3 n = normalize(normal);
+    int vertex = int(tile.w) * vertices_per_tile + gl_VertexID;
+    vec4 position_lit = texelFetch(vertex_position_lit, vertex);
+    frag_offset = position_lit.xyz + tile.xyz;   // tiles are only translated
+    vec3 n = normalize(texelFetch(vertex_normal, vertex).xyz);
     vec3 to_camera = -normalize(frag_offset);
     float mu0 = dot(n, sun_dir);
     float mu = dot(n, to_camera);
@@ -64,6 +67,6 @@ void main()
         }
     }
     frag_radiance = rf * irradiance / PI;
-    frag_lit = clamp(texcoord_0.x, 0.0, 1.0);
+    frag_lit = clamp(position_lit.w, 0.0, 1.0);  // from the horizon march
     gl_Position = P * V * vec4(frag_offset, 1.0);
 }

@@ -168,8 +168,10 @@ def render_trajectory(
     frames: str | os.PathLike,
     video: str | os.PathLike,
     preview: str | os.PathLike,
+    backend: str = "auto",
 ) -> None:
-    """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv, preview.mp4."""
+    """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv, preview.mp4.
+    `backend`: the OpenGL backend (render.resolve_backend); it changes speed, not the scene."""
     s = settings
     tr = read_trajectory(trajectory)
     if tr.t is None or len(tr.t) < 1:
@@ -197,11 +199,12 @@ def render_trajectory(
     start = time.perf_counter()
     triangles = reused = added = 0
     with (
-        TerrainRenderer(tiles, camera, sun, reflectance, stars=s.star_field()) as renderer,
+        TerrainRenderer(tiles, camera, sun, reflectance, stars=s.star_field(), backend=backend) as renderer,
         FramesWriter(frames, s.height, s.width, attrs) as out,
         VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
         VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview,
     ):
+        log(f"  OpenGL: {renderer.backend} ({renderer.gl_renderer})")
         frame = None
         for k in range(n):
             # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
