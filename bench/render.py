@@ -72,7 +72,9 @@ def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backe
     results = {}
     for budget in [reference, *budgets]:
         tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
-        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as renderer:
+        with TerrainRenderer(
+            tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend
+        ) as renderer:
             start = time.perf_counter()
             for pose in path:  # build every tile the stretch needs
                 tiles.select(pose, camera)
