@@ -68,7 +68,13 @@ def cmd_render(args) -> int:
     from .stages.render import RenderSettings, render_trajectory
 
     render_trajectory(
-        args.trajectory, _settings(RenderSettings, args.settings), args.frames, args.video, args.preview, args.backend
+        args.trajectory,
+        _settings(RenderSettings, args.settings),
+        args.frames,
+        args.video,
+        args.preview,
+        args.backend,
+        args.tile_cache,
     )
     return 0
 
@@ -300,6 +306,12 @@ def build_parser() -> argparse.ArgumentParser:
         default=section("render")["backend"],
         help="OpenGL backend: egl (a GPU, headless), osmesa (the CPU, Mesa llvmpipe) or auto (EGL when a GPU's "
         "EGL device exists, else OSMesa); default: %(default)s",
+    )
+    p.add_argument(
+        "--tile-cache",
+        metavar="FOLDER",
+        help="share built tiles' terrain heights with other render jobs through this folder (the workflow "
+        "passes render.tile_cache); default: no cache",
     )
     p.set_defaults(func=cmd_render)
 

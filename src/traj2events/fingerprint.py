@@ -95,7 +95,9 @@ def data_files(tree: ast.AST) -> list[Path]:
             isinstance(node, ast.Constant)
             and isinstance(node.value, str)
             and node.value
+            and len(node.value) < 256  # a file name, not a docstring or a message
             and "/" not in node.value
+            and "\n" not in node.value
             and not node.value.startswith(".")
         ):
             candidate = PACKAGE_DIR / node.value

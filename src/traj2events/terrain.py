@@ -26,9 +26,10 @@ a low-pass version of the fine one, not a different surface).
 
 from __future__ import annotations
 
+import hashlib
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Protocol
 
@@ -76,6 +77,9 @@ class TerrainParams:
 class Terrain(Protocol):
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
         """Height (m, up) at horizontal points, resolved to features >= 2 spacings."""
+
+    def identity(self) -> dict:
+        """Everything the heights depend on, as JSON-serialisable values (the tile cache's key)."""
 
 
 # --- crater shapes (functions of rho = r / crater radius) ----------------------------------
@@ -182,6 +186,10 @@ class ProceduralTerrain:
         self.params = params
         self.crater_octaves = size_octaves(params.crater_diameter_min_m, params.crater_diameter_max_m)
         self.boulder_octaves = size_octaves(params.boulder_diameter_min_m, params.boulder_diameter_max_m)
+
+    def identity(self) -> dict:
+        """What the heights depend on (the tile cache's key): the parameters, seed included."""
+        return {"procedural": asdict(self.params)}
 
     def craters_in(
         self, x_range: tuple[float, float], y_range: tuple[float, float], min_diameter_m: float = 0.0
@@ -446,6 +454,12 @@ class GridTerrain:
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
         return bilinear(self.heights_m, self.origin_m, self.spacing_m, x_m, y_m, fill=0.0)
+
+    def identity(self) -> dict:
+        """What the heights depend on (the tile cache's key): the grid's values and placement."""
+        values = hashlib.sha256(np.ascontiguousarray(self.heights_m, dtype=np.float64).tobytes()).hexdigest()
+        shape = list(np.shape(self.heights_m))
+        return {"grid_sha256": values, "shape": shape, "spacing_m": self.spacing_m, "origin_m": list(self.origin_m)}
 
 
 def bilinear(

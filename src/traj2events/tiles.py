@@ -13,6 +13,10 @@ geometric mean of its projected sides (`foreshortening`), for tiles farther than
 own size. Neighbours at different levels
 meet with skirts (a strip hanging below each tile edge) instead of cracks.
 
+Building a tile is mostly evaluating the terrain's heights on its grid: with a tile cache
+(`cache_dir`, formats/tile_cache.py) those are stored once and read by every later
+TileSet with the same terrain, quadtree and Sun side, in this process or another.
+
 Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
 grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights
 beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
@@ -27,6 +31,7 @@ import numpy as np
 
 from .camera import Camera, CameraPose
 from .defaults import section
+from .formats.tile_cache import TileCache
 from .illumination import ShadowField, no_obstruction, shadow_field
 from .terrain import Terrain, surface_points
 
@@ -73,7 +78,10 @@ class TileSet:
         radius_m: float,
         half_extent_m: float,
         lod: LodSettings = LodSettings(),
+        cache_dir: str | None = None,
     ):
+        """`cache_dir`: a folder for the tile cache (heights shared with other TileSets
+        and jobs; formats/tile_cache.py), or None: every tile's terrain is evaluated here."""
         self.terrain = terrain
         self.sun_dir = np.asarray(sun_dir, float)
         self.radius_m = radius_m
@@ -81,6 +89,24 @@ class TileSet:
         self.lod = lod
         self._cache: dict[TileKey, Tile] = {}
         self.faces = _grid_faces(lod.cells + 1)
+        self.disk = TileCache(cache_dir, self.heights_identity()) if cache_dir else None
+        self.n_evaluated = 0  # tiles whose terrain was evaluated here (not read from the disk cache)
+
+    def heights_identity(self) -> dict:
+        """What a tile's heights depend on: the terrain, the quadtree and the Sun's side
+        (the margin's), and the terrain code."""
+        from .fingerprint import code_fingerprint
+
+        if not hasattr(self.terrain, "identity"):
+            raise TypeError(f"tile cache: {type(self.terrain).__name__} has no identity() to key the cache by")
+        return {
+            "terrain": self.terrain.identity(),
+            "half_extent_m": float(self.half_extent_m),
+            "cells": self.lod.cells,
+            "margin": self.lod.margin,
+            "sun_side": [bool(self.sun_dir[0] > 0), bool(self.sun_dir[1] > 0)],
+            "code": code_fingerprint("traj2events.terrain"),
+        }
 
     # --- geometry ---------------------------------------------------------------------
 
@@ -123,7 +149,12 @@ class TileSet:
         x = x0 + spacing * np.arange(-lo_x, n + 1 + hi_x)
         y = y0 + spacing * np.arange(-lo_y, n + 1 + hi_y)
         xx, yy = np.meshgrid(x, y, indexing="ij")
-        h = self.terrain.height_m(xx, yy, spacing)
+        h = self.disk.load(key, xx.shape) if self.disk else None
+        if h is None:
+            h = self.terrain.height_m(xx, yy, spacing)
+            self.n_evaluated += 1
+            if self.disk:
+                self.disk.save(key, h)
         beyond = no_obstruction if level == 0 else self.tile((level - 1, i >> 1, j >> 1)).shadow.obstruction_at
         shadow = shadow_field(x, y, h, self.sun_dir, self.radius_m, beyond)
         points = surface_points(xx, yy, h, self.radius_m)

@@ -71,6 +71,12 @@ def elevation_grid(wildcards):
     return [grid] if grid else []
 
 
+def tile_cache_option(wildcards):
+    """The render command's --tile-cache option (render.tile_cache), or nothing."""
+    folder = config["render"]["tile_cache"]
+    return f"--tile-cache '{folder}'" if folder else ""
+
+
 def frames_output(path):
     """frames.h5 (linear radiance + depth) is large: temporary unless render.keep_frames."""
     return path if config["render"]["keep_frames"] else temp(path)

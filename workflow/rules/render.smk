@@ -22,7 +22,8 @@ rule render:
         settings=render_settings,
         code=code("render"),
         backend=config["render"]["backend"],
+        tile_cache=tile_cache_option,
     shell:
         # llvmpipe would start a thread per core in every job; one job = one core.
         "LP_NUM_THREADS={threads} traj2events render {input.trajectory} --settings '{params.settings}' "
-        "--frames {output.frames} --video {output.video} --preview {output.preview} --backend {params.backend} 2> {log}"
+        "--frames {output.frames} --video {output.video} --preview {output.preview} --backend {params.backend} {params.tile_cache} 2> {log}"

@@ -8,4 +8,5 @@ of the pipeline never loads the solver or the renderer.
     flow        motion_field.h5 and Middlebury .flo
     events      the event dtype and events.h5 (DSEC layout)
     exports     the ELOPE-style .npz, EVT 3.0 and AEDAT4
+    tile_cache  the render's cache of tile heights, shared between jobs
 """

@@ -94,13 +94,15 @@ class RenderSettings:
     def from_json(cls, text: str) -> "RenderSettings":
         return cls(**json.loads(text))
 
-    def build(self):
-        """(camera, tiles, sun, reflectance) ready for render.TerrainRenderer."""
+    def build(self, tile_cache: str | None = None):
+        """(camera, tiles, sun, reflectance) ready for render.TerrainRenderer; `tile_cache`:
+        the folder of the tile cache shared between jobs (None: none)."""
         t = dict(self.terrain)
         grid, spacing = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None)
         terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
         sun = Sun(**self.sun)
-        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, LodSettings(**self.lod))
+        lod = LodSettings(**self.lod)
+        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache)
         return (
             Camera(self.width, self.height, self.fov_deg, self.mount_height_m),
             tiles,
@@ -169,15 +171,17 @@ def render_trajectory(
     video: str | os.PathLike,
     preview: str | os.PathLike,
     backend: str = "auto",
+    tile_cache: str | None = None,
 ) -> None:
     """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv, preview.mp4.
-    `backend`: the OpenGL backend (render.resolve_backend); it changes speed, not the scene."""
+    `backend`: the OpenGL backend (render.resolve_backend); `tile_cache`: a folder where
+    tile heights are shared with other jobs (formats/tile_cache.py). Neither changes the scene."""
     s = settings
     tr = read_trajectory(trajectory)
     if tr.t is None or len(tr.t) < 1:
         raise ValueError(f"{trajectory}: expected poses/t with at least one pose")
     timing = FrameTiming(**s.timing)
-    camera, tiles, sun, reflectance = s.build()
+    camera, tiles, sun, reflectance = s.build(tile_cache)
     fps = float(tr.attrs["fps"])
     n = len(tr.t)
     attrs = {
@@ -232,6 +236,8 @@ def render_trajectory(
                     f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 + added - reused, 1):.0f} triangles/frame"
                 )
     log(f"{n} frames and {added} adaptive ones in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
+    if tiles.disk is not None:
+        log(f"tiles: {tiles.n_evaluated} built, {tiles.disk.n_read} read from the tile cache {tiles.disk.folder}")
 
 
 # frames.h5's attribute order (kept, so the same scene gives the same bytes).

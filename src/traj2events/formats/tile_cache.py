@@ -1,0 +1,78 @@
+"""The tile cache on disk (`render.tile_cache`): the terrain heights of built tiles,
+shared by every render job whose tiles are the same (all trajectories of a scenario).
+
+A tile's heights (its grid extended for normals and the shadow march, float64) are the
+costly part of building it (the procedural craters, boulders and roughness); the shadows,
+normals and skirts are recomputed from them, so a tile read back is the tile built, byte
+for byte. The heights depend on the terrain (its settings, or the elevation grid's
+values), on the quadtree (root half-extent, cells, margin), on the sides where a tile's
+grid extends toward the Sun (the signs of the Sun direction's x and y) and on the
+terrain code: a folder is named by a hash of all of these (written out beside the tiles
+in identity.json), so a changed setting or code never reads another's tiles.
+
+One .npy per tile, `{folder}/{level}/{i}_{j}.npy`, written to a temporary name and
+renamed: concurrent jobs (a cluster's, on a shared file system) never read half a tile,
+and two writing the same tile write the same bytes. A file that cannot be read or has
+the wrong shape is rebuilt; a write that fails (a full disk) only leaves the tile
+uncached. The folder can be deleted at any time.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+FORMAT = 1  # bumped when the stored arrays change meaning
+
+
+class TileCache:
+    def __init__(self, root: str | os.PathLike, identity: dict):
+        """`identity`: everything the stored heights depend on (JSON-serialisable)."""
+        text = json.dumps({"format": FORMAT, **identity}, sort_keys=True)
+        self.folder = Path(root) / hashlib.sha256(text.encode()).hexdigest()[:16]
+        self.n_read = self.n_written = 0
+        self.folder.mkdir(parents=True, exist_ok=True)
+        if not (self.folder / "identity.json").exists():
+            self._write(self.folder / "identity.json", lambda f: f.write(text.encode()))
+
+    def path(self, key: tuple[int, int, int]) -> Path:
+        level, i, j = key
+        return self.folder / str(level) / f"{i}_{j}.npy"
+
+    def load(self, key: tuple[int, int, int], shape: tuple[int, int]) -> np.ndarray | None:
+        """The tile's stored heights, or None (not stored, unreadable or not `shape`)."""
+        try:
+            heights = np.load(self.path(key), allow_pickle=False)
+        except (OSError, ValueError):
+            return None
+        if heights.shape != shape or heights.dtype != np.float64:
+            return None
+        self.n_read += 1
+        return heights
+
+    def save(self, key: tuple[int, int, int], heights: np.ndarray) -> None:
+        if self._write(self.path(key), lambda f: np.save(f, heights, allow_pickle=False)):
+            self.n_written += 1
+
+    @staticmethod
+    def _write(path: Path, write) -> bool:
+        """Write through a temporary file renamed into place; False if it failed."""
+        tmp = None
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+            with os.fdopen(fd, "wb") as f:
+                write(f)
+            os.replace(tmp, path)
+            return True
+        except OSError:
+            if tmp is not None:
+                with contextlib.suppress(OSError):
+                    os.unlink(tmp)
+            return False

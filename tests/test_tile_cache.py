@@ -1,0 +1,85 @@
+"""The tile cache on disk: tiles read back are the tiles built, byte for byte; a changed
+terrain never reads another's; a damaged file is rebuilt; a failed write is harmless."""
+
+import json
+
+import numpy as np
+import pytest
+
+from traj2events.camera import Camera, camera_pose
+from traj2events.formats.tile_cache import TileCache
+from traj2events.illumination import Sun
+from traj2events.terrain import GridTerrain, ProceduralTerrain, TerrainParams
+from traj2events.tiles import LodSettings, TileSet
+
+R_MOON = 1737400.0
+SUN = Sun(1.496e11, 105.0, 7.0)
+CAMERA = Camera(64, 64, 45.0)
+
+
+def pose():
+    s = np.zeros(13)
+    s[:3] = 0.0, 0.0, -300.0
+    s[7] = np.radians(40.0)
+    return camera_pose(s)
+
+
+def tiles(folder, seed=1, sun=SUN):
+    t = TileSet(ProceduralTerrain(TerrainParams(seed=seed)), sun.direction, R_MOON, 20e3, LodSettings(), folder)
+    keys = t.select(pose(), CAMERA)
+    return t, keys
+
+
+def test_tiles_read_back_are_the_tiles_built(tmp_path):
+    reference, keys = tiles(None)
+    first, _ = tiles(tmp_path)
+    second, again = tiles(tmp_path)
+    assert again == keys and len(keys) > 10
+    assert first.n_evaluated == first.disk.n_written == first.n_cached > len(keys)  # parents too
+    assert second.n_evaluated == 0 and second.disk.n_read == second.n_cached
+    for key in keys:
+        a, b = reference.tile(key), second.tile(key)
+        for name in ("vertices", "normals", "lit", "heights_m"):
+            assert np.array_equal(getattr(a, name), getattr(b, name)), (key, name)
+    identity = json.loads((second.disk.folder / "identity.json").read_text())
+    assert identity["terrain"]["procedural"]["seed"] == 1 and identity["format"] == 1
+
+
+def test_another_terrain_or_sun_side_has_its_own_folder(tmp_path):
+    a, _ = tiles(tmp_path, seed=1)
+    b, _ = tiles(tmp_path, seed=2)
+    c, _ = tiles(tmp_path, seed=1, sun=Sun(1.496e11, 285.0, 7.0))  # the Sun on the other side
+    d, _ = tiles(tmp_path, seed=1, sun=Sun(1.496e11, 100.0, 9.0))  # the same side: shared
+    assert len({a.disk.folder, b.disk.folder, c.disk.folder}) == 3
+    assert d.disk.folder == a.disk.folder and d.n_evaluated == 0
+    assert b.n_evaluated == b.n_cached and c.n_evaluated == c.n_cached
+
+
+def test_an_elevation_grid_is_keyed_by_its_values(tmp_path):
+    heights = np.zeros((50, 50))
+    one = TileCache(tmp_path, GridTerrain(heights, 2.0, (-50.0, -50.0)).identity())
+    heights[3, 4] = 0.5
+    other = TileCache(tmp_path, GridTerrain(heights, 2.0, (-50.0, -50.0)).identity())
+    assert one.folder != other.folder
+
+
+def test_a_damaged_tile_is_rebuilt_and_a_failed_write_is_harmless(tmp_path):
+    first, keys = tiles(tmp_path)
+    damaged = first.disk.path(keys[0])
+    damaged.write_bytes(damaged.read_bytes()[:100])  # a truncated file
+    second, _ = tiles(tmp_path)
+    assert second.n_evaluated == 1
+    assert np.array_equal(second.tile(keys[0]).heights_m, first.tile(keys[0]).heights_m)
+    cache = TileCache(tmp_path / "x", {"a": 1})
+    (cache.folder / "9").write_text("a file where the level's folder should be")
+    cache.save((9, 0, 0), np.zeros((3, 3)))
+    assert cache.n_written == 0 and cache.load((9, 0, 0), (3, 3)) is None
+
+
+def test_a_terrain_without_identity_cannot_be_cached(tmp_path):
+    class Flat:
+        def height_m(self, x_m, y_m, spacing_m):
+            return np.zeros(np.shape(x_m))
+
+    with pytest.raises(TypeError, match="tile cache: Flat has no identity"):
+        TileSet(Flat(), SUN.direction, R_MOON, 20e3, LodSettings(), tmp_path)
