@@ -11,7 +11,7 @@ from dataclasses import dataclass
 # Bytes per pixel per frame (per field for the motion field), measured on the default
 # dataset (128 x 128) and bench/frames_store.py (1024 x 1024).
 BYTES_PER_PX = {
-    "frames.h5": 3.5,  # radiance + depth, 16 significant bits, Blosc/zstd-1 (gzip-1 gave 3.0)
+    "frames.h5": 3.5,  # radiance + depth, 16 significant bits, Blosc/LZ4 (3.3 at 1024^2; zstd-1 gave 2.8)
     "video.mkv": 0.43,  # FFV1 of the 8-bit display frames
     "preview.mp4": 0.03,
     "events.h5": 1.0,  # paper preset through the sensor model: 1.03 at 1024^2 (bench/workflow_cost.py), 0.49 at 128^2
@@ -21,9 +21,9 @@ BYTES_PER_PX = {
 EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # measured on the default dataset
 # Seconds of one core: per frame (a fixed part and a per-pixel part), per motion field;
 # at 1024^2 from bench/workflow_cost.py (CPU time of the whole commands, encoders included).
-RENDER_S = (0.012, 3.8e-7)  # 128^2: 15 ms/frame, 1024^2: 0.36-0.44 s/frame with the two encoders
+RENDER_S = (0.012, 3.2e-7)  # 128^2: 15 ms/frame, 1024^2: 0.31-0.37 s/frame with the two encoders
 EVENTS_S = (0.0005, 6.6e-8)  # the whole events command (decoding, emulation, writing): 0.07 s at 1024^2
-FIELD_S_PER_PX = 1.9e-7  # motion field with the terrain-true field: 0.20 s at 1024^2
+FIELD_S_PER_PX = 1.35e-7  # motion field with the terrain-true field: 0.13-0.15 s at 1024^2
 # Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
 # the smoke descent trajectory (694 frames) at 128^2 and 512^2, the motion field at 256^2
 # and 1024^2 (docs/benchmarks.md).
