@@ -15,7 +15,9 @@ each output comes from the longest clip. Then the config's dataset (`traj2events
 frame, field and trajectory counts, t_f = tf_guess_s) at those rates: CPU core-hours per
 stage and in all, and disk per output kind. Rates are averaged over the trajectories
 given. The trajectory solves are left out (~0.02 core-hours for 500, docs/benchmarks.md).
-GPU-hours are not measured here (no GPU on this machine).
+The header names the OpenGL backend the render command takes (`render.backend`); with
+EGL on a GPU the render's CPU seconds are its CPU side only, and its wall seconds
+(printed per run) bound the GPU's share: GPU-hours are not fitted here.
 """
 
 from __future__ import annotations
@@ -41,6 +43,7 @@ from traj2events.config import load_config  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory, write_trajectory  # noqa: E402
 from traj2events.plan import dataset_plan  # noqa: E402
+from traj2events.render import resolve_backend  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 from traj2events.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
 
@@ -58,14 +61,14 @@ def clip_trajectory(trajectory: Path, t0_s: float, seconds: float, fps: float, o
     return len(t)
 
 
-def cpu_seconds(command: list[str]) -> float:
-    """CPU seconds (user + system) of a command and the children it waited for."""
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+def cpu_seconds(command: list[str]) -> tuple[float, float]:
+    """(CPU seconds (user + system) of a command and the children it waited for, wall seconds)."""
+    before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
     done = subprocess.run(command, env={**os.environ, **ONE_CORE}, capture_output=True, text=True)
     if done.returncode:
         raise RuntimeError(f"{' '.join(command)} failed:\n{done.stderr[-3000:]}")
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), time.perf_counter() - start
 
 
 def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_every: int) -> dict[str, list[str]]:
@@ -110,9 +113,10 @@ def main() -> None:
     disk_per_frame: dict[str, list[float]] = {}
     print(
         f"# workflow cost: {args.config}, {config['camera']['width']}^2 at {fps:g} fps, clips of {args.seconds} s; "
-        f"{platform.node()} ({os.cpu_count()} cores, 1 per command), {time.strftime('%Y-%m-%d')}"
+        f"{platform.node()} ({os.cpu_count()} cores, 1 per command), {time.strftime('%Y-%m-%d')}; "
+        f"render backend {resolve_backend(config['render']['backend'])}"
     )
-    print("| trajectory | stage | CPU s per job (a) | CPU s per frame (b) | runs: frames -> CPU s |")
+    print("| trajectory | stage | CPU s per job (a) | CPU s per frame (b) | runs: frames -> CPU s (wall s) |")
     print("|---|---|---|---|---|")
     for path in args.trajectories:
         tr = read_trajectory(path)
@@ -124,17 +128,17 @@ def main() -> None:
                 n = clip_trajectory(path, t0, seconds, fps, folder / "clip.h5")
                 fields = len(range(0, n - 1, every))
                 for stage, command in stage_commands(config, scenario, folder / "clip.h5", folder, every).items():
-                    runs[stage].append((fields if stage == "motion field" else n, cpu_seconds(command)))
+                    runs[stage].append((fields if stage == "motion field" else n, *cpu_seconds(command)))
                 sizes = output_bytes(folder)
             for name, size in sizes.items():
                 count = fields if name in ("motion_field.h5", "flow/*.flo") else n
                 disk_per_frame.setdefault(name, []).append(size / count)
         for stage, points in runs.items():
-            x, y = np.array(points, dtype=float).T
+            x, y, _ = np.array(points, dtype=float).T
             b, a = np.polyfit(x, y, 1) if len(set(x)) > 1 else (y[0] / x[0], 0.0)
             per_frame[stage].append(b)
             per_job[stage].append(a)
-            shown = ", ".join(f"{int(f)} -> {s:.1f}" for f, s in points)
+            shown = ", ".join(f"{int(f)} -> {s:.1f} ({w:.1f} wall)" for f, s, w in points)
             print(f"| {scenario} | {stage} | {a:.1f} | {b:.4f} | {shown} |", flush=True)
     plan = dataset_plan(config)
     hours = {
