@@ -53,6 +53,7 @@ from traj2events.scenarios import (  # noqa: E402
     sample_conditions,
 )
 from traj2events.stages.base_solution import solve_base  # noqa: E402
+from traj2events.state import MASS  # noqa: E402
 from traj2events.upsample import ShootingCheck, final_state_error  # noqa: E402
 
 
@@ -113,7 +114,7 @@ def batch(config: dict, jobs: int, nodes: int | None, clustering: float | None, 
     for name in config["scenarios"]:
         s = ScenarioSettings.from_config(config, name)
         t0 = time.perf_counter()
-        base = LandingProblem(s.vehicle, s.ocp).solve(base_conditions(s.scenario, s.vehicle))
+        base, _ = solve_base(s)
         results = solve_samples(
             s.vehicle, s.ocp, s.scenario, s.seed, base_conditions(s.scenario, s.vehicle), base, jobs=jobs
         )
@@ -196,20 +197,22 @@ def motion(config: dict, overlay_path: str, n_samples: int, jobs: int) -> None:
     print(
         "| scenario | vehicle | solved / draws | t_f (s, median) | pitch start (deg) | monotone pitch "
         f"(rise <= {MONOTONE_DEG:g} deg) | pitch rise (deg, median / max) | at the tilt limit "
-        "| roll swing (deg, median / max) | yaw swing (deg, median / max) | travel / drop (median) | solve CPU (s) |"
+        "| roll swing (deg, median / max) | yaw swing (deg, median / max) | travel / drop (median) "
+        "| fuel (kg, median) | solve CPU (s) |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in config["scenarios"]:
         for label, cfg in variants.items():
             results, cpu_s = solve_scenario(cfg, name, n_samples, jobs)
             ok = [r for r in results if r.success]
             if not ok:
-                print(f"| {name} | {label} | 0 / {len(results)} | | | | | | | | | {cpu_s:.1f} |", flush=True)
+                print(f"| {name} | {label} | 0 / {len(results)} | | | | | | | | | | {cpu_s:.1f} |", flush=True)
                 continue
             rows = [motion_summary(r.solution.state) for r in ok]
             m = {k: np.array([row[k] for row in rows]) for k in rows[0]}
             tilt = cfg["vehicle"]["tilt_max_deg"]
             med = np.median
+            fuel = med([r.solution.state[0, MASS] - r.solution.state[-1, MASS] for r in ok])
             print(
                 f"| {name} | {label} | {len(ok)} / {len(results)} | {med([r.solution.tf_s for r in ok]):.0f} "
                 f"| {med(m['pitch_start_deg']):.0f} | {np.mean(m['pitch_rise_deg'] <= MONOTONE_DEG):.0%} "
@@ -217,7 +220,7 @@ def motion(config: dict, overlay_path: str, n_samples: int, jobs: int) -> None:
                 f"| {np.mean(m['pitch_max_deg'] >= tilt - 1.0):.0%} "
                 f"| {med(m['roll_excursion_deg']):.0f} / {m['roll_excursion_deg'].max():.0f} "
                 f"| {med(m['yaw_excursion_deg']):.0f} / {m['yaw_excursion_deg'].max():.0f} "
-                f"| {med(m['travel_per_drop']):.2f} | {cpu_s:.1f} |",
+                f"| {med(m['travel_per_drop']):.2f} | {fuel:.0f} | {cpu_s:.1f} |",
                 flush=True,
             )
 

@@ -55,3 +55,40 @@ def test_the_default_vehicle_brakes_without_riding_the_tilt_limit(tmp_path):
     stats = [motion_summary(r.solution.state) for r in solved]
     assert sum(m["pitch_max_deg"] >= s.vehicle.tilt_max_deg - 1.0 for m in stats) <= 1, stats
     assert np.median([max(m["roll_excursion_deg"], m["yaw_excursion_deg"]) for m in stats]) > 20.0, stats
+
+
+def test_braking_pitch_keeps_decreasing_only_where_the_scenario_asks():
+    """Mass-optimal braking pitches up by ~20 deg while it coasts; with
+    scenarios.braking.pitch_decreasing (the default) the pitch never rises, at the nodes
+    and along the re-integrated flight between them, for a few kg of fuel."""
+    from traj2events.batch import solve_samples
+    from traj2events.config import resolve_config
+    from traj2events.dynamics import Dynamics
+    from traj2events.scenarios import ScenarioSettings
+    from traj2events.stages.base_solution import solve_base
+    from traj2events.state import MASS
+    from traj2events.upsample import ReintegratedStates
+
+    fuel, rise = {}, {}
+    for decreasing in (False, True):
+        config = resolve_config(
+            {
+                "ocp": {"n_nodes": 30, "refine_n_nodes": 60},
+                "scenarios": {"braking": {"n_trajectories": 3, "pitch_decreasing": decreasing}},
+            }
+        )
+        s = ScenarioSettings.from_config(config, "braking")
+        assert s.ocp.pitch_decreasing is decreasing
+        base, bc = solve_base(s)
+        solved = [r.solution for r in solve_samples(s.vehicle, s.ocp, s.scenario, s.seed, bc, base) if r.success]
+        assert len(solved) == 3
+        flown = [
+            ReintegratedStates(Dynamics(s.vehicle), sol.t, sol.state[0], sol.control).states(
+                np.linspace(0.0, sol.t[-1], 2000)
+            )
+            for sol in solved
+        ]
+        rise[decreasing] = [pitch_rise_deg(states[:, PITCH]) for states in flown]
+        fuel[decreasing] = [sol.state[0, MASS] - sol.state[-1, MASS] for sol in solved]
+    assert max(rise[True]) < 0.05 and np.median(rise[False]) > 2.0, rise
+    assert 0.0 <= np.median(np.subtract(fuel[True], fuel[False])) < 0.02 * np.median(fuel[False]), fuel

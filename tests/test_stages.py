@@ -92,7 +92,7 @@ def test_a_failed_sample_is_refused_by_camera_poses(built, tmp_path):
 def test_an_unsolvable_base_problem_is_named(config, tmp_path):
     bad = dict(config["scenarios"]["descent"], altitude_m=[90000.0, 90000.0])  # far beyond the fuel
     s = ScenarioSettings.from_config(
-        resolve_config({"ocp": {"max_iter": 15}, "scenarios": {"descent": bad}}),
+        resolve_config({"ocp": {"max_iter": 15, "base_max_iter": 15}, "scenarios": {"descent": bad}}),
         "descent",
     )
     with pytest.raises(BaseSolveError, match="scenario 'descent'"):
@@ -105,7 +105,7 @@ def test_a_recorded_base_failure_reaches_the_summary_and_names_itself(config, tm
     # summary reports the scenario, and each of its trajectories fails naming the cause.
     bad = dict(config["scenarios"]["descent"], altitude_m=[90000.0, 90000.0])
     s = ScenarioSettings.from_config(
-        resolve_config({"ocp": {"max_iter": 15}, "scenarios": {"descent": bad}}), "descent"
+        resolve_config({"ocp": {"max_iter": 15, "base_max_iter": 15}, "scenarios": {"descent": bad}}), "descent"
     )
     sol = base_solution(s, tmp_path / "base.h5", record_failure=True)
     assert not sol.success and not read_trajectory(tmp_path / "base.h5").attrs["solver_success"]

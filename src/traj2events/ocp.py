@@ -3,7 +3,8 @@
     minimise   J = (1 - eps) (m0 - m(tf)) + eps * integral |u|^2 dt
     subject to x' = f(x, u),  0 <= uT <= 1,  -1 <= u_att <= 1,
                cos(phi) cos(theta) >= cos(tilt_max),  z <= 0,  m >= dry mass,
-               x(0) = x0,  x(tf) = xf (yaw and mass free),  tf free.
+               x(0) = x0,  x(tf) = xf (yaw and mass free),  tf free;
+               optionally theta non-increasing (pitch_decreasing: nodes and midpoints).
 
 Transcriptions: Hermite-Simpson with piecewise-linear controls (the midpoint control is
 the mean of its nodes: quadratic interpolants overshoot their bounds where controls
@@ -27,7 +28,7 @@ import numpy as np
 
 from .defaults import section
 from .dynamics import N_STATE, Vehicle, split_control_dynamics
-from .state import MASS_KG, STATE_SCALE, TIME_S
+from .state import MASS_KG, PITCH, STATE_SCALE, TIME_S
 
 TRANSCRIPTIONS = ("hermite-simpson", "trapezoidal")
 
@@ -48,6 +49,7 @@ class OcpSettings:
     mesh_clustering: float = _OCP["mesh_clustering"]
     epsilon: float = _OCP["epsilon"]
     max_iter: int = _OCP["max_iter"]
+    base_max_iter: int = _OCP["base_max_iter"]
     tol: float = _OCP["tol"]
     tf_min_s: float = _OCP["tf_min_s"]
     tf_max_s: float = _OCP["tf_max_s"]
@@ -56,6 +58,10 @@ class OcpSettings:
     accept_error_m: float = _OCP["accept_error_m"]
     accept_error_m_s: float = _OCP["accept_error_m_s"]
     refine_n_nodes: int = _OCP["refine_n_nodes"]
+    # Pitch never increases (at the nodes and the midpoints): the paper's braking and
+    # approach, which a mass-optimal landing does not do by itself (docs/trajectories.md).
+    # Set per scenario (scenarios.<name>.pitch_decreasing).
+    pitch_decreasing: bool = False
 
     def __post_init__(self) -> None:
         if self.transcription not in TRANSCRIPTIONS:
@@ -162,6 +168,9 @@ class LandingProblem:
             Xm = 0.5 * (X[:, :-1] + X[:, 1:]) + hx / 8 * (Fk[:, :-1] - Fk[:, 1:])
             Fm = f_scaled.map(n - 1)(Xm, Wm)
             opti.subject_to(X[:, 1:] - X[:, :-1] == hx / 6 * (Fk[:, :-1] + 4 * Fm + Fk[:, 1:]))
+            if settings.pitch_decreasing:
+                opti.subject_to(Xm[PITCH, :] <= X[PITCH, :-1])
+                opti.subject_to(X[PITCH, 1:] <= Xm[PITCH, :])
             effort = ca.sum2(h * (Lk[:-1] + 4 * control_effort(Wm) + Lk[1:])) / 6
         else:
             opti.subject_to(X[:, 1:] - X[:, :-1] == hx / 2 * (Fk[:, :-1] + Fk[:, 1:]))
@@ -180,6 +189,8 @@ class LandingProblem:
         # of reach (without them ~2-5 % of solves diverged there).
         angle_max = np.radians(0.5 * (vehicle.tilt_max_deg + 90.0))
         opti.subject_to(opti.bounded(-angle_max, ca.vec(X[6:8, :]), angle_max))
+        if settings.pitch_decreasing:
+            opti.subject_to(X[PITCH, 1:] <= X[PITCH, :-1])
         opti.subject_to(X[2, :] <= 0)  # above the ground (z down)
         opti.subject_to(X[12, :] >= vehicle.dry_mass_kg / MASS_KG)
         opti.subject_to(X[:, 0] == x0)

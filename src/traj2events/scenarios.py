@@ -254,9 +254,10 @@ class ScenarioSettings:
     def from_config(cls, config: dict, name: str) -> "ScenarioSettings":
         vehicle = dict(config["vehicle"])
         vehicle["inertia_kgm2"] = tuple(vehicle["inertia_kgm2"])
+        pitch_decreasing = bool(config["scenarios"][name].get("pitch_decreasing", False))
         return cls(
             Vehicle(**vehicle),
-            OcpSettings(**config["ocp"]),
+            OcpSettings(**config["ocp"], pitch_decreasing=pitch_decreasing),
             Scenario.from_config(name, config["scenarios"][name]),
             int(config["seed"]),
         )

@@ -4,6 +4,7 @@ continuation sampling starts from."""
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 from .. import __version__
 from ..formats.trajectory import solution_attrs, vehicle_attrs, write_trajectory
@@ -23,7 +24,9 @@ def solve_base(settings: ScenarioSettings) -> tuple[Solution, object]:
     """(solution, boundary conditions) of the scenario's base problem: the first t_f guess
     that converges, else the last failed attempt (solution.success is False)."""
     s = settings
-    problem = LandingProblem(s.vehicle, s.ocp)
+    # Solved once per scenario from a cold start: its own IPOPT cap (a constrained problem,
+    # pitch_decreasing, needs more iterations than the warm-started samples).
+    problem = LandingProblem(s.vehicle, replace(s.ocp, max_iter=s.ocp.base_max_iter))
     bc = base_conditions(s.scenario, s.vehicle)
     for factor in TF_GUESS_FACTORS:
         trial = replace_tf_guess(bc, bc.tf_guess_s * factor)
