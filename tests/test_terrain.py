@@ -78,13 +78,13 @@ def test_landing_pad_is_level_but_keeps_its_regolith_texture():
     r = np.linspace(0, 19.9, 50)
     assert np.all(flat.height_m(0.6 * r, 0.8 * r, 0.5) == 0.0)
     assert site_pad_weight(np.array([40.0]), np.array([0.0]), 20.0)[0] == 1.0
-    # With the default, the pad keeps the roughness of 1 m and shorter (cm high): texture
+    # With the default, the pad keeps the roughness of 2 m and shorter (cm high): texture
     # for the last seconds, level at the lander's scale.
     terrain = ProceduralTerrain(TerrainParams(seed=1, site_radius_m=20.0))
     x, y = np.meshgrid(np.arange(-10, 10, 0.05), np.arange(-10, 10, 0.05), indexing="ij")
     h = terrain.height_m(x, y, 0.05)
     np.testing.assert_array_equal(h, terrain.roughness_m(x, y, 0.05, short=True))
-    expected_rms = 0.02 * np.sqrt(sum(0.5 ** (2 * 0.8 * k) for k in range(4)))  # octaves 1, 0.5, 0.25, 0.125 m
+    expected_rms = 0.02 * np.sqrt(sum((2 * 0.5**k) ** (2 * 0.8) for k in range(5)))  # octaves 2, 1, ..., 0.125 m
     assert 0.3 * expected_rms < h.std() < 1.5 * expected_rms and np.abs(h).max() < 0.15
     slope_deg = np.degrees(np.arctan(np.hypot(*np.gradient(h, 0.05))))
     assert np.percentile(slope_deg, 90) > 2.0  # steeper than the descent's 2 deg Sun: shading and shadows
