@@ -83,3 +83,29 @@ def test_a_terrain_without_identity_cannot_be_cached(tmp_path):
 
     with pytest.raises(TypeError, match="tile cache: Flat has no identity"):
         TileSet(Flat(), SUN.direction, R_MOON, 20e3, LodSettings(), tmp_path)
+
+
+def test_a_killed_writers_temporary_files_go_with_the_next_job(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    from traj2events.formats import tile_cache
+
+    cache = TileCache(tmp_path, {"a": 1})
+    host = tile_cache._WRITER.partition("@")[2]
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    names = {
+        "killed here": f".0_0.npy.{int(dead.stdout)}@{host}.abc123.part",
+        "alive here": f".0_1.npy.{os.getpid()}@{host}.abc123.part",
+        "other host, fresh": ".1_0.npy.99@elsewhere.abc123.part",
+        "other host, two days old": ".1_1.npy.99@elsewhere.abc123.part",
+    }
+    for name in names.values():
+        (cache.folder / "3").mkdir(exist_ok=True)
+        (cache.folder / "3" / name).write_bytes(b"half a tile")
+    old = cache.folder / "3" / names["other host, two days old"]
+    os.utime(old, (old.stat().st_atime, old.stat().st_mtime - 2 * 86400))
+    TileCache(tmp_path, {"a": 1})  # the next job opens the cache
+    left = {p.name for p in (cache.folder / "3").iterdir()}
+    assert left == {names["alive here"], names["other host, fresh"]}

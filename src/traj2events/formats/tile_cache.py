@@ -12,9 +12,11 @@ in identity.json), so a changed setting or code never reads another's tiles.
 
 One .npy per tile, `{folder}/{level}/{i}_{j}.npy`, written to a temporary name and
 renamed: concurrent jobs (a cluster's, on a shared file system) never read half a tile,
-and two writing the same tile write the same bytes. A file that cannot be read or has
-the wrong shape is rebuilt; a write that fails (a full disk) only leaves the tile
-uncached. The folder can be deleted at any time.
+and two writing the same tile write the same bytes. A temporary name carries its
+writer's process id and host: a job opening the cache removes those its host's killed
+jobs left (and any older than a day), so a SIGKILL leaves no debris past the next job.
+A file that cannot be read or has the wrong shape is rebuilt; a write that fails (a full
+disk) only leaves the tile uncached. The folder can be deleted at any time.
 """
 
 from __future__ import annotations
@@ -23,12 +25,16 @@ import contextlib
 import hashlib
 import json
 import os
+import socket
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
 
 FORMAT = 1  # bumped when the stored arrays change meaning
+STALE_S = 86400.0  # a temporary file of another host older than this is a killed job's
+_WRITER = f"{os.getpid()}@{socket.gethostname().replace('.', '-')}"
 
 
 class TileCache:
@@ -38,6 +44,7 @@ class TileCache:
         self.folder = Path(root) / hashlib.sha256(text.encode()).hexdigest()[:16]
         self.n_read = self.n_written = 0
         self.folder.mkdir(parents=True, exist_ok=True)
+        remove_stale_temporaries(self.folder)
         if not (self.folder / "identity.json").exists():
             self._write(self.folder / "identity.json", lambda f: f.write(text.encode()))
 
@@ -66,7 +73,7 @@ class TileCache:
         tmp = None
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{_WRITER}.", suffix=".part", dir=path.parent)
             with os.fdopen(fd, "wb") as f:
                 write(f)
             os.replace(tmp, path)
@@ -76,3 +83,29 @@ class TileCache:
                 with contextlib.suppress(OSError):
                     os.unlink(tmp)
             return False
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process: alive
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: Path) -> None:
+    """Remove the temporary files killed writers left under `folder`: this host's whose
+    process is gone, and other hosts' older than STALE_S."""
+    host = _WRITER.partition("@")[2]
+    for tmp in folder.rglob(".*.part"):
+        writer = tmp.name.rsplit(".", 3)[1] if tmp.name.count(".") >= 4 else ""
+        pid, _, writer_host = writer.partition("@")
+        with contextlib.suppress(OSError):
+            if writer_host == host and pid.isdigit():
+                stale = not _process_alive(int(pid))
+            else:
+                stale = time.time() - tmp.stat().st_mtime > STALE_S
+            if stale:
+                tmp.unlink()
