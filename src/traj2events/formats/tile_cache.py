@@ -97,15 +97,12 @@ def _process_alive(pid: int) -> bool:
 
 def remove_stale_temporaries(folder: Path) -> None:
     """Remove the temporary files killed writers left under `folder`: this host's whose
-    process is gone, and other hosts' older than STALE_S."""
+    process is gone, and any older than STALE_S."""
     host = _WRITER.partition("@")[2]
     for tmp in folder.rglob(".*.part"):
         writer = tmp.name.rsplit(".", 3)[1] if tmp.name.count(".") >= 4 else ""
         pid, _, writer_host = writer.partition("@")
         with contextlib.suppress(OSError):
-            if writer_host == host and pid.isdigit():
-                stale = not _process_alive(int(pid))
-            else:
-                stale = time.time() - tmp.stat().st_mtime > STALE_S
-            if stale:
+            old = time.time() - tmp.stat().st_mtime > STALE_S  # whoever wrote it (a reused pid too)
+            if old or (writer_host == host and pid.isdigit() and not _process_alive(int(pid))):
                 tmp.unlink()
