@@ -20,9 +20,14 @@ def log_intensity_8bit(frame_dn: np.ndarray, dtype=np.float64) -> np.ndarray:
     return np.where(i <= KNEE_DN, i * slope, np.log(np.maximum(i, KNEE_DN)))
 
 
+def display_dn_per_radiance(white: float) -> float:
+    """The display scale's DN per unit radiance, 255 / white (`radiance_to_dn`'s factor)."""
+    return 255.0 / white
+
+
 def radiance_to_dn(radiance: np.ndarray, white: float, dtype=np.float64) -> np.ndarray:
     """Linear radiance -> linear 8-bit-equivalent DN, 255 L / white, neither clipped nor
     quantised: the HDR input path. The model's DN-based constants (the 20 DN lin-log knee,
     the bandwidth and noise laws) then keep their meaning, with `white` the radiance at
     full scale (the renderer's display white)."""
-    return np.asarray(radiance, dtype=dtype) * (255.0 / white)
+    return np.asarray(radiance, dtype=dtype) * display_dn_per_radiance(white)

@@ -370,12 +370,12 @@ class TerrainRenderer:
         for key in keys:
             self._last_used[key] = self._frame_count
         self._evict()
-        dists, radii = self.tiles.distances(keys, pose.position)
+        offsets, radii = self.tiles.offsets(keys, pose.position)
+        dists = np.linalg.norm(offsets, axis=1)
         order = sorted(range(len(keys)), key=lambda a: (dists[a], keys[a]))
         instances = np.empty((len(keys), 4), np.float32)
-        for row, a in enumerate(order):
-            instances[row, :3] = self.tiles.tile(keys[a]).centre - np.asarray(pose.position, float)
-            instances[row, 3] = slots[a]
+        instances[:, :3] = offsets[order]
+        instances[:, 3] = np.asarray(slots, np.float32)[order]
         near, far = depth_range(dists, radii, self.camera) if keys else (1.0, 10.0)
         uniforms = {
             **self._uniforms,

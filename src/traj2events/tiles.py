@@ -219,11 +219,11 @@ class TileSet:
         root = self.tile((0, 0, 0))
         return float(max(np.max(np.abs(root.heights_m)) * 2.0, 100.0))
 
-    def distances(self, keys: list[TileKey], position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(distance from `position` to each tile's centre, each tile's bounding radius), m."""
+    def offsets(self, keys: list[TileKey], position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(each tile's centre minus `position` (n, 3), each tile's bounding radius (n,)), m."""
         centres = np.array([self.tile(k).centre for k in keys]).reshape(-1, 3)
         radii = np.array([self.tile(k).radius_m for k in keys])
-        return np.linalg.norm(centres - np.asarray(position, float), axis=1), radii
+        return centres - np.asarray(position, float), radii
 
 
 def depth_range(dists: np.ndarray, radii: np.ndarray, camera: Camera) -> tuple[float, float]:

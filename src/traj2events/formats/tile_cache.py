@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 FORMAT = 1  # bumped when the stored arrays change meaning
-STALE_S = 86400.0  # a temporary file of another host older than this is a killed job's
+STALE_S = 86400.0  # a temporary file older than this is a killed job's, whoever wrote it
 _WRITER = f"{os.getpid()}@{socket.gethostname().replace('.', '-')}"
 
 
@@ -97,7 +97,9 @@ def _process_alive(pid: int) -> bool:
 
 def remove_stale_temporaries(folder: Path) -> None:
     """Remove the temporary files killed writers left under `folder`: this host's whose
-    process is gone, and any older than STALE_S."""
+    process is gone, and any older than STALE_S. (Not formats.atomic's helper of the same
+    name, which removes every temporary of a path: right for an output only one job
+    writes, wrong here, where jobs write the same tiles at the same time.)"""
     host = _WRITER.partition("@")[2]
     for tmp in folder.rglob(".*.part"):
         writer = tmp.name.rsplit(".", 3)[1] if tmp.name.count(".") >= 4 else ""

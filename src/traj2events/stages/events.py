@@ -24,6 +24,7 @@ from ..formats.events import EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
+from ..log_response import display_dn_per_radiance
 from ..progress import log
 from ..sensor import SensorParams, dn_per_radiance
 from ..state import BODY_RATES
@@ -87,7 +88,7 @@ def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorPar
         if not white > 0:
             frames.close()
             raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
-        scale = 255.0 / white  # radiance_to_dn's factor
+        scale = display_dn_per_radiance(white)
         kind = f"linear radiance (white {white:g} W m^-2 sr^-1)"
 
     def radiance():  # float32 as stored: the emulator scales it per pixel (no float64 copy)
