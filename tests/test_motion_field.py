@@ -8,6 +8,7 @@ from traj2events.camera import Camera, camera_motion, camera_pose
 from traj2events.motion_field import (
     MOON_RADIUS_M,
     OUT_OF_VIEW,
+    SKY,
     VISIBLE,
     inverse_depth_from_depth,
     inverse_depth_plane,
@@ -18,6 +19,7 @@ from traj2events.motion_field import (
     site_vertical,
     sphere_displacement,
     sphere_flow,
+    sphere_motion,
 )
 
 R = MOON_RADIUS_M
@@ -45,16 +47,28 @@ def random_state(rng, altitude):
     return state_from(position, rotation, rng.uniform(-80, 80, 3), rng.uniform(-0.2, 0.2, 3))
 
 
+def numpy_sphere_flow(cam, state):
+    return sphere_flow(cam, state, dtype=np.float64)
+
+
+def compiled_sphere_flow(cam, state):
+    """The motion-field stage's one-pass kernel (flow, displacement, status together)."""
+    flow, _, status = sphere_motion(cam, state, rigid_motion(state, 0.01), dtype=np.float64)
+    return flow, status != SKY
+
+
+@pytest.mark.parametrize("flow_of", [numpy_sphere_flow, compiled_sphere_flow])
 @pytest.mark.parametrize("seed, mount_height_m", [(0, 3.0), (1, 0.0), (2, 30.0), (3, 3.0), (4, 3.0)])
-def test_analytic_field_matches_finite_differences(seed, mount_height_m):
+def test_analytic_field_matches_finite_differences(seed, mount_height_m, flow_of):
     """The field of a camera mounted on the rotating body (its velocity gains omega x r)
-    against finite differences of a fixed point projected by the moved camera."""
+    against finite differences of a fixed point projected by the moved camera, for the
+    numpy field and the compiled one each (not only against each other)."""
     cam = Camera(64, 48, 45.0, mount_height_m)
     rng = np.random.default_rng(seed)
     state = random_state(rng, altitude=rng.uniform(40, 4000))
     pose = cam.pose(state)
     f = cam.focal_px
-    flow, terrain = sphere_flow(cam, state, dtype=np.float64)
+    flow, terrain = flow_of(cam, state)
     rows, cols = np.nonzero(terrain)
     pick = rng.choice(len(rows), size=20, replace=False)
     normal, height = local_vertical(pose.position, pose.rotation, R)
@@ -258,6 +272,38 @@ def test_depth_map_field_equals_the_analytic_field_for_the_same_surface():
     np.testing.assert_allclose(flow[..., 0], u, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(flow[..., 1], v, rtol=1e-12, atol=1e-12)
     np.testing.assert_array_equal(terrain, h > 0)
+    # The stage's compiled pass: the same field, its sky where the depth map has none.
+    from traj2events.motion_field import depth_motion
+
+    compiled, _, status = depth_motion(CAM, state, rigid_motion(state, 0.01), depth, dtype=np.float64)
+    np.testing.assert_allclose(compiled[..., 0], u, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(compiled[..., 1], v, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(status != SKY, h > 0)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_one_pass_kernel_gives_the_numpy_field_and_the_displacement_bit_for_bit(seed):
+    """sphere_motion and depth_motion: the float64 numpy field and displacement, rounded
+    once to the stored float32 (the stage used to compute the flow in float32 arithmetic)."""
+    from traj2events.motion_field import depth_displacement, depth_flow, depth_motion
+
+    rng = np.random.default_rng(20 + seed)
+    cam = Camera(96, 64, 50.0)
+    state = random_state(rng, altitude=rng.uniform(5, 3000))
+    later = rigid_motion(state, 0.02)
+    flow, disp, status = sphere_motion(cam, state, later)
+    disp64, status64 = sphere_displacement(cam, state, later)
+    assert flow.dtype == disp.dtype == np.float32
+    np.testing.assert_array_equal(flow, sphere_flow(cam, state, dtype=np.float64)[0].astype(np.float32))
+    np.testing.assert_array_equal(disp, disp64.astype(np.float32))
+    np.testing.assert_array_equal(status, status64)
+    depth = rng.uniform(50.0, 500.0, (cam.height, cam.width)).astype(np.float32)
+    depth[:5] = 0.0  # sky
+    flow, disp, status = depth_motion(cam, state, later, depth, depth[::-1])
+    np.testing.assert_array_equal(flow, depth_flow(cam, state, depth.astype(np.float64))[0].astype(np.float32))
+    disp64, status64 = depth_displacement(cam, state, later, depth, depth[::-1])
+    np.testing.assert_array_equal(disp, disp64.astype(np.float32))
+    np.testing.assert_array_equal(status, status64)
 
 
 def test_huge_time_step_keeps_valid_displacements_finite():

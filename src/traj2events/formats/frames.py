@@ -18,6 +18,8 @@ import numpy as np
 from .atomic import atomic_output, ensure_free_space
 from .hdf5 import (
     Attributes,
+    ChunkReader,
+    ChunkWriter,
     FileFormatError,
     blosc,
     create,
@@ -62,6 +64,7 @@ class FramesWriter:
             )
             for name in ("radiance", "depth_m")
         }
+        self._writers = {name: ChunkWriter(dataset) for name, dataset in self._sets.items()}
         self._attrs = attrs
 
     def append(self, t_s: float, frame_index: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
@@ -70,7 +73,7 @@ class FramesWriter:
         with write_errors_named(self.path):
             for name, image in (("radiance", radiance), ("depth_m", depth_m)):
                 self._sets[name].resize(i + 1, axis=0)
-                self._sets[name][i] = round_mantissa(image)
+                self._writers[name][i] = round_mantissa(image)
         self._t.append(float(t_s))
         self._frame_index.append(int(frame_index))
 
@@ -111,6 +114,9 @@ class FramesFile:
         if len(self.shape) != 3 or len(self.t) != self.shape[0]:
             self._file.close()
             raise FileFormatError(f"{self.path}: radiance has shape {self.shape}, expected ({len(self.t)}, H, W)")
+        # Frames are decompressed straight into their arrays (formats.hdf5.ChunkReader).
+        self._radiance = ChunkReader(self._file["radiance"])
+        self._depth = ChunkReader(self._file["depth_m"]) if "depth_m" in self._file else None
         self.frame_index = self._file["frame_index"][()] if "frame_index" in self._file else np.arange(len(self.t))
         self._pose_rows = np.flatnonzero(self.frame_index >= 0)
         if not np.array_equal(self.frame_index[self._pose_rows], np.arange(len(self._pose_rows))):
@@ -126,10 +132,12 @@ class FramesFile:
         return int(self._pose_rows[k])
 
     def radiance(self, k: int) -> np.ndarray:
-        return self._file["radiance"][k]
+        return self._radiance[k]
 
     def depth_m(self, k: int) -> np.ndarray:
-        return self._file["depth_m"][k]
+        if self._depth is None:
+            raise FileFormatError(f"{self.path}: no dataset 'depth_m' (expected the depth of every frame)")
+        return self._depth[k]
 
     def depth_at(self, i: int, j: int) -> np.ndarray:
         """The depth of pixel (row i, column j) in every frame (n,)."""
@@ -138,7 +146,7 @@ class FramesFile:
     def radiance_chunks(self, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames."""
         for start in range(0, self.shape[0], chunk):
-            yield self._file["radiance"][start : start + chunk], self.t[start : start + chunk]
+            yield self._radiance[start : start + chunk], self.t[start : start + chunk]
 
     def close(self) -> None:
         self._file.close()

@@ -12,19 +12,18 @@ import numpy as np
 from .. import __version__
 from ..camera import Camera
 from ..formats.atomic import atomic_directory
-from ..formats.flow import flo_bytes, motion_field_file
+from ..formats.flow import motion_field_file, write_flo
 from ..formats.frames import FramesFile
 from ..formats.hdf5 import set_attrs, write_dataset
 from ..formats.trajectory import read_trajectory
 from ..motion_field import (
     OCCLUDED,
     OUT_OF_VIEW,
+    SKY,
     STATUS_NAMES,
-    depth_displacement,
-    depth_flow,
+    depth_motion,
     field_difference,
-    sphere_displacement,
-    sphere_flow,
+    sphere_motion,
 )
 from ..progress import log
 
@@ -98,25 +97,26 @@ def motion_field(
         layout = field_layout(h, w, rendered is not None)
         with (
             atomic_directory(flo_dir) as tmp_dir,
-            motion_field_file(output, tr.t[picked], picked, layout) as out,
+            motion_field_file(output, tr.t[picked], picked, layout) as (out, fields),
         ):
             for i, k in enumerate(picked):
-                flow, on_sphere = sphere_flow(camera, tr.state[k], moon_radius_m, np.float32)
-                disp, status = sphere_displacement(camera, tr.state[k], tr.state[k + 1], moon_radius_m)
-                disp = disp.astype(np.float32)  # as stored; numpy casts faster than HDF5 does
-                out["flow_sphere"][i], out["displacement_sphere"][i], out["status_sphere"][i] = flow, disp, status
-                out["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
+                flow, disp, status = sphere_motion(camera, tr.state[k], tr.state[k + 1], moon_radius_m, np.float32)
+                fields["flow_sphere"][i], fields["displacement_sphere"][i] = flow, disp
+                fields["status_sphere"][i] = status
+                fields["valid"][i] = status <= OUT_OF_VIEW  # on the sphere, in front of k+1, this side of the limb
                 # The folder is atomic as a whole: its files need no temporary of their own.
-                (Path(tmp_dir) / f"{k:06d}.flo").write_bytes(flo_bytes(disp))
+                write_flo(Path(tmp_dir) / f"{k:06d}.flo", disp, atomic=False)
                 if rendered is not None:
                     depth = next_depth[1] if next_depth[0] == k else rendered.depth_m(rendered.row_of_pose(k))
                     next_depth = (k + 1, rendered.depth_m(rendered.row_of_pose(k + 1)))
-                    terrain_flow, seen = depth_flow(camera, tr.state[k], depth)
-                    disp, status = depth_displacement(camera, tr.state[k], tr.state[k + 1], depth, next_depth[1])
-                    out["flow_terrain"][i], out["displacement_terrain"][i] = terrain_flow, disp.astype(np.float32)
-                    out["status_terrain"][i] = status
-                    out["valid_terrain"][i] = status <= OCCLUDED  # terrain, in front of camera k+1
-                    offset_mean[i], offset_rms[i] = field_difference(flow, terrain_flow, seen & on_sphere)
+                    terrain_flow, disp, terrain_status = depth_motion(
+                        camera, tr.state[k], tr.state[k + 1], depth, next_depth[1], dtype=np.float32
+                    )
+                    fields["flow_terrain"][i], fields["displacement_terrain"][i] = terrain_flow, disp
+                    fields["status_terrain"][i] = terrain_status
+                    fields["valid_terrain"][i] = terrain_status <= OCCLUDED  # terrain, in front of camera k+1
+                    both = (status != SKY) & (terrain_status != SKY)  # sphere and terrain under the pixel
+                    offset_mean[i], offset_rms[i] = field_difference(flow, terrain_flow, both)
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
             if rendered is not None:

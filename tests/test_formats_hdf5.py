@@ -1,0 +1,71 @@
+"""formats.hdf5: chunks compressed outside HDF5 read back through HDF5's own Blosc filter."""
+
+import h5py
+import hdf5plugin  # noqa: F401  (the Blosc filter the reader needs)
+import numpy as np
+import pytest
+
+from traj2events.formats.hdf5 import ChunkReader, ChunkWriter, FileFormatError, blosc, create
+
+
+@pytest.mark.parametrize("codec, bitshuffle", [("lz4", True), ("lz4", False), ("zstd", True)])
+@pytest.mark.parametrize("dtype", [np.float32, np.uint8, bool])
+def test_chunk_writer_reads_back_through_the_hdf5_filter(tmp_path, codec, bitshuffle, dtype):
+    rng = np.random.default_rng(0)
+    items = [rng.normal(scale=50, size=(33, 17, 2)).astype(dtype) for _ in range(3)]
+    with create(tmp_path / "a.h5") as f:
+        dataset = f.create_dataset(
+            "x", shape=(3, 33, 17, 2), dtype=dtype, chunks=(1, 33, 17, 2), **blosc(codec, 5, bitshuffle)
+        )
+        writer = ChunkWriter(dataset)
+        for i in (2, 0, 1):  # any order
+            writer[i] = items[i]
+    with h5py.File(tmp_path / "a.h5") as f:
+        np.testing.assert_array_equal(f["x"][()], np.stack(items))
+        assert f["x"].id.read_direct_chunk((1, 0, 0, 0))[1][:1] == b"\x02"  # a Blosc frame, not raw bytes
+
+
+def test_chunk_writer_refuses_what_it_cannot_write(tmp_path):
+    with create(tmp_path / "a.h5") as f:
+        plain = f.create_dataset("plain", shape=(2, 4), dtype=np.float32, chunks=(1, 4))
+        with pytest.raises(ValueError, match="plain: expected one Blosc filter"):
+            ChunkWriter(plain)
+        several = f.create_dataset("several", shape=(2, 4), dtype=np.float32, chunks=(2, 4), **blosc())
+        with pytest.raises(ValueError, match="one item per chunk"):
+            ChunkWriter(several)
+        writer = ChunkWriter(f.create_dataset("x", shape=(2, 4), dtype=np.float32, chunks=(1, 4), **blosc()))
+        with pytest.raises(ValueError, match=r"x: expected an item of shape \(4,\), got \(5,\)"):
+            writer[0] = np.zeros(5)
+
+
+def test_chunk_reader_reads_items_and_slices_as_h5py_does(tmp_path):
+    rng = np.random.default_rng(1)
+    images = rng.normal(size=(5, 9, 13)).astype(np.float32)
+    with create(tmp_path / "a.h5") as f:
+        f.create_dataset("blosc", data=images, chunks=(1, 9, 13), **blosc("lz4", 5))
+        f.create_dataset("gzip", data=images, chunks=(1, 9, 13), compression="gzip")
+    with h5py.File(tmp_path / "a.h5") as f:
+        for name in ("blosc", "gzip"):  # the second through h5py
+            reader = ChunkReader(f[name])
+            np.testing.assert_array_equal(reader[3], images[3])
+            np.testing.assert_array_equal(reader[-1], images[-1])
+            np.testing.assert_array_equal(reader[1:4], images[1:4])
+            np.testing.assert_array_equal(reader[3:10], images[3:])
+            with pytest.raises(IndexError):
+                reader[5]
+
+
+def test_chunk_reader_does_not_trust_a_chunk_of_the_wrong_size(tmp_path):
+    """A chunk whose Blosc header claims another size (a damaged or foreign file) is an
+    error naming the file and the item, not decompressed past the end of the array."""
+    import blosc as codec
+
+    with create(tmp_path / "a.h5") as f:
+        dataset = f.create_dataset("x", shape=(2, 8), dtype=np.float32, chunks=(1, 8), **blosc("lz4", 5))
+        ChunkWriter(dataset)[0] = np.arange(8, dtype=np.float32)
+        dataset.id.write_direct_chunk((1, 0), codec.compress(np.zeros(64, np.float32), typesize=4))
+    with h5py.File(tmp_path / "a.h5") as f:
+        reader = ChunkReader(f["x"])
+        np.testing.assert_array_equal(reader[0], np.arange(8))
+        with pytest.raises(FileFormatError, match=r"a.h5: /x item 1: its chunk holds 256 bytes, expected 32"):
+            reader[1]
