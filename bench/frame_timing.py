@@ -3,6 +3,16 @@
   python bench/frame_timing.py results/braking/0000/trajectory.h5 results/descent/0000/trajectory.h5 \\
       [--size 512] [--reference-fps 2000] [--fps 50]
   python bench/frame_timing.py --whole TRAJECTORY.h5 ... [--size 128]
+  python bench/frame_timing.py --flight 12 TRAJECTORY.h5 ... [--size 256] [--window 0.2]
+
+--flight N: N short windows (--window s each) spread evenly over each whole flight instead
+of two 1 s clips, each measured as a clip is (below), pooled per trajectory and over all.
+Windows sample the flight uniformly in time, so frames summed over them estimate the
+flight's frame counts (fixed and adaptive alike) and their pooled events weigh each phase
+of the flight by its events: the comparison at equal frames that clips within one phase
+cannot make (there a flight's motion hardly changes, and adaptive timing spends frames as
+a fixed rate would). For each adaptive bound it also prints the fixed rate's error at the
+same frame count, interpolated log-log between the fixed rates around it.
 
 --whole: the render stage itself (`stages.render.render_trajectory`) over whole
 trajectories with fixed timing and with each adaptive bound: frames rendered, seconds,
@@ -60,6 +70,8 @@ ADAPTIVE = {
 
 # --whole renders every adaptive frame of whole flights: the bounds that stay affordable.
 WHOLE = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "adaptive, 1 px")
+# --flight: the bounds whose frame counts fall among the fixed rates' (50-400 fps).
+FLIGHT = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1")
 
 
 class Stream:
@@ -106,7 +118,9 @@ def matched_timing_errors_us(events: np.ndarray, reference: np.ndarray, width: i
     return np.abs(ta[ia] - tb[ib]).astype(float)
 
 
-def run_clip(renderer, camera, states, white, t0: float, t1: float, ref_fps: int, fps: int) -> list[dict]:
+def run_clip(
+    renderer, camera, states, white, t0: float, t1: float, ref_fps: int, fps: int, adaptive=tuple(ADAPTIVE)
+) -> list[dict]:
     w, h = camera.width, camera.height
 
     def render(t):
@@ -140,7 +154,7 @@ def run_clip(renderer, camera, states, white, t0: float, t1: float, ref_fps: int
     ]
     fixed_times = t0 + np.arange(int(round((t1 - t0) * fps)) + 1) / fps
     tf = float(states.t_nodes[-1])
-    for name, timing in ADAPTIVE.items():
+    for name, timing in ((k, v) for k, v in ADAPTIVE.items() if k in adaptive):
         # The render stage's own schedule (stages.render.render_between), timed with its prediction.
         stream, render_adaptive_s = Stream(w, h), 0.0
         for k, t in enumerate(fixed_times):
@@ -219,6 +233,8 @@ def main() -> None:
     parser.add_argument("--fps", type=int, default=50, help="the fixed rate adaptive timing starts from")
     parser.add_argument("--duration", type=float, default=1.0, help="clip length, s")
     parser.add_argument("--whole", action="store_true", help="whole trajectories through the render stage")
+    parser.add_argument("--flight", type=int, metavar="N", help="N windows spread over each whole flight")
+    parser.add_argument("--window", type=float, default=0.2, help="--flight: window length, s")
     args = parser.parse_args()
     if args.whole:
         whole_trajectories(args.trajectories, args.size, args.fps)
@@ -235,6 +251,7 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|---|---|")
     pooled: dict[str, list[dict]] = {}
+    adaptive = FLIGHT if args.flight else tuple(ADAPTIVE)
     for path in args.trajectories:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
@@ -243,14 +260,20 @@ def main() -> None:
         camera, tiles, sun, reflectance = settings.build()
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
-        clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
+        if args.flight:
+            clips = flight_windows(tf, args.flight, args.window, args.fps)
+        else:
+            clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
+        flight: dict[str, list[dict]] = {}
         with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
             for clip, (t0, t1) in clips.items():
                 rows = run_clip(
-                    renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps
-                )
+                    renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps,
+                    adaptive,
+                )  # fmt: skip
                 for r in rows:
                     pooled.setdefault(r["timing"], []).append(r)
+                    flight.setdefault(r["timing"], []).append(r)
                     s = r["stream"]
                     print(
                         f"| {scenario} {clip} | {r['timing']} | {s.frames} | {r['render_s']:.1f} | "
@@ -258,21 +281,55 @@ def main() -> None:
                         f"{r['p90_us']:.0f} | {s.worst[0]:.2f} ({s.worst[1]:.2f}) |",
                         flush=True,
                     )
-    print_pooled(pooled)
+        if args.flight:
+            print_pooled(flight, f"{scenario} {int(tr.attrs['id']):04d}, {len(clips)} windows", windows=True)
+    print_pooled(pooled, "all windows" if args.flight else "all clips", windows=bool(args.flight))
 
 
-def print_pooled(pooled: dict[str, list[dict]]) -> None:
-    """All clips together: frames rendered over all of them, and every matched event's
-    timing error in one distribution (fast and slow clips weighted by their events)."""
-    print("\n| all clips | frames | x fixed 100 fps | events vs reference | median abs dt, us | p90 abs dt, us |")
-    print("|---|---|---|---|---|---|")
-    base = sum(r["stream"].frames for r in pooled["fixed 100 fps"])
+def flight_windows(tf: float, n: int, window_s: float, fps: int) -> dict[str, tuple[float, float]]:
+    """n windows of window_s, centred in n equal stretches of [0, tf], starting on a frame
+    of the fixed rate (every variant renders it) and ending by touchdown."""
+    starts = (np.arange(n) + 0.5) * tf / n - window_s / 2
+    starts = np.clip(np.round(starts * fps) / fps, 0.0, np.floor((tf - window_s) * fps) / fps)
+    return {f"t {t0:.2f} s": (float(t0), float(t0) + window_s) for t0 in starts}
+
+
+def print_pooled(pooled: dict[str, list[dict]], title: str = "all clips", windows: bool = False) -> None:
+    """Clips or windows together: frames rendered over all of them (windows: less each
+    window's closing frame, so that windows count a flight's frames per second
+    exactly), and every matched
+    event's timing error in one distribution (fast and slow stretches weighted by their
+    events). For adaptive rows, the fixed rates' median and p90 at the same frame count,
+    interpolated log-log between the fixed rates around it."""
+    print(f"\n| {title} | frames | x fixed 100 fps | events vs reference | median abs dt, us | p90 abs dt, us "
+          "| fixed at the same frames: median, p90 us |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    closing = int(windows)
+    base = sum(r["stream"].frames - closing for r in pooled["fixed 100 fps"])
+    summary = {}
     for name, rows in pooled.items():
-        frames = sum(r["stream"].frames for r in rows)
+        frames = sum(r["stream"].frames - closing for r in rows)
         dt = np.concatenate([r["dt_us"] for r in rows])
         events = sum(r["events"] for r in rows) / sum(r["n_reference"] for r in rows) - 1
-        print(f"| {name} | {frames} | {frames / base:.2f} | {events:+.1%} | {np.median(dt):.0f} | "
-              f"{np.percentile(dt, 90):.0f} |")  # fmt: skip
+        summary[name] = (frames, np.median(dt), np.percentile(dt, 90))
+        same = ""
+        if name.startswith("adaptive"):
+            fixed = sorted(v for k, v in summary.items() if k.startswith("fixed"))
+            same = ", ".join(f"{x:.0f}" for x in interpolate_fixed(fixed, frames)) if fixed else ""
+        print(f"| {name} | {frames} | {frames / base:.2f} | {events:+.1%} | {summary[name][1]:.0f} | "
+              f"{summary[name][2]:.0f} | {same} |")  # fmt: skip
+
+
+def interpolate_fixed(fixed: list[tuple[int, float, float]], frames: int) -> tuple[float, float]:
+    """(median, p90) of the fixed rates at `frames`, log-log between the two rates around it
+    (NaN outside their range); fixed: (frames, median, p90) sorted by frames."""
+    n = np.log([f for f, _, _ in fixed])
+    out = []
+    for column in (1, 2):
+        y = np.log(np.maximum([row[column] for row in fixed], 1e-3))
+        inside = n[0] <= np.log(frames) <= n[-1]
+        out.append(float(np.exp(np.interp(np.log(frames), n, y))) if inside else float("nan"))
+    return out[0], out[1]
 
 
 if __name__ == "__main__":

@@ -35,10 +35,13 @@ def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
     more than 12 bits at any brightness, and the dropped low bits compress to nothing."""
     a = np.ascontiguousarray(x, dtype=np.float32)
     drop = 24 - bits
-    u = a.view(np.uint32)
-    rounded = (u + np.uint32(1 << (drop - 1))) & np.uint32((0xFFFFFFFF << drop) & 0xFFFFFFFF)
-    finite = np.isfinite(a)
-    return np.where(finite, rounded.view(np.float32), a)
+    rounded = a.view(np.uint32) + np.uint32(1 << (drop - 1))  # the one full-size temporary: in place after
+    rounded &= np.uint32((0xFFFFFFFF << drop) & 0xFFFFFFFF)
+    out = rounded.view(np.float32)
+    special = ~np.isfinite(a)
+    if special.any():
+        out[special] = a[special]  # inf and NaN as they were
+    return out
 
 
 class FramesWriter:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import json
+import math
 import os
 from pathlib import Path
 from typing import Iterator
@@ -103,7 +104,7 @@ def write_errors_named(path: str | os.PathLike) -> Iterator[None]:
 
 
 # HDF5's Blosc filter as hdf5plugin registers it: its parameters (cd_values) 4, 5 and 6 are
-# the level, the shuffle (0 none, 1 byte, 2 bit: python-blosc's codes) and the codec.
+# the level, the shuffle (0 none, 1 byte, 2 bit: c-blosc's codes) and the codec.
 BLOSC_FILTER = 32001
 _BLOSC_CODECS = ("blosclz", "lz4", "lz4hc", "snappy", "zlib", "zstd")
 
@@ -119,29 +120,71 @@ def _blosc_parameters(dataset: h5py.Dataset) -> tuple[int, int, str] | None:
     return level, shuffle, _BLOSC_CODECS[codec]
 
 
-def _blosc_codec():
-    import blosc as codec  # python-blosc: only the writers and fast readers need it
+class _BloscLibrary:
+    """c-blosc's one-shot calls from the very library hdf5plugin's Blosc filter is built
+    with (its plugin exports them), through ctypes: chunks compressed here are byte for
+    byte what the filter would write, and nothing else needs installing. One thread, as
+    the filter uses: a job's cores are what its rule asks for."""
 
-    codec.set_nthreads(1)  # a job's cores are what its rule asks for; HDF5's filter uses one
-    return codec
+    OVERHEAD = 16  # BLOSC_MAX_OVERHEAD: a chunk's header; incompressible data is copied after it
+
+    def __init__(self):
+        import ctypes
+
+        import hdf5plugin
+
+        lib = ctypes.CDLL(os.path.join(hdf5plugin.PLUGIN_PATH, "libh5blosc.so"))
+        size_t, ptr = ctypes.c_size_t, ctypes.c_void_p
+        lib.blosc_compress_ctx.argtypes = [ctypes.c_int, ctypes.c_int, size_t, size_t, ptr, ptr, size_t,
+                                           ctypes.c_char_p, size_t, ctypes.c_int]  # fmt: skip
+        lib.blosc_decompress_ctx.argtypes = [ptr, ptr, size_t, ctypes.c_int]
+        lib.blosc_cbuffer_sizes.argtypes = [ptr, ctypes.POINTER(size_t), ctypes.POINTER(size_t), ctypes.POINTER(size_t)]
+        self._lib, self._ctypes = lib, ctypes
+
+    def compress(self, data: np.ndarray, level: int, shuffle: int, codec: str, out: np.ndarray) -> memoryview:
+        """`data` (C-contiguous) compressed into `out` (uint8, at least data.nbytes + OVERHEAD)."""
+        n = self._lib.blosc_compress_ctx(
+            level, shuffle, min(data.dtype.itemsize, 255), data.nbytes, data.ctypes.data, out.ctypes.data, out.nbytes,
+            codec.encode(), 0, 1,
+        )  # fmt: skip
+        if n <= 0:
+            raise RuntimeError(f"blosc: compressing {data.nbytes} bytes with {codec} failed ({n})")
+        return memoryview(out[:n])
+
+    def decompressed_size(self, chunk: bytes) -> int:
+        if len(chunk) < self.OVERHEAD:
+            return -1
+        sizes = [self._ctypes.c_size_t() for _ in range(3)]
+        self._lib.blosc_cbuffer_sizes(chunk, *(self._ctypes.byref(x) for x in sizes))
+        return sizes[0].value
+
+    def decompress_into(self, chunk: bytes, out: np.ndarray) -> int:
+        """Bytes written into `out` (C-contiguous), never more than it holds; < 0: an error."""
+        return self._lib.blosc_decompress_ctx(chunk, out.ctypes.data, out.nbytes, 1)
+
+
+@functools.cache
+def _blosc_codec() -> _BloscLibrary:
+    return _BloscLibrary()
 
 
 class ChunkWriter:
     """Writes item i of a dataset chunked one item per chunk (`chunks=(1, *shape)`) with
-    `blosc(...)`: the chunk is compressed here by python-blosc with the dataset's own
-    filter parameters and handed to HDF5 whole (`write_direct_chunk`). HDF5's filter
-    pipeline copies each chunk on its way; skipping it writes a 1024^2 motion field's
-    datasets in ~36 ms instead of ~50 (docs/benchmarks.md). Readers see the same data:
-    HDF5's Blosc filter decompresses it as its own (the bytes may differ from that
-    filter's where the two builds of LZ4 differ; each is deterministic)."""
+    `blosc(...)`: the chunk is compressed here, by the Blosc filter's own library with the
+    dataset's own parameters, and handed to HDF5 whole (`write_direct_chunk`). HDF5's
+    filter pipeline copies each chunk on its way; skipping it writes a 1024^2 motion
+    field's datasets in ~36 ms instead of ~50 (docs/benchmarks.md). The file is the one
+    the filter would have written."""
 
     def __init__(self, dataset: h5py.Dataset):
         parameters = _blosc_parameters(dataset)
         if parameters is None:
             raise ValueError(f"{dataset.name}: expected one Blosc filter and one item per chunk")
-        level, shuffle, codec = parameters
-        self._compress = functools.partial(_blosc_codec().compress, clevel=level, shuffle=shuffle, cname=codec)
-        self.dataset = dataset
+        self._parameters, self._codec, self.dataset = parameters, _blosc_codec(), dataset
+        # One output buffer, reused: a fresh one per chunk costs page faults (~1 ms per 4 MB).
+        self._buffer = np.empty(
+            dataset.dtype.itemsize * math.prod(dataset.shape[1:]) + _BloscLibrary.OVERHEAD, np.uint8
+        )
 
     def __setitem__(self, i: int, item: np.ndarray) -> None:
         data = np.ascontiguousarray(item, dtype=self.dataset.dtype)
@@ -149,13 +192,13 @@ class ChunkWriter:
             raise ValueError(
                 f"{self.dataset.name}: expected an item of shape {self.dataset.shape[1:]}, got {data.shape}"
             )
-        chunk = self._compress(data, typesize=data.dtype.itemsize)
+        chunk = self._codec.compress(data, *self._parameters, self._buffer)
         self.dataset.id.write_direct_chunk((i,) + (0,) * data.ndim, chunk)
 
 
 class ChunkReader:
     """Reads items of a dataset chunked one item per chunk with a Blosc filter by
-    decompressing each chunk here (`read_direct_chunk` + python-blosc) into the result,
+    decompressing each chunk here (`read_direct_chunk`, the filter's library) into the result,
     without HDF5's filter pipeline copies (a 1024^2 float32 image in ~1.8 ms instead of
     ~2.5); any other dataset is read through h5py."""
 
@@ -185,10 +228,9 @@ class ChunkReader:
         if mask != 0:  # HDF5 stored this chunk without its filter: let it read it
             out[...] = self.dataset[i]
             return
-        nbytes = self._codec.get_cbuffer_sizes(chunk)[0]
-        if nbytes != out.nbytes:  # never decompress past the end of `out`
+        nbytes = self._codec.decompressed_size(chunk)
+        if nbytes != out.nbytes or self._codec.decompress_into(chunk, out) != out.nbytes:
             raise FileFormatError(
                 f"{self.dataset.file.filename}: {self.dataset.name} item {i}: its chunk holds {nbytes} bytes, "
                 f"expected {out.nbytes}"
             )
-        self._codec.decompress_ptr(chunk, out.ctypes.data)
