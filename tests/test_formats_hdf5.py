@@ -51,7 +51,7 @@ def test_chunk_writer_refuses_what_it_cannot_write(tmp_path):
             writer[0] = np.zeros(5)
 
 
-def test_chunk_reader_reads_items_and_slices_as_h5py_does(tmp_path):
+def test_chunk_reader_reads_items_as_h5py_does(tmp_path):
     rng = np.random.default_rng(1)
     images = rng.normal(size=(5, 9, 13)).astype(np.float32)
     with create(tmp_path / "a.h5") as f:
@@ -62,8 +62,6 @@ def test_chunk_reader_reads_items_and_slices_as_h5py_does(tmp_path):
             reader = ChunkReader(f[name])
             np.testing.assert_array_equal(reader[3], images[3])
             np.testing.assert_array_equal(reader[-1], images[-1])
-            np.testing.assert_array_equal(reader[1:4], images[1:4])
-            np.testing.assert_array_equal(reader[3:10], images[3:])
             with pytest.raises(IndexError):
                 reader[5]
 

@@ -149,7 +149,7 @@ class FramesFile:
     def radiance_chunks(self, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames."""
         for start in range(0, self.shape[0], chunk):
-            yield self._radiance[start : start + chunk], self.t[start : start + chunk]
+            yield self._file["radiance"][start : start + chunk], self.t[start : start + chunk]
 
     def close(self) -> None:
         self._file.close()
