@@ -240,6 +240,7 @@ def main() -> None:
     parser.add_argument("--whole", action="store_true", help="whole trajectories through the render stage")
     parser.add_argument("--flight", type=int, metavar="N", help="N windows spread over each whole flight")
     parser.add_argument("--window", type=float, default=0.2, help="--flight: window length, s")
+    parser.add_argument("--adaptive", nargs="+", choices=list(ADAPTIVE), help="the adaptive variants to run")
     args = parser.parse_args()
     if args.whole:
         whole_trajectories(args.trajectories, args.size, args.fps)
@@ -256,7 +257,7 @@ def main() -> None:
     )
     print("|---|---|---|---|---|---|---|---|---|---|")
     pooled: dict[str, list[dict]] = {}
-    adaptive = FLIGHT if args.flight else CLIPS
+    adaptive = args.adaptive or (FLIGHT if args.flight else CLIPS)
     for path in args.trajectories:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])

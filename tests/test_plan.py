@@ -50,6 +50,12 @@ def test_adaptive_timing_plans_the_measured_extra_frames():
     adaptive = dataset_plan(resolve_config({**ONE, "render": {"timing": timing}}))
     # The default dataset's braking flight at 128^2 rendered 1.72x its camera frames at 0.5.
     assert adaptive.core_hours["render"] / fixed.core_hours["render"] == pytest.approx(1.72, rel=0.05)
+    # Windows over both flights at 256^2 rendered 3.28x the camera frames at 0.5, 1.90x at 1.
+    wide = {**ONE, "camera": {"width": 256, "height": 256}}
+    for bound, measured in ((0.5, 3.28), (1.0, 1.90)):
+        twice = dataset_plan(resolve_config({**wide, "render": {"timing": {**timing, "max_log_change": bound}}}))
+        ratio = twice.core_hours["render"] / dataset_plan(resolve_config(wide)).core_hours["render"]
+        assert ratio == pytest.approx(measured, rel=0.1)
     assert adaptive.disk_bytes["video.mkv"] == fixed.disk_bytes["video.mkv"]  # the video keeps the fixed rate
     capped = {**timing, "max_log_change": 0.001, "max_fps": 100.0}  # never past max_fps / fps (50)
     assert dataset_plan(resolve_config({**ONE, "render": {"timing": capped}})).core_hours["render"] == pytest.approx(
