@@ -82,3 +82,18 @@ def test_chunk_reader_does_not_trust_a_chunk_of_the_wrong_size(tmp_path):
         np.testing.assert_array_equal(reader[0], np.arange(8))
         with pytest.raises(FileFormatError, match=r"a.h5: /x item 1: its chunk holds 256 bytes, expected 32"):
             reader[1]
+
+
+def test_without_the_filter_library_hdf5_reads_and_writes_the_chunks(tmp_path, monkeypatch):
+    """Where hdf5plugin ships the Blosc filter under another name, the chunks go through
+    HDF5's own pipeline: the same data (and file) either way."""
+    from traj2events.formats import hdf5
+
+    monkeypatch.setattr(hdf5, "_blosc_codec", lambda: None)
+    items = np.arange(24, dtype=np.float32).reshape(2, 3, 4)
+    with create(tmp_path / "a.h5") as f:
+        dataset = f.create_dataset("x", shape=items.shape, dtype=np.float32, chunks=(1, 3, 4), **blosc("lz4", 5))
+        writer = ChunkWriter(dataset)
+        writer[0], writer[1] = items
+    with h5py.File(tmp_path / "a.h5") as f:
+        np.testing.assert_array_equal(ChunkReader(f["x"])[1], items[1])

@@ -128,12 +128,10 @@ class _BloscLibrary:
 
     OVERHEAD = 16  # BLOSC_MAX_OVERHEAD: a chunk's header; incompressible data is copied after it
 
-    def __init__(self):
+    def __init__(self, path: str):
         import ctypes
 
-        import hdf5plugin
-
-        lib = ctypes.CDLL(os.path.join(hdf5plugin.PLUGIN_PATH, "libh5blosc.so"))
+        lib = ctypes.CDLL(path)
         size_t, ptr = ctypes.c_size_t, ctypes.c_void_p
         lib.blosc_compress_ctx.argtypes = [ctypes.c_int, ctypes.c_int, size_t, size_t, ptr, ptr, size_t,
                                            ctypes.c_char_p, size_t, ctypes.c_int]  # fmt: skip
@@ -164,8 +162,16 @@ class _BloscLibrary:
 
 
 @functools.cache
-def _blosc_codec() -> _BloscLibrary:
-    return _BloscLibrary()
+def _blosc_codec() -> _BloscLibrary | None:
+    """The Blosc filter's library, or None where hdf5plugin ships it under another name
+    (then HDF5's own pipeline reads and writes the chunks: the same files, slower)."""
+    import hdf5plugin
+
+    found = sorted(Path(hdf5plugin.PLUGIN_PATH).glob("libh5blosc.*"))
+    try:
+        return _BloscLibrary(str(found[0])) if found else None
+    except (OSError, AttributeError):  # not loadable, or without c-blosc's calls
+        return None
 
 
 class ChunkWriter:
@@ -192,6 +198,9 @@ class ChunkWriter:
             raise ValueError(
                 f"{self.dataset.name}: expected an item of shape {self.dataset.shape[1:]}, got {data.shape}"
             )
+        if self._codec is None:
+            self.dataset[i] = data
+            return
         chunk = self._codec.compress(data, *self._parameters, self._buffer)
         self.dataset.id.write_direct_chunk((i,) + (0,) * data.ndim, chunk)
 
@@ -205,7 +214,7 @@ class ChunkReader:
 
     def __init__(self, dataset: h5py.Dataset):
         self.dataset = dataset
-        self._codec = _blosc_codec() if _blosc_parameters(dataset) is not None else None
+        self._codec = _blosc_codec() if _blosc_parameters(dataset) is not None else None  # None: h5py reads
 
     def __getitem__(self, i: int) -> np.ndarray:
         n = self.dataset.shape[0]
