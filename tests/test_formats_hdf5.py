@@ -12,7 +12,8 @@ from traj2events.formats.hdf5 import ChunkReader, ChunkWriter, FileFormatError, 
 @pytest.mark.parametrize("dtype", [np.float32, np.uint8, bool])
 def test_chunk_writer_reads_back_through_the_hdf5_filter(tmp_path, codec, bitshuffle, dtype):
     rng = np.random.default_rng(0)
-    items = [rng.normal(scale=50, size=(33, 17, 2)).astype(dtype) for _ in range(3)]
+    # Compressible (a few values), as the datasets it writes are: random bits would be left raw.
+    items = [rng.integers(0, 3, size=(33, 17, 2)).astype(dtype) for _ in range(3)]
     with create(tmp_path / "a.h5") as f:
         dataset = f.create_dataset(
             "x", shape=(3, 33, 17, 2), dtype=dtype, chunks=(1, 33, 17, 2), **blosc(codec, 5, bitshuffle)
@@ -26,9 +27,11 @@ def test_chunk_writer_reads_back_through_the_hdf5_filter(tmp_path, codec, bitshu
 
 
 def test_chunk_writer_writes_the_file_the_hdf5_filter_writes(tmp_path):
-    """Byte for byte: the chunks are compressed by the filter's own library."""
+    """Byte for byte: the chunks are compressed by the filter's own library, and a chunk
+    that does not shrink (random bits) is left raw, as the filter leaves it."""
     rng = np.random.default_rng(2)
     smooth = np.cumsum(rng.normal(size=(4, 64, 48)), axis=2).astype(np.float32)  # compressible
+    smooth[2] = rng.integers(0, 2**32, size=(64, 48), dtype=np.uint32).view(np.float32)  # incompressible
     for name in ("filter", "direct"):
         with create(tmp_path / f"{name}.h5") as f:
             dataset = f.create_dataset("x", shape=smooth.shape, dtype=np.float32, chunks=(1, 64, 48), **blosc("lz4", 5))

@@ -126,7 +126,7 @@ class _BloscLibrary:
     byte what the filter would write, and nothing else needs installing. One thread, as
     the filter uses: a job's cores are what its rule asks for."""
 
-    OVERHEAD = 16  # BLOSC_MAX_OVERHEAD: a chunk's header; incompressible data is copied after it
+    OVERHEAD = 16  # BLOSC_MAX_OVERHEAD: a chunk's header
 
     def __init__(self, path: str):
         import ctypes
@@ -139,15 +139,15 @@ class _BloscLibrary:
         lib.blosc_cbuffer_sizes.argtypes = [ptr, ctypes.POINTER(size_t), ctypes.POINTER(size_t), ctypes.POINTER(size_t)]
         self._lib, self._ctypes = lib, ctypes
 
-    def compress(self, data: np.ndarray, level: int, shuffle: int, codec: str, out: np.ndarray) -> memoryview:
-        """`data` (C-contiguous) compressed into `out` (uint8, at least data.nbytes + OVERHEAD)."""
+    def compress(self, data: np.ndarray, level: int, shuffle: int, codec: str, out: np.ndarray) -> memoryview | None:
+        """`data` (C-contiguous) compressed into `out` (uint8); None when it does not fit."""
         n = self._lib.blosc_compress_ctx(
             level, shuffle, min(data.dtype.itemsize, 255), data.nbytes, data.ctypes.data, out.ctypes.data, out.nbytes,
             codec.encode(), 0, 1,
         )  # fmt: skip
-        if n <= 0:
+        if n < 0:
             raise RuntimeError(f"blosc: compressing {data.nbytes} bytes with {codec} failed ({n})")
-        return memoryview(out[:n])
+        return memoryview(out[:n]) if n > 0 else None
 
     def decompressed_size(self, chunk: bytes) -> int:
         if len(chunk) < self.OVERHEAD:
@@ -179,18 +179,17 @@ class ChunkWriter:
     `blosc(...)`: the chunk is compressed here, by the Blosc filter's own library with the
     dataset's own parameters, and handed to HDF5 whole (`write_direct_chunk`). HDF5's
     filter pipeline copies each chunk on its way; skipping it writes a 1024^2 motion
-    field's datasets in ~36 ms instead of ~50 (docs/benchmarks.md). The file is the one
-    the filter would have written."""
+    field's datasets in ~36 ms instead of ~50 (docs/benchmarks.md). Items written in order
+    give the file the filter would have written, byte for byte."""
 
     def __init__(self, dataset: h5py.Dataset):
         parameters = _blosc_parameters(dataset)
         if parameters is None:
             raise ValueError(f"{dataset.name}: expected one Blosc filter and one item per chunk")
         self._parameters, self._codec, self.dataset = parameters, _blosc_codec(), dataset
-        # One output buffer, reused: a fresh one per chunk costs page faults (~1 ms per 4 MB).
-        self._buffer = np.empty(
-            dataset.dtype.itemsize * math.prod(dataset.shape[1:]) + _BloscLibrary.OVERHEAD, np.uint8
-        )
+        # One output buffer, reused (a fresh one per chunk costs page faults, ~1 ms per 4 MB),
+        # no larger than the item: as the filter, which leaves a chunk that does not shrink raw.
+        self._buffer = np.empty(dataset.dtype.itemsize * math.prod(dataset.shape[1:]), np.uint8)
 
     def __setitem__(self, i: int, item: np.ndarray) -> None:
         data = np.ascontiguousarray(item, dtype=self.dataset.dtype)
@@ -198,10 +197,11 @@ class ChunkWriter:
             raise ValueError(
                 f"{self.dataset.name}: expected an item of shape {self.dataset.shape[1:]}, got {data.shape}"
             )
-        if self._codec is None:
+        chunk = None if self._codec is None else self._codec.compress(data, *self._parameters, self._buffer)
+        if chunk is None:  # no library, or incompressible: HDF5's pipeline writes it as it would
             self.dataset[i] = data
+            self.dataset.id.flush()  # now, not from HDF5's chunk cache later: the file keeps its order
             return
-        chunk = self._codec.compress(data, *self._parameters, self._buffer)
         self.dataset.id.write_direct_chunk((i,) + (0,) * data.ndim, chunk)
 
 
