@@ -329,13 +329,11 @@ def print_pooled(pooled: dict[str, list[dict]], title: str = "all clips", window
 def interpolate_fixed(fixed: list[tuple[int, float, float]], frames: int) -> tuple[float, float]:
     """(median, p90) of the fixed rates at `frames`, log-log between the two rates around it
     (NaN outside their range); fixed: (frames, median, p90) sorted by frames."""
-    n = np.log([f for f, _, _ in fixed])
-    out = []
-    for column in (1, 2):
-        y = np.log(np.maximum([row[column] for row in fixed], 1e-3))
-        inside = n[0] <= np.log(frames) <= n[-1]
-        out.append(float(np.exp(np.interp(np.log(frames), n, y))) if inside else float("nan"))
-    return out[0], out[1]
+    n, at = np.log([f for f, _, _ in fixed]), np.log(frames)
+    if not n[0] <= at <= n[-1]:
+        return float("nan"), float("nan")
+    median, p90 = (np.log(np.maximum([row[column] for row in fixed], 1e-3)) for column in (1, 2))
+    return float(np.exp(np.interp(at, n, median))), float(np.exp(np.interp(at, n, p90)))
 
 
 if __name__ == "__main__":

@@ -18,7 +18,8 @@ only are computed on the row or column and broadcast, which keeps a 1024 x 1024 
 a handful of full-size operations. The motion-field stage computes a field's flow, exact
 displacement and each pixel's status in one compiled pass (numba, `_motion_pixels`,
 `sphere_motion` and `depth_motion`): the same float64 operations, in the same order, as
-the numpy expressions (bit for bit in float64), ~8x faster than numpy.
+the numpy expressions (bit for bit in float64); per 1024^2 field 12-17 ms over the sphere
+and 20 ms from a depth map (docs/benchmarks.md).
 """
 
 from __future__ import annotations

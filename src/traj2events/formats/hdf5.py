@@ -214,19 +214,17 @@ class ChunkReader:
 
     def __init__(self, dataset: h5py.Dataset):
         self.dataset = dataset
-        self._codec = _blosc_codec() if _blosc_parameters(dataset) is not None else None  # None: h5py reads
+        self._codec = _blosc_codec() if _blosc_parameters(dataset) is not None else None  # None: h5py reads it
 
     def __getitem__(self, i: int) -> np.ndarray:
         n = self.dataset.shape[0]
         if not -n <= i < n:
             raise IndexError(f"{self.dataset.name}: item {i} of {n}")
         i = int(i) % n
-        mask, chunk = (
-            (None, None)
-            if self._codec is None
-            else self.dataset.id.read_direct_chunk((i,) + (0,) * (self.dataset.ndim - 1))
-        )
-        if mask != 0:  # another filter, or HDF5 stored this chunk without its filter
+        if self._codec is None:
+            return self.dataset[i]
+        mask, chunk = self.dataset.id.read_direct_chunk((i,) + (0,) * (self.dataset.ndim - 1))
+        if mask != 0:  # HDF5 stored this chunk without its filter (it did not shrink)
             return self.dataset[i]
         out = np.empty(self.dataset.shape[1:], self.dataset.dtype)
         nbytes = self._codec.decompressed_size(chunk)
