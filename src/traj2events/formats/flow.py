@@ -59,7 +59,7 @@ def motion_field_file(
     memory stays one field whatever K."""
     n = len(t)
     # LZ4 + bit shuffle: a 1024^2 field's datasets written in ~47 ms through HDF5's pipeline
-    # (~36 ms by ChunkWriter) against ~90 ms with zstd-1 (and ~480 ms with gzip-4), read
+    # (36-41 ms by ChunkWriter) against ~90 ms with zstd-1 (and ~480 ms with gzip-4), read
     # ~1.8x faster, 1 % larger (docs/benchmarks.md).
     compression = blosc("lz4", 5)
     with atomic_output(path) as tmp, create(tmp) as f:
