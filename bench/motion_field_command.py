@@ -8,7 +8,8 @@ The trajectory's first --poses poses (from mid-flight) are copied into a shorter
 trajectory.h5 and rendered once at --size by the render stage (frames.h5). Then the
 command runs (one core, OMP_NUM_THREADS=1) for every --every-th field and for a single
 field, with and without --frames; seconds per field = (many - one) / (fields - 1), so
-start-up (imports, compiled-kernel loading) is left out and reported apart. With
+start-up (imports, compiled-kernel loading) is left out and reported apart (one untimed
+run per source first, so that no timed run compiles the kernels). With
 --compare-src, the same runs with another source tree (e.g. a `git worktree` of an
 older commit) alternate with this one's, A B A B, and the fields are checked equal.
 """
@@ -113,6 +114,8 @@ def main() -> None:
         print("| source | field | s per field (runs) | start-up + one field, s (runs) |")
         print("|---|---|---|---|")
         rows: dict[tuple[str, str], tuple[list, list]] = {}
+        for src in sources.values():  # compiles the kernels where a source edit invalidated their cache
+            run_command(src, trajectory, args.size, args.poses, frames, work)
         for _ in range(args.repeats):
             for kind, given in (("sphere only", None), ("sphere + terrain", frames)):
                 for name, src in sources.items():

@@ -353,6 +353,34 @@ def test_terrain_displacement_marks_what_a_known_occluder_hides():
     assert not (unchecked == OCCLUDED).any()
 
 
+def test_first_corner_prefilter_never_skips_a_point_the_full_occlusion_test_flags():
+    """The branch-free row test run before `_behind_nearer` must be a necessary condition
+    for it (else occluded points would go unflagged), for points in and out of view,
+    near the borders, behind nearer and farther surfaces, and with NaN coordinates."""
+    from traj2events.motion_field import _behind_nearer, _first_corner_nearer_row
+
+    rng = np.random.default_rng(5)
+    height, width, rel_tol = 12, 16, 0.01
+    depth_next = rng.uniform(1.0, 3.0, (height, width)).astype(np.float32)
+    depth_next[0, :4] = 0.0  # sky
+    n = 4000
+    x_cols = rng.uniform(-width / 2 - 2, width / 2 + 2, n)  # centred coordinates, some out of view
+    u_row = rng.normal(0.0, 0.5, n)
+    u_row[::97] = np.nan
+    z_row = rng.uniform(0.5, 4.0, n)
+    flagged = passed_then_rejected = 0
+    for y_s in (-height / 2 - 0.7, -height / 2 + 0.2, 0.3, height / 2 - 0.4, height / 2 + 0.1):
+        v_row = rng.normal(0.0, 0.5, n)
+        maybe = np.zeros(n)
+        _first_corner_nearer_row(x_cols, u_row, y_s, v_row, z_row, depth_next, rel_tol, maybe)
+        full = np.array([_behind_nearer.py_func(x_cols[j] + u_row[j], y_s + v_row[j], z_row[j], depth_next, rel_tol)
+                         for j in range(n)])  # fmt: skip
+        assert (maybe[full] == 1.0).all()
+        flagged += full.sum()
+        passed_then_rejected += (maybe.astype(bool) & ~full).sum()
+    assert flagged > 100 and passed_then_rejected > 100  # not vacuous
+
+
 def test_sphere_displacement_marks_sky_out_of_view_and_beyond_the_limb():
     from traj2events.motion_field import OCCLUDED, SKY, local_vertical
 

@@ -18,8 +18,8 @@ only are computed on the row or column and broadcast, which keeps a 1024 x 1024 
 a handful of full-size operations. The motion-field stage computes a field's flow, exact
 displacement and each pixel's status in one compiled pass (numba, `_motion_pixels`,
 `sphere_motion` and `depth_motion`): the same float64 operations, in the same order, as
-the numpy expressions (bit for bit in float64); per 1024^2 field 12-17 ms over the sphere
-and 20 ms from a depth map (docs/benchmarks.md).
+the numpy expressions (bit for bit in float64); per 1024^2 field 11-12 ms over the sphere
+and 14-16 ms from a depth map (docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -308,8 +308,8 @@ def _motion(camera: Camera, pose_k, pose_next, depth, sphere, q, depth_next, rel
         x_s,
         y_s,
         rates,
-        flow,
-        displacement,
+        flow.reshape(flow.shape[0], 2 * flow.shape[1]),  # (u, v) pairs along a row: stride 2 known to the compiler
+        displacement.reshape(shape[0], -1),
         status,
     )
     return flow, displacement, status
@@ -341,14 +341,17 @@ def _motion_pixels(
     empty), and the status, the first that applies of SKY, BEHIND_CAMERA, OCCLUDED,
     OUT_OF_VIEW, VISIBLE. Float64 throughout, in the same operations and order as the
     numpy expressions. The arithmetic loops are branch-free and write row buffers so that
-    LLVM vectorises them (2.5x the single per-pixel loop); only the status loop branches."""
+    LLVM vectorises them (2.5x the single per-pixel loop); only the status loop branches.
+    flow and displacement come as (H, 2 W) views, (u, v) pairs along each row."""
     width, height = a_cols.size, b_rows.size
     from_depth, limb, from_next = depth.size > 0, q.size > 0, depth_next.size > 0
     above = sphere.size > 0 and sphere[5] > 0.0  # camera above the sphere's surface
     vx, vy, vz, p, q_rate, r = rates[0], rates[1], rates[2], rates[3], rates[4], rates[5]
     m00, m01, m02, m10, m11, m12, m20, m21, m22 = m.ravel()
-    rows = np.zeros((7, width))  # h, the point (x, y, z) at k+1, displacement (u, v), scratch
-    h_row, x_row, y_row, z_row, u_row, v_row, w_row = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5], rows[6]
+    # h, the point (x, y, z) at k+1, displacement (u, v), flow (u, v), maybe occluded
+    rows = np.zeros((9, width))
+    h_row, x_row, y_row, z_row, u_row, v_row = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
+    flow_u_row, flow_v_row, maybe_row = rows[6], rows[7], rows[8]
     for i in range(height):
         b, y_s = b_rows[i], y_rows[i]
         if from_depth:
@@ -367,22 +370,22 @@ def _motion_pixels(
             x_row[j], y_row[j], z_row[j] = x, y, z
             u_row[j] = f * x / z - x_cols[j]
             v_row[j] = f * y / z - y_s
-        for j in range(width):
-            displacement[i, j, 0] = u_row[j]
-            displacement[i, j, 1] = v_row[j]
+        for j in range(width):  # both components in one loop: LLVM vectorises the interleaved store
+            displacement[i, 2 * j] = u_row[j]
+            displacement[i, 2 * j + 1] = v_row[j]
         if flow.size > 0:
             for j in range(width):
                 h, x_s = h_row[j], x_cols[j]
                 xy_over_f = x_s * (y_s / f)
-                w_row[j] = h * (x_s * vz - f * vx) + (p * xy_over_f + ((-(f + x_s * x_s / f) * q_rate) + y_s * r))
+                flow_u_row[j] = h * (x_s * vz - f * vx) + (p * xy_over_f + ((-(f + x_s * x_s / f) * q_rate) + y_s * r))
+                flow_v_row[j] = h * (y_s * vz - f * vy) + (
+                    (-q_rate) * xy_over_f + (((f + y_s * y_s / f) * p) - x_s * r)
+                )
             for j in range(width):
-                flow[i, j, 0] = w_row[j]
-            for j in range(width):
-                h, x_s = h_row[j], x_cols[j]
-                xy_over_f = x_s * (y_s / f)
-                w_row[j] = h * (y_s * vz - f * vy) + ((-q_rate) * xy_over_f + (((f + y_s * y_s / f) * p) - x_s * r))
-            for j in range(width):
-                flow[i, j, 1] = w_row[j]
+                flow[i, 2 * j] = flow_u_row[j]
+                flow[i, 2 * j + 1] = flow_v_row[j]
+        if from_next:  # branch-free: whether the first pixel around the landing point is nearer
+            _first_corner_nearer_row(x_cols, u_row, y_s, v_row, z_row, depth_next, rel_tol, maybe_row)
         for j in range(width):
             h, x, y, z = h_row[j], x_row[j], y_row[j], z_row[j]
             col, row = x_cols[j] + u_row[j], y_s + v_row[j]  # centred coordinates at k+1
@@ -392,7 +395,7 @@ def _motion_pixels(
                 status[i, j] = BEHIND_CAMERA
             elif limb and not -(x * (x + q[0]) + y * (y + q[1]) + z * (z + q[2])) > 0.0:
                 status[i, j] = OCCLUDED  # beyond the sphere's limb seen from camera k+1
-            elif from_next and _behind_nearer(col, row, z, depth_next, rel_tol):
+            elif from_next and maybe_row[j] > 0.0 and _behind_nearer(col, row, z, depth_next, rel_tol):
                 status[i, j] = OCCLUDED
             elif not (abs(col) <= width / 2 and abs(row) <= height / 2):
                 status[i, j] = OUT_OF_VIEW
@@ -419,6 +422,25 @@ def _sphere_row(a_cols, b, n_x, n_y, n_z, r_plus_h, k, h_row):
         disc = (r_plus_h * r_plus_h) * (dot * dot) - k * s
         root = (r_plus_h * dot + np.sqrt(max(disc, 0.0))) / k
         h_row[j] = root if (disc >= 0.0 and dot > 0.0) else 0.0
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _first_corner_nearer_row(x_cols, u_row, y_s, v_row, z_row, depth_next, rel_tol, maybe_row):
+    """1 where a row's point lands in view at k+1 and the first of the four pixels around
+    it (`_behind_nearer`'s first test, the same arithmetic) shows a surface nearer than it,
+    else 0: a necessary condition for `_behind_nearer`, computed without branches (the
+    per-pixel test, which mostly stops at that pixel, mispredicts)."""
+    height, width = depth_next.shape
+    for j in range(x_cols.size):
+        col = (x_cols[j] + u_row[j]) + width / 2 - 0.5
+        row = (y_s + v_row[j]) + height / 2 - 0.5
+        inside = (col > -1) & (col < width) & (row > -1) & (row < height)
+        # Clamped before the integer conversion (NaN to 0): an index for any point, used only inside.
+        col = min(col if col > 0.0 else 0.0, width - 1.0)
+        row = min(row if row > 0.0 else 0.0, height - 1.0)
+        d = np.float64(depth_next[np.int64(row), np.int64(col)])
+        nearer = (d > 0.0) & (d < z_row[j] * (1.0 - rel_tol))
+        maybe_row[j] = 1.0 if inside & nearer else 0.0
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
