@@ -11,11 +11,11 @@ from dataclasses import dataclass
 # Bytes per pixel per frame (per field for the motion field), measured on the default
 # dataset (128 x 128) and bench/frames_store.py (1024 x 1024).
 BYTES_PER_PX = {
-    "frames.h5": 3.5,  # radiance + depth, 16 significant bits, Blosc/LZ4 (3.3 at 1024^2; zstd-1 gave 2.8)
+    "frames.h5": 2.9,  # radiance + depth, 16 significant bits, LZ4 + byte shuffle: 2.6-3.1 at 1024^2
     "video.mkv": 0.43,  # FFV1 of the 8-bit display frames
     "preview.mp4": 0.03,
     "events.h5": 1.0,  # paper preset through the sensor model: 1.03 at 1024^2 (bench/workflow_cost.py), 0.49 at 128^2
-    "motion_field.h5": 20.5,  # per field written: sphere and terrain flow, displacement, masks
+    "motion_field.h5": 21.7,  # per field written: sphere and terrain flow, displacement, masks
     "flow/*.flo": 8.0,  # per field written
 }
 EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # measured on the default dataset

@@ -4,7 +4,7 @@
 adaptive frame between two poses, for the emulator only; render.timing); `radiance`
 (n, H, W) float32 W m^-2 sr^-1 and `depth_m` (n, H, W) float32 along the boresight
 (0 = sky), both rounded to 16 significant bits and compressed one frame per chunk
-(Blosc/LZ4 with bit shuffle: `import hdf5plugin` to read them with h5py);
+(Blosc/LZ4 with byte shuffle: `import hdf5plugin` to read them with h5py);
 attributes: camera, Sun, terrain, reflectance, display, timing."""
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ class FramesWriter:
                 maxshape=(None, height, width),
                 dtype=np.float32,
                 chunks=(1, height, width),
-                **blosc("lz4", 5),  # written ~1.5x and read ~2x faster than zstd-1, 11 % larger
+                **blosc("lz4", 5, bitshuffle=False),  # rounded floats: byte shuffle is faster and smaller here
             )
             for name in ("radiance", "depth_m")
         }
