@@ -223,3 +223,44 @@ def test_compiled_crater_pass_on_a_grid_equals_the_profiles_crater_by_crater():
         on_grid = terrain.crater_relief_m(x, y, spacing)
         scattered = terrain.crater_relief_m(x.ravel(), y.ravel(), spacing)  # 1-D: no grid, the numpy path
         assert np.abs(on_grid).max() > 0 and on_grid.ravel().tobytes() == scattered.tobytes()
+
+
+def numpy_features_in_cells(seed, stream, lam, ix, iy):
+    """`_in_cells` as numpy expressions (as the terrain computed it before it was compiled):
+    the reference the compiled pass must equal bit for bit."""
+    from traj2events.terrain import _hash_uniform
+
+    ii, jj = (a.ravel() for a in np.meshgrid(ix, iy, indexing="ij"))
+    u = _hash_uniform(seed, stream, ii, jj)
+    counts, term, k = np.zeros(u.shape, np.int64), np.exp(-lam), 0
+    cdf = np.full(u.shape, term)
+    while (u >= cdf).any() and k <= 50:
+        counts += u >= cdf
+        k += 1
+        term *= lam / k
+        cdf = cdf + term
+    ci, cj = np.repeat(ii, counts), np.repeat(jj, counts)
+    m = np.arange(len(ci)) - np.repeat(np.cumsum(counts) - counts, counts)
+    return ci, cj, [_hash_uniform(seed, stream + 1 + s, ci * 256 + m, cj) for s in range(4)]
+
+
+@pytest.mark.parametrize("lam", [0.003, 0.7, 4.0, 80.0])
+def test_features_per_cell_are_poisson_and_equal_the_numpy_reference(lam):
+    """Counts per cell: the numpy reference's, bit for bit, with Poisson's mean and
+    variance lam (capped at 51 where lam is large); the features' uniforms the same too."""
+    from traj2events.terrain import _features_in_cells, _stream_key
+
+    ix, iy = np.arange(-40.0, 40.0), np.arange(7.0, 57.0)
+    keys = np.array([_stream_key(3, 8 + s) for s in range(5)], np.uint64)
+    ci, cj, uniforms = _features_in_cells(keys, lam, np.exp(-lam), ix[0], len(ix), iy[0], len(iy))
+    ref_ci, ref_cj, ref_uniforms = numpy_features_in_cells(3, 8, lam, ix, iy)
+    assert ci.tobytes() == ref_ci.tobytes() and cj.tobytes() == ref_cj.tobytes()
+    assert all(a.tobytes() == b.tobytes() for a, b in zip(uniforms, ref_uniforms))
+    counts = np.zeros((len(ix), len(iy)))
+    np.add.at(counts, ((ci - ix[0]).astype(int), (cj - iy[0]).astype(int)), 1)
+    if lam < 51:
+        n = counts.size  # 4000 cells: the mean within 4 standard errors
+        assert abs(counts.mean() - lam) < 4 * np.sqrt(lam / n)
+        assert counts.var() == pytest.approx(lam, rel=0.2 if lam > 0.1 else 0.6)
+    else:
+        assert counts.max() == 51 and counts.mean() > 50  # the inversion stops at 51
