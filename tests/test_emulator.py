@@ -389,3 +389,28 @@ def test_input_scale_on_float32_frames_is_the_float64_product_byte_for_byte():
         assert events.tobytes() == reference[0].tobytes() and labels.tobytes() == reference[1].tobytes()
     with pytest.raises(ValueError, match="input_scale: expected a finite value > 0"):
         EventEmulator(4, 4, input_scale=0.0)
+
+
+@pytest.mark.parametrize("width, height", [(1024, 1024), (346, 260), (1, 7), (640, 1)])
+@pytest.mark.parametrize("labels", [False, True])
+def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels):
+    """_assemble's key (t us, y, x, p[, label]) decodes to the very events it encodes, in
+    (t, y, x, p) order: t from 0 (the first key inside t = 0's range) to hours, every
+    corner pixel, both polarities, on image widths that are not powers of two."""
+    from traj2events.emulator import _assemble
+
+    rng = np.random.default_rng(width + height)
+    n_pixels = width * height
+    n = 20_000
+    t_us = np.concatenate([[0, 0, 1, 3_600_000_000], rng.integers(0, 5_000, n - 4)])
+    pix = np.concatenate([[n_pixels - 1, 1, 0, n_pixels - 1], rng.integers(0, n_pixels, n - 4)])
+    on = rng.random(n) < 0.5
+    label = rng.integers(0, 4, n).astype(np.uint8) if labels else None
+    events, out_label = _assemble(pix, t_us * 1e-6, on, label, width, n_pixels)
+    order = np.lexsort(((label if labels else np.zeros(n)), on, pix % width, pix // width, t_us))
+    np.testing.assert_array_equal(events["t"], t_us[order])
+    np.testing.assert_array_equal(events["y"], (pix // width)[order])
+    np.testing.assert_array_equal(events["x"], (pix % width)[order])
+    np.testing.assert_array_equal(events["p"], on[order])
+    if labels:
+        np.testing.assert_array_equal(out_label, label[order])

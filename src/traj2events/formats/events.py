@@ -62,8 +62,8 @@ class EventsWriter:
         if not len(events):
             return
         ensure_free_space(self._path, len(events) * events.dtype.itemsize)
-        t = events["t"].astype(np.int64) - self.t_offset_us
-        if t[0] < self._last_t or np.any(np.diff(t) < 0):
+        t = np.subtract(events["t"], self.t_offset_us, dtype=np.int64)  # one pass, contiguous
+        if t[0] < self._last_t or (t[1:] < t[:-1]).any():  # no int64 temporary, as np.diff makes
             raise ValueError("events.h5: events must arrive sorted by t")
         # ms_to_idx[m] = first index with t >= 1000 m, for every m up to this chunk's last event.
         last_ms = int(t[-1] // 1000)
