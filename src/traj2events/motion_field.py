@@ -308,8 +308,9 @@ def _motion(camera: Camera, pose_k, pose_next, depth, sphere, q, depth_next, rel
         x_s,
         y_s,
         rates,
-        flow.reshape(flow.shape[0], 2 * flow.shape[1]),  # (u, v) pairs along a row: stride 2 known to the compiler
-        displacement.reshape(shape[0], -1),
+        # (H, 2 W) views: (u, v) pairs along a row, a stride of 2 the compiler knows
+        flow.reshape(flow.shape[0], 2 * flow.shape[1]),
+        displacement.reshape(shape[0], 2 * shape[1]),
         status,
     )
     return flow, displacement, status
