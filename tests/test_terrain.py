@@ -225,13 +225,20 @@ def test_compiled_crater_pass_on_a_grid_equals_the_profiles_crater_by_crater():
         assert np.abs(on_grid).max() > 0 and on_grid.ravel().tobytes() == scattered.tobytes()
 
 
+def hash_uniform(seed, stream, i, j):
+    """The terrain's hashed uniforms at lattice points (i, j), element by element."""
+    from traj2events.terrain import _hash_pair, _stream_key
+
+    i, j = np.broadcast_arrays(np.asarray(i).astype(np.int64), np.asarray(j).astype(np.int64))
+    key = _stream_key(seed, stream)
+    return np.array([_hash_pair(key, a, b) for a, b in zip(i.ravel(), j.ravel())]).reshape(i.shape)
+
+
 def numpy_features_in_cells(seed, stream, lam, ix, iy):
     """`_in_cells` as numpy expressions (as the terrain computed it before it was compiled):
     the reference the compiled pass must equal bit for bit."""
-    from traj2events.terrain import _hash_uniform
-
     ii, jj = (a.ravel() for a in np.meshgrid(ix, iy, indexing="ij"))
-    u = _hash_uniform(seed, stream, ii, jj)
+    u = hash_uniform(seed, stream, ii, jj)
     counts, term, k = np.zeros(u.shape, np.int64), np.exp(-lam), 0
     cdf = np.full(u.shape, term)
     while (u >= cdf).any() and k <= 50:
@@ -241,7 +248,7 @@ def numpy_features_in_cells(seed, stream, lam, ix, iy):
         cdf = cdf + term
     ci, cj = np.repeat(ii, counts), np.repeat(jj, counts)
     m = np.arange(len(ci)) - np.repeat(np.cumsum(counts) - counts, counts)
-    return ci, cj, [_hash_uniform(seed, stream + 1 + s, ci * 256 + m, cj) for s in range(4)]
+    return ci, cj, [hash_uniform(seed, stream + 1 + s, ci * 256 + m, cj) for s in range(4)]
 
 
 @pytest.mark.parametrize("lam", [0.003, 0.7, 4.0, 80.0])
@@ -264,3 +271,23 @@ def test_features_per_cell_are_poisson_and_equal_the_numpy_reference(lam):
         assert counts.var() == pytest.approx(lam, rel=0.2 if lam > 0.1 else 0.6)
     else:
         assert counts.max() == 51 and counts.mean() > 50  # the inversion stops at 51
+
+
+def test_value_noise_passes_through_the_lattice_values_and_is_continuous():
+    """At lattice points the noise is the point's hashed uniform; between them it blends
+    the four corners (so it stays in [0, 1)) and is continuous across cell edges."""
+    from traj2events.terrain import _value_noise
+
+    i, j = np.meshgrid(np.arange(-5.0, 5.0), np.arange(-3.0, 4.0), indexing="ij")
+    np.testing.assert_array_equal(_value_noise(4, 1000, i, j), hash_uniform(4, 1000, i, j))
+    rng = np.random.default_rng(0)
+    u, v = rng.uniform(-50, 50, 10_000), rng.uniform(-50, 50, 10_000)
+    noise = _value_noise(4, 1000, u, v)
+    assert noise.min() >= 0.0 and noise.max() < 1.0
+    edge = np.round(u)  # either side of a cell edge: the fade's zero slope makes the jump tiny
+    below, above = _value_noise(4, 1000, edge - 1e-9, v), _value_noise(4, 1000, edge + 1e-9, v)
+    assert np.abs(below - above).max() < 1e-8
+    # Midway along an edge: the mean of its two corners (the fade is 1/2 there).
+    mid = _value_noise(4, 1000, i + 0.5, j)
+    corners = 0.5 * (hash_uniform(4, 1000, i, j) + hash_uniform(4, 1000, i + 1, j))
+    np.testing.assert_allclose(mid, corners, rtol=0, atol=1e-15)
