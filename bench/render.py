@@ -18,7 +18,6 @@ and the paper config's cost (500 trajectories x ~7500 frames).
 from __future__ import annotations
 
 import argparse
-import io
 import os
 import platform
 import statistics
@@ -29,11 +28,10 @@ from pathlib import Path
 os.environ.setdefault("LP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 from traj2events.camera import Camera, camera_pose  # noqa: E402
-from traj2events.formats.frames import round_mantissa  # noqa: E402
+from traj2events.formats.frames import FramesWriter  # noqa: E402
 from traj2events.illumination import Sun  # noqa: E402
 from traj2events.reflectance import ReflectanceParams  # noqa: E402
 from traj2events.render import TerrainRenderer  # noqa: E402
@@ -119,20 +117,14 @@ def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backe
 
 
 def disk_bytes(frame, size):
-    buf = io.BytesIO()
-    with h5py.File(buf, "w") as f:
-        for name, data in (("radiance", frame.radiance), ("depth_m", frame.depth_m)):
-            f.create_dataset(
-                name,
-                data=round_mantissa(data)[None],
-                chunks=(1, size, size),
-                compression="gzip",
-                compression_opts=1,
-                shuffle=True,
-            )
-    h5_bytes = len(buf.getvalue())
+    """Bytes of one frame in frames.h5 (written by the render stage's own FramesWriter, ten
+    copies, per frame) and in video.mkv."""
     tmp = Path("bench/out")
     tmp.mkdir(parents=True, exist_ok=True)
+    with FramesWriter(tmp / "frames.h5", size, size, {}) as frames:
+        for k in range(10):
+            frames.append(k / 100.0, k, frame.radiance, frame.depth_m)
+    h5_bytes = (tmp / "frames.h5").stat().st_size / 10
     shown = display_frame(frame.radiance, 40.0, 2.2)
     with VideoWriter(tmp / "one.mkv", size, size, 100.0) as video:
         for _ in range(10):
