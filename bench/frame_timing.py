@@ -302,11 +302,11 @@ def flight_windows(tf: float, n: int, window_s: float, fps: int) -> dict[str, tu
 
 def print_pooled(pooled: dict[str, list[dict]], title: str = "all clips", windows: bool = False) -> None:
     """Clips or windows together: frames rendered over all of them (windows: less each
-    window's closing frame, so that windows count a flight's frames per second
-    exactly), and every matched
-    event's timing error in one distribution (fast and slow stretches weighted by their
-    events). For adaptive rows, the fixed rates' median and p90 at the same frame count,
-    interpolated log-log between the fixed rates around it."""
+    window's closing frame, so that windows count a flight's frames per second exactly),
+    and every matched event's timing error in one distribution (fast and slow stretches
+    weighted by their events). For adaptive rows, the fixed rates' median and p90 at the
+    same frame count, interpolated log-log between the fixed rates around it (the fixed
+    rows come first in `pooled`)."""
     print(f"\n| {title} | frames | x fixed 100 fps | events vs reference | median abs dt, us | p90 abs dt, us "
           "| fixed at the same frames: median, p90 us |")  # fmt: skip
     print("|---|---|---|---|---|---|---|")
