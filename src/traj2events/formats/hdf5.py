@@ -179,8 +179,8 @@ class ChunkWriter:
     """Writes item i of a dataset chunked one item per chunk (`chunks=(1, *shape)`) with
     `blosc(...)`: the chunk is compressed here, by the Blosc filter's own library with the
     dataset's own parameters, and handed to HDF5 whole (`write_direct_chunk`). HDF5's
-    filter pipeline copies each chunk on its way; skipping it writes a 1024^2 motion
-    field's datasets in 36-41 ms instead of 43-55 (docs/benchmarks.md). Items written in order
+    filter pipeline copies each chunk on its way; skipping it wrote a 1024^2 motion
+    field's datasets in 36-41 ms instead of 43-55 (LZ4 + bit shuffle, docs/benchmarks.md). Items written in order
     give the file the filter would have written, byte for byte."""
 
     def __init__(self, dataset: h5py.Dataset):
