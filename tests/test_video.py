@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from traj2events.video import VideoWriter, display_frame, read_video
+from traj2events.video import VideoWriter, _display_steps, display_code, display_frame, read_video
 
 
 def test_ffv1_round_trip_is_exact(tmp_path):
@@ -37,3 +37,44 @@ def test_failed_write_leaves_nothing(tmp_path):
 def test_display_mapping():
     values = display_frame(np.array([0.0, 10.0, 40.0, 400.0, -1.0]), 40.0, 2.2)
     assert values.tolist() == [0, round(255 * 0.25 ** (1 / 2.2)), 255, 255, 0]
+
+
+def test_display_law_at_published_points():
+    # round(255 (L / white)^(1/gamma)): white -> 255, white * 0.5^gamma -> 127.5 -> 128, 0 -> 0.
+    white, gamma = 40.0, 2.2
+    radiance = np.array([0.0, white * 0.5**gamma * 1.0001, white * 0.5**gamma * 0.9999, white, 1e30], np.float32)
+    assert display_frame(radiance, white, gamma).tolist() == [0, 128, 127, 255, 255]
+
+
+@pytest.mark.parametrize("gamma", [1.0, 1.8, 2.2, 2.4, 3.0])
+def test_display_steps_give_the_law_bit_for_bit(gamma):
+    """The float32 path (255 steps found by bisection) against the law in float64, on
+    every step's edge (one float32 each side), random frames, strided views and the limits."""
+    white = 37.5
+    step_bits, _, _ = _display_steps(white, gamma)
+    edges = step_bits[1:256].view(np.float32)
+    below = np.nextafter(edges, np.float32(0))
+    rng = np.random.default_rng(3)
+    radiance = np.concatenate(
+        [
+            edges,
+            below,
+            (rng.random(20000) ** 4 * 2 * white).astype(np.float32),
+            np.array([0.0, -0.0, -1.0, np.inf, -np.inf, white, 2 * white, 1e-38, 1e-45], np.float32),
+        ]
+    )
+    np.testing.assert_array_equal(display_frame(radiance, white, gamma), display_code(radiance, white, gamma))
+    # each step's edge is where the law's code rises, by one
+    assert (display_code(edges, white, gamma) == np.arange(1, 256)).all()
+    assert (display_code(below, white, gamma) == np.arange(0, 255)).all()
+    frame = np.empty((64, 48, 2), np.float32)  # the renderer's frames: a channel of a flipped image
+    frame[..., 0] = rng.random((64, 48)) * 1.2 * white
+    view = frame[::-1][..., 0]
+    np.testing.assert_array_equal(display_frame(view, white, gamma), display_code(view, white, gamma))
+
+
+def test_display_gamma_below_one_takes_the_law():
+    """Steps too narrow for the buckets: the law itself computes the codes."""
+    assert _display_steps(40.0, 0.5) is None
+    radiance = np.linspace(-1, 50, 1001, dtype=np.float32)
+    np.testing.assert_array_equal(display_frame(radiance, 40.0, 0.5), display_code(radiance, 40.0, 0.5))

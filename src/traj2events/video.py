@@ -4,20 +4,87 @@ through ffmpeg (ffmpeg-python builds the command lines)."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import subprocess
 import tempfile
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 
 from .formats.atomic import atomic_output
 
 
-def display_frame(radiance: np.ndarray, white_w_m2_sr: float, gamma: float) -> np.ndarray:
-    """Linear radiance -> 8-bit display values: 255 (L / white)^(1/gamma), clipped."""
+def display_code(radiance: np.ndarray, white_w_m2_sr: float, gamma: float) -> np.ndarray:
+    """The display law itself: round(255 (L / white)^(1/gamma)), L clipped to [0, white]."""
     x = np.clip(np.asarray(radiance, dtype=np.float64) / white_w_m2_sr, 0.0, 1.0)
     return np.round(255.0 * x ** (1.0 / gamma)).astype(np.uint8)
+
+
+def display_frame(radiance: np.ndarray, white_w_m2_sr: float, gamma: float) -> np.ndarray:
+    """Linear radiance -> 8-bit display values: 255 (L / white)^(1/gamma), clipped
+    (`display_code`). A float32 frame (the renderer's) goes through the law's 255 steps
+    instead, the same bytes in a fraction of the time: the law is monotone, so a pixel's code
+    is the number of steps at or below its radiance."""
+    radiance = np.asarray(radiance)
+    steps = _display_steps(float(white_w_m2_sr), float(gamma)) if radiance.dtype == np.float32 else None
+    if steps is None:
+        return display_code(radiance, white_w_m2_sr, gamma)
+    rows = radiance.reshape(-1, radiance.shape[-1]) if radiance.ndim >= 2 else radiance.reshape(1, -1)
+    codes = np.empty(rows.shape, np.uint8)
+    # Same-size views keep any strides: the renderer's frames are strided views.
+    _codes_from_steps(rows.view(np.int32), codes, *steps)
+    return codes.reshape(radiance.shape)
+
+
+# Buckets of float32 bit patterns >> 15: 2^-8 relative width, narrower than the law's
+# narrowest step (gamma / 255 relative, near white): a bucket holds at most one step.
+_BUCKET_SHIFT = 15
+
+
+@functools.lru_cache(maxsize=8)
+def _display_steps(white_w_m2_sr: float, gamma: float) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """(step_bits, bucket_codes, first_bucket) of the law for float32 radiance; None where
+    a bucket would hold two steps' starts (gamma below ~1).
+
+    step_bits[v], v = 1..255: the bit pattern of the smallest float32 L whose code is >= v,
+    found by bisection over bit patterns with `display_code` itself (the patterns of
+    non-negative floats sort as the values do). bucket_codes[b]: the code at the start of
+    bucket first_bucket + b."""
+    v = np.arange(1, 256)
+    low = np.zeros(255, np.int64)  # code(0.0) = 0 < v
+    high = np.full(255, np.float32(2 * white_w_m2_sr).view(np.int32), np.int64)  # code 255 >= v
+    while np.any(high - low > 1):
+        mid = (low + high) // 2
+        reached = display_code(mid.astype(np.int32).view(np.float32), white_w_m2_sr, gamma) >= v
+        high, low = np.where(reached, mid, high), np.where(reached, low, mid)
+    # step_bits[256]: no step beyond 255.
+    step_bits = np.concatenate([[0], high, [np.iinfo(np.int32).max]]).astype(np.int32)
+    first, last = step_bits[1] >> _BUCKET_SHIFT, step_bits[255] >> _BUCKET_SHIFT
+    starts = np.arange(first, last + 1, dtype=np.int64) << _BUCKET_SHIFT
+    bucket_codes = np.searchsorted(step_bits[1:256], starts, side="right").astype(np.int32)
+    ends = np.searchsorted(step_bits[1:256], starts + (1 << _BUCKET_SHIFT) - 1, side="right")
+    if np.any(ends - bucket_codes > 1):  # gamma < ~1: steps narrower than the buckets
+        return None
+    return step_bits, bucket_codes, int(first)
+
+
+@njit(cache=True, nogil=True)
+def _codes_from_steps(bits, codes, step_bits, bucket_codes, first_bucket):  # pragma: no cover (compiled)
+    n_buckets = len(bucket_codes)
+    for i in range(bits.shape[0]):
+        for j in range(bits.shape[1]):
+            x = bits[i, j]
+            b = (x >> _BUCKET_SHIFT) - first_bucket
+            if b < 0:  # below the first step, or negative (the sign bit)
+                code = 0
+            elif b >= n_buckets:  # beyond the last step (white and above, inf)
+                code = 255
+            else:  # a bucket holds at most one step's start (_display_steps)
+                code = bucket_codes[b]
+                code += x >= step_bits[code + 1]
+            codes[i, j] = code
 
 
 class VideoWriter:
