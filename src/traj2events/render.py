@@ -122,6 +122,9 @@ def _context(backend: str, width: int, height: int):
 
         platform = OSMesaPlatform(width, height)
     else:
+        # pyrender imports pyglet for its viewer (unused here); pyglet's default windowing
+        # needs X11's libraries, which a GPU server often lacks: its headless mode needs EGL only.
+        os.environ.setdefault("PYGLET_HEADLESS", "true")
         from pyrender.platforms.egl import EGLPlatform, query_devices
 
         devices = query_devices()
