@@ -115,8 +115,13 @@ def test_egl_and_osmesa_draw_the_same_pixels(tmp_path):
     assert (images["osmesa"][1] > 0).mean() > 0.5  # mostly terrain
     if hardware_egl_device(egl_devices()) is None:  # both are llvmpipe: the very same pixels
         assert np.array_equal(images["egl"], images["osmesa"])
-    else:  # a GPU: within float rounding, except at a few edge pixels
-        assert np.mean(~np.isclose(images["egl"], images["osmesa"], rtol=1e-4, atol=1e-6)) < 1e-3
+    else:  # a GPU rounds its arithmetic otherwise: on an H100 at 1024^2 (bench/render_backends.py),
+        # depth agreed to float rounding (median 1e-7-7e-7 relative) and radiance to 5e-4-8e-4 RMS
+        # of its mean, a few % of the pixels (occluding edges, grazing Sun) apart by more than 1e-3.
+        ground = (images["egl"][1] > 0) & (images["osmesa"][1] > 0)
+        assert np.median(np.abs(images["egl"][1][ground] / images["osmesa"][1][ground] - 1)) < 1e-5
+        radiance_egl, radiance_osmesa = images["egl"][0][ground], images["osmesa"][0][ground]
+        assert np.sqrt(np.mean((radiance_egl - radiance_osmesa) ** 2)) / radiance_osmesa.mean() < 5e-3
 
 
 def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch):
@@ -330,3 +335,24 @@ def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
     assert 0 < np.count_nonzero(sky) < 0.2 * sky.size  # points, not a glow
     # Each star's radiance x pixel solid angle sums to at most its irradiance (part may be hidden).
     assert sky.max() * np.cos(np.radians(32)) ** 3 / camera.focal_px**2 <= stars.irradiance_w_m2.max()
+
+
+def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
+    """render_sequence keeps a frame in flight while the caller works: with render() calls
+    in between and tiles evicted (slots refilled) while a frame is in flight, every frame
+    is the one a fresh renderer draws alone."""
+    camera = Camera(40, 32, 45.0)
+    poses = [camera_pose(state(x=x, altitude=300.0, pitch=30.0)) for x in (-3000.0, -1500.0, 0.0, 1500.0)]
+    between = camera_pose(state(x=-800.0, altitude=250.0, pitch=20.0))
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, LodSettings())
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend="osmesa") as renderer:
+        frames, extra = [], None
+        for k, frame in enumerate(renderer.render_sequence(iter(poses))):
+            frames.append(frame)
+            if k == 1:  # as adaptive timing does, while pose 2 is in flight
+                extra = renderer.render(between)
+        assert len(renderer._gl.pixel_buffers) == 2  # two frames in flight at most
+    for pose, frame in [*zip(poses, frames), (between, extra)]:
+        alone, _ = render(ProceduralTerrain(TerrainParams(seed=6)), camera, pose)
+        assert np.array_equal(frame.radiance, alone.radiance) and np.array_equal(frame.depth_m, alone.depth_m)
+        assert frame.n_tiles == alone.n_tiles > 0

@@ -17,7 +17,8 @@ then rejects hidden fragments early, and which of two coincident surfaces wins i
 carrying its origin's offset from the camera (float64 on the CPU, small float32 numbers on
 the GPU) and its slot, from which the vertex shader fetches the vertices. The output is a
 single-sample float32 two-channel framebuffer: radiance (W m^-2 sr^-1) and depth along the
-boresight (m, computed in the shader; 0 for sky).
+boresight (m, computed in the shader; 0 for sky). It is read back through a pixel buffer,
+asynchronously: `render_sequence` draws each frame before handing over the previous one.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from __future__ import annotations
 import ctypes
 import os
 import sys
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from importlib import resources
 
@@ -193,6 +195,9 @@ class _GLScene:
         self.vertex_textures = list(gl.glGenTextures(2))
         self._allocate(_INITIAL_SLOTS)
         self._framebuffer()
+        self.image_bytes = width * height * 2 * 4  # (radiance, depth) float32
+        self.pixel_buffers: list[int] = []
+        self.free_pixel_buffers: list[int] = []
         gl.glUseProgram(self.program)
         self.uniform("vertex_position_lit", 0)
         self.uniform("vertex_normal", 1)
@@ -255,9 +260,10 @@ class _GLScene:
         else:
             gl.glUniform3f(loc, *(float(x) for x in np.asarray(value, np.float32)))
 
-    def draw(self, instances: np.ndarray, uniforms: dict) -> np.ndarray:
-        """One instanced draw of `instances` ((n, 4) float32: offset from the camera, slot);
-        returns the (H, W, 2) float32 image, top row first."""
+    def draw(self, instances: np.ndarray, uniforms: dict) -> int:
+        """Issues one instanced draw of `instances` ((n, 4) float32: offset from the camera,
+        slot) and the read-back of its image into a pixel buffer; returns that buffer, for
+        `image`. The GPU goes on alone: the caller can prepare the next frame meanwhile."""
         from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels
 
         gl = self.gl
@@ -280,9 +286,34 @@ class _GLScene:
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
             gl.glBufferData(gl.GL_ARRAY_BUFFER, instances.nbytes, instances, gl.GL_STREAM_DRAW)
             gl.glDrawElementsInstanced(gl.GL_TRIANGLES, self.n_indices, gl.GL_UNSIGNED_INT, None, len(instances))
+        if self.free_pixel_buffers:
+            pixels = self.free_pixel_buffers.pop()
+        else:  # one per frame in flight (two at most in a render stage)
+            pixels = gl.glGenBuffers(1)
+            gl.glBindBuffer(gl.GL_PIXEL_PACK_BUFFER, pixels)
+            gl.glBufferData(gl.GL_PIXEL_PACK_BUFFER, self.image_bytes, None, gl.GL_STREAM_READ)
+            self.pixel_buffers.append(pixels)
+        gl.glBindBuffer(gl.GL_PIXEL_PACK_BUFFER, pixels)
+        # The raw entry point: PyOpenGL's wrapper knows no GL_RG; with a pack buffer bound
+        # the pointer is an offset into it, and the copy is the GPU's, asynchronous.
+        raw_read_pixels(0, 0, self.width, self.height, gl.GL_RG, gl.GL_FLOAT, ctypes.c_void_p(0))
+        gl.glBindBuffer(gl.GL_PIXEL_PACK_BUFFER, 0)
+        gl.glFlush()  # starts the GPU now, not at the next command
+        return pixels
+
+    def image(self, pixels: int) -> np.ndarray:
+        """The (H, W, 2) float32 image a `draw` read back into `pixels`, top row first;
+        waits for the GPU where it has not finished. The buffer is free again after."""
+        gl = self.gl
         image = np.empty((self.height, self.width, 2), dtype=np.float32)
-        # The raw entry point: PyOpenGL's wrapper knows no GL_RG, and this one fills our array.
-        raw_read_pixels(0, 0, self.width, self.height, gl.GL_RG, gl.GL_FLOAT, image)
+        gl.glBindBuffer(gl.GL_PIXEL_PACK_BUFFER, pixels)
+        address = gl.glMapBufferRange(gl.GL_PIXEL_PACK_BUFFER, 0, self.image_bytes, gl.GL_MAP_READ_BIT)
+        if not address:
+            raise RuntimeError("OpenGL: the read-back buffer could not be mapped")
+        ctypes.memmove(image.ctypes.data, address, self.image_bytes)
+        gl.glUnmapBuffer(gl.GL_PIXEL_PACK_BUFFER)
+        gl.glBindBuffer(gl.GL_PIXEL_PACK_BUFFER, 0)
+        self.free_pixel_buffers.append(pixels)
         return image[::-1]  # OpenGL's first row is the bottom one (a view: no copy)
 
     def delete(self) -> None:
@@ -291,6 +322,8 @@ class _GLScene:
         gl.glDeleteRenderbuffers(2, [self.colour, self.depth])
         gl.glDeleteTextures(self.vertex_textures)
         gl.glDeleteBuffers(4, [*self.vertex_buffers, self.index_buffer, self.instance_buffer])
+        if self.pixel_buffers:
+            gl.glDeleteBuffers(len(self.pixel_buffers), self.pixel_buffers)
         gl.glDeleteVertexArrays(1, [self.vao])
         gl.glDeleteProgram(self.program)
 
@@ -366,12 +399,31 @@ class TerrainRenderer:
         return self._slots[key]
 
     def render(self, pose: CameraPose) -> Frame:
+        return self._finish(self._start(pose))
+
+    def render_sequence(self, poses: Iterable[CameraPose]) -> Iterator[Frame]:
+        """The frames of `poses` in order, as `render` draws them, one drawn ahead: each pose
+        is drawn and its read-back started before the previous frame is handed over, so the
+        GPU works while the caller handles that frame. `render` may be called in between."""
+        ahead = None
+        for pose in poses:
+            started = self._start(pose)
+            if ahead is not None:
+                yield self._finish(ahead)
+            ahead = started
+        if ahead is not None:
+            yield self._finish(ahead)
+
+    def _start(self, pose: CameraPose) -> tuple:
+        """Selects, uploads and draws `pose`'s tiles; the read-back runs on (`_finish`)."""
         keys = self.tiles.select(pose, self.camera)
         self._frame_count += 1
         self._platform.make_current()
         slots = [self._slot(key) for key in keys]
         for key in keys:
             self._last_used[key] = self._frame_count
+        # Slots freed here may still feed a frame in flight: OpenGL runs the commands in
+        # order, so that frame's draw reads them before a later upload overwrites them.
         self._evict()
         offsets, radii = self.tiles.offsets(keys, pose.position)
         dists = np.linalg.norm(offsets, axis=1)
@@ -386,12 +438,16 @@ class TerrainRenderer:
             "P": projection_matrix(self.camera, near, far),
             "boresight": np.asarray(pose.rotation, float)[:, 2],
         }
-        image = self._gl.draw(instances, uniforms)
-        n_tri = len(keys) * self._gl.n_indices // 3
+        return pose, self._gl.draw(instances, uniforms), len(keys)
+
+    def _finish(self, started: tuple) -> Frame:
+        pose, pixels, n_tiles = started
+        self._platform.make_current()
+        image = self._gl.image(pixels)
         radiance, depth = image[..., 0], image[..., 1]
         if self.stars is not None:
             radiance = add_stars(radiance, depth, self.stars, self.camera, pose)
-        return Frame(radiance, depth, len(keys), n_tri)
+        return Frame(radiance, depth, n_tiles, n_tiles * self._gl.n_indices // 3)
 
     @property
     def n_uploaded(self) -> int:

@@ -209,11 +209,13 @@ def render_trajectory(
         VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview,
     ):
         log(f"  OpenGL: {renderer.backend} ({renderer.gl_renderer})")
-        frame = None
+        # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
+        moved = [k == 0 or not np.array_equal(tr.state[k, POSE], tr.state[k - 1, POSE]) for k in range(n)]
+        # Drawn one ahead: the GPU draws pose k+1 while this loop writes frame k.
+        drawn = renderer.render_sequence(camera.pose(tr.state[k]) for k in range(n) if moved[k])
         for k in range(n):
-            # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
-            if frame is None or not np.array_equal(tr.state[k, POSE], tr.state[k - 1, POSE]):
-                frame = renderer.render(camera.pose(tr.state[k]))
+            if moved[k]:
+                frame = next(drawn)
                 triangles += frame.n_triangles
             else:
                 reused += 1
