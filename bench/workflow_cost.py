@@ -72,8 +72,15 @@ def cpu_seconds(command: list[str]) -> tuple[float, float]:
     return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), time.perf_counter() - start
 
 
+def traj2events_cli() -> list[str]:
+    """The installed `traj2events` script beside this Python, else `python -m traj2events`
+    (a checkout on PYTHONPATH, not installed)."""
+    script = Path(sys.executable).parent / "traj2events"
+    return [str(script)] if script.exists() else [sys.executable, "-m", "traj2events"]
+
+
 def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_every: int) -> dict[str, list[str]]:
-    cli = [str(Path(sys.executable).parent / "traj2events")]
+    cli = traj2events_cli()
     camera, events = config["camera"], config["events"]
     settings = RenderSettings.from_config(config, scenario).to_json()
     frames = folder / "frames.h5"
