@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Iterator
 
 import numpy as np
+from numba import njit
 
 from .atomic import atomic_output, ensure_free_space
 from .hdf5 import (
@@ -30,18 +31,35 @@ from .hdf5 import (
 )
 
 
-def round_mantissa(x: np.ndarray, bits: int = 16) -> np.ndarray:
+def round_mantissa(x: np.ndarray, bits: int = 16, out: np.ndarray | None = None) -> np.ndarray:
     """float32 rounded to `bits` significant bits (relative step 2^-bits): values keep far
-    more than 12 bits at any brightness, and the dropped low bits compress to nothing."""
-    a = np.ascontiguousarray(x, dtype=np.float32)
+    more than 12 bits at any brightness, and the dropped low bits compress to nothing.
+    Rounding adds half a step to the bit pattern and clears the dropped bits; inf and NaN
+    stay as they were. One compiled pass from any strides (the renderer's frames are
+    strided views) into `out` (C-contiguous float32 of x's shape; None: a new array)."""
+    a = np.asarray(x, dtype=np.float32)
+    if out is None:
+        out = np.empty(a.shape, np.float32)
+    elif out.shape != a.shape or out.dtype != np.float32 or not out.flags.c_contiguous:
+        raise ValueError(f"round_mantissa: out must be C-contiguous float32 of shape {a.shape}")
+    rows = a.reshape(-1, a.shape[-1]) if a.ndim >= 2 else a.reshape(1, -1)
     drop = 24 - bits
-    rounded = a.view(np.uint32) + np.uint32(1 << (drop - 1))  # the one full-size temporary: in place after
-    rounded &= np.uint32((0xFFFFFFFF << drop) & 0xFFFFFFFF)
-    out = rounded.view(np.float32)
-    special = ~np.isfinite(a)
-    if special.any():
-        out[special] = a[special]  # inf and NaN as they were
+    _round_rows(
+        rows.view(np.uint32),
+        out.reshape(rows.shape).view(np.uint32),
+        1 << (drop - 1),
+        (0xFFFFFFFF << drop) & 0xFFFFFFFF,
+    )
     return out
+
+
+@njit(cache=True, nogil=True)
+def _round_rows(pattern, out, half, keep):  # pragma: no cover (compiled)
+    for i in range(pattern.shape[0]):
+        for j in range(pattern.shape[1]):
+            v = pattern[i, j]
+            # All exponent bits set: inf or NaN, kept. A finite pattern + half never passes 2^32.
+            out[i, j] = v if (v & 0x7F800000) == 0x7F800000 else (v + half) & keep
 
 
 class FramesWriter:
@@ -68,6 +86,8 @@ class FramesWriter:
             for name in ("radiance", "depth_m")
         }
         self._writers = {name: ChunkWriter(dataset) for name, dataset in self._sets.items()}
+        # Rounded into one buffer per image, reused: compressed before the next frame comes.
+        self._rounded = {name: np.empty((height, width), np.float32) for name in self._sets}
         self._attrs = attrs
 
     def append(self, t_s: float, frame_index: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
@@ -76,7 +96,7 @@ class FramesWriter:
         with write_errors_named(self.path):
             for name, image in (("radiance", radiance), ("depth_m", depth_m)):
                 self._sets[name].resize(i + 1, axis=0)
-                self._writers[name][i] = round_mantissa(image)
+                self._writers[name][i] = round_mantissa(image, out=self._rounded[name])
         self._t.append(float(t_s))
         self._frame_index.append(int(frame_index))
 
