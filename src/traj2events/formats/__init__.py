@@ -5,6 +5,7 @@ of the pipeline never loads the solver or the renderer.
     hdf5        byte-reproducible HDF5 files, datasets and attributes
     trajectory  base.h5, solutions.h5, trajectory.h5 (nodes, poses, vehicle constants)
     frames      frames.h5 (linear radiance and depth per frame)
+    rounding    frames.h5's mantissa rounding, compiled (numba: for writing only)
     flow        motion_field.h5 and Middlebury .flo
     events      the event dtype and events.h5 (DSEC layout)
     exports     the ELOPE-style .npz, EVT 3.0 and AEDAT4

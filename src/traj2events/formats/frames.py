@@ -14,7 +14,6 @@ from pathlib import Path
 from typing import Iterator
 
 import numpy as np
-from numba import njit
 
 from .atomic import atomic_output, ensure_free_space
 from .hdf5 import (
@@ -42,24 +41,17 @@ def round_mantissa(x: np.ndarray, bits: int = 16, out: np.ndarray | None = None)
         out = np.empty(a.shape, np.float32)
     elif out.shape != a.shape or out.dtype != np.float32 or not out.flags.c_contiguous:
         raise ValueError(f"round_mantissa: out must be C-contiguous float32 of shape {a.shape}")
+    from .rounding import round_rows  # numba: loaded for writing only, never for reading
+
     rows = a.reshape(-1, a.shape[-1]) if a.ndim >= 2 else a.reshape(1, -1)
     drop = 24 - bits
-    _round_rows(
+    round_rows(
         rows.view(np.uint32),
         out.reshape(rows.shape).view(np.uint32),
         1 << (drop - 1),
         (0xFFFFFFFF << drop) & 0xFFFFFFFF,
     )
     return out
-
-
-@njit(cache=True, nogil=True)
-def _round_rows(pattern, out, half, keep):  # pragma: no cover (compiled)
-    for i in range(pattern.shape[0]):
-        for j in range(pattern.shape[1]):
-            v = pattern[i, j]
-            # All exponent bits set: inf or NaN, kept. A finite pattern + half never passes 2^32.
-            out[i, j] = v if (v & 0x7F800000) == 0x7F800000 else (v + half) & keep
 
 
 class FramesWriter:
