@@ -31,11 +31,12 @@ from .hdf5 import (
 
 
 def round_mantissa(x: np.ndarray, bits: int = 16, out: np.ndarray | None = None) -> np.ndarray:
-    """float32 rounded to `bits` significant bits (relative step 2^-bits): values keep far
-    more than 12 bits at any brightness, and the dropped low bits compress to nothing.
-    Rounding adds half a step to the bit pattern and clears the dropped bits; inf and NaN
-    stay as they were. One compiled pass from any strides (the renderer's frames are
-    strided views) into `out` (C-contiguous float32 of x's shape; None: a new array)."""
+    """float32 rounded to `bits` significant bits (a relative step of 2^(1-bits) at most,
+    an error of half that): values keep far more than 12 bits at any brightness, and the
+    dropped low bits compress to nothing. Rounding adds half a step to the bit pattern and
+    clears the dropped bits; inf and NaN stay as they were. One compiled pass from any
+    strides (the renderer's frames are strided views) into `out` (C-contiguous float32 of
+    x's shape; None: a new array)."""
     a = np.asarray(x, dtype=np.float32)
     if out is None:
         out = np.empty(a.shape, np.float32)
