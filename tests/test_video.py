@@ -78,3 +78,20 @@ def test_display_gamma_below_one_takes_the_law():
     assert _display_steps(40.0, 0.5) is None
     radiance = np.linspace(-1, 50, 1001, dtype=np.float32)
     np.testing.assert_array_equal(display_frame(radiance, 40.0, 0.5), display_code(radiance, 40.0, 0.5))
+
+
+def test_the_pipe_to_ffmpeg_holds_a_whole_frame(tmp_path):
+    """A 1024^2 frame fits the pipe at once (a write need not wait for ffmpeg to read);
+    small frames keep the default pipe, never a smaller one."""
+    from traj2events.video import pipe_bytes
+
+    with VideoWriter(tmp_path / "big.mkv", 1024, 1024, 100.0) as video:
+        size = pipe_bytes(video._process.stdin.fileno())
+        if size is None:
+            pytest.skip("no F_GETPIPE_SZ on this system")
+        assert size >= 1024 * 1024
+        video.write(np.zeros((1024, 1024), np.uint8))
+    with VideoWriter(tmp_path / "small.mkv", 40, 24, 100.0) as video:
+        assert pipe_bytes(video._process.stdin.fileno()) >= 65536
+        video.write(np.zeros((24, 40), np.uint8))
+    np.testing.assert_array_equal(read_video(tmp_path / "big.mkv"), np.zeros((1, 1024, 1024), np.uint8))

@@ -87,6 +87,34 @@ def _codes_from_steps(bits, codes, step_bits, bucket_codes, first_bucket):  # pr
             codes[i, j] = code
 
 
+_PIPE_MAX_BYTES = 1 << 20  # Linux's default limit for unprivileged pipes (/proc/sys/fs/pipe-max-size)
+
+
+def pipe_bytes(fd: int) -> int | None:
+    """A pipe's capacity in bytes (Linux's F_GETPIPE_SZ), or None where it cannot be read."""
+    try:
+        import fcntl
+
+        return fcntl.fcntl(fd, getattr(fcntl, "F_GETPIPE_SZ", 1032))
+    except (ImportError, OSError):
+        return None
+
+
+def _widen_pipe(fd: int, frame_bytes: int) -> None:
+    """Make the pipe to ffmpeg hold a whole frame (up to 1 MiB, Linux's default limit), so
+    that a write returns while ffmpeg still encodes the frame before: a 64 KiB pipe passes a
+    1024^2 frame in 16 hand-overs between the processes. Elsewhere the pipe stays as it is."""
+    current = pipe_bytes(fd)
+    if current is None or current >= frame_bytes:
+        return
+    try:
+        import fcntl
+
+        fcntl.fcntl(fd, getattr(fcntl, "F_SETPIPE_SZ", 1031), min(frame_bytes, _PIPE_MAX_BYTES))
+    except OSError:  # over a lowered system limit: the default pipe works, only slower
+        pass
+
+
 class VideoWriter:
     """Streams 8-bit grey frames into a video file; written under a temporary name and
     renamed on close, so an interrupted run leaves nothing behind.
@@ -123,6 +151,7 @@ class VideoWriter:
         self._errors = tempfile.TemporaryFile()
         command = out.overwrite_output().global_args("-loglevel", "error").compile()
         self._process = subprocess.Popen(command, stdin=subprocess.PIPE, stderr=self._errors)
+        _widen_pipe(self._process.stdin.fileno(), width * height)
         self.n_frames = 0
 
     def write(self, frame: np.ndarray) -> None:
@@ -130,7 +159,7 @@ class VideoWriter:
         if frame.shape != (self.height, self.width):
             raise ValueError(f"{self.path}: expected a {self.height} x {self.width} frame, got {frame.shape}")
         try:
-            self._process.stdin.write(frame.tobytes())
+            self._process.stdin.write(frame.data)  # the array's own bytes: no copy
         except BrokenPipeError:
             raise OSError(f"{self.path}: ffmpeg stopped reading frames: {self._error_text()}") from None
         self.n_frames += 1
