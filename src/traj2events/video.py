@@ -95,8 +95,8 @@ def pipe_bytes(fd: int) -> int | None:
     try:
         import fcntl
 
-        return fcntl.fcntl(fd, getattr(fcntl, "F_GETPIPE_SZ", 1032))
-    except (ImportError, OSError):
+        return fcntl.fcntl(fd, fcntl.F_GETPIPE_SZ)  # Linux only (Python >= 3.10 names it)
+    except (ImportError, AttributeError, OSError):
         return None
 
 
@@ -110,7 +110,7 @@ def _widen_pipe(fd: int, frame_bytes: int) -> None:
     try:
         import fcntl
 
-        fcntl.fcntl(fd, getattr(fcntl, "F_SETPIPE_SZ", 1031), min(frame_bytes, _PIPE_MAX_BYTES))
+        fcntl.fcntl(fd, fcntl.F_SETPIPE_SZ, min(frame_bytes, _PIPE_MAX_BYTES))
     except OSError:  # over a lowered system limit: the default pipe works, only slower
         pass
 
