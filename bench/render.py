@@ -18,6 +18,7 @@ and the paper config's cost (500 trajectories x ~7500 frames).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import platform
 import statistics
@@ -63,20 +64,30 @@ def poses(state: np.ndarray, n: int, fps: float = 100.0) -> list:
     return out
 
 
-def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backend):
+@contextlib.contextmanager
+def stretch_renderer(state, sun, extent, size, n_frames, budget, backend, terrain=None):
+    """A renderer over one case's stretch of `n_frames` poses (`size`^2, 45 deg field of
+    view, Hapke, `budget` px/cell), every tile the stretch needs built beforehand, as a
+    trajectory's first frames would: yields (renderer, poses, seconds the tiles took to
+    build). `terrain`: one shared between calls (None: seed 1's)."""
     camera = Camera(size, size, 45.0)
-    terrain = ProceduralTerrain(TerrainParams(seed=1))
+    terrain = ProceduralTerrain(TerrainParams(seed=1)) if terrain is None else terrain
+    tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
     path = poses(state, n_frames)
+    with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as renderer:
+        start = time.perf_counter()
+        for pose in path:
+            tiles.select(pose, camera)
+        yield renderer, path, time.perf_counter() - start
+
+
+def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backend):
+    terrain = ProceduralTerrain(TerrainParams(seed=1))
     results = {}
     for budget in [reference, *budgets]:
-        tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
-        with TerrainRenderer(
-            tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend
-        ) as renderer:
-            start = time.perf_counter()
-            for pose in path:  # build every tile the stretch needs
-                tiles.select(pose, camera)
-            build_s = time.perf_counter() - start
+        stretch = stretch_renderer(state, sun, extent, size, n_frames, budget, backend, terrain)
+        with stretch as (renderer, path, build_s):
+            tiles, camera = renderer.tiles, renderer.camera
             drawn_by = f"{renderer.backend}: {renderer.gl_renderer}"
             renderer.render(path[0])  # upload
             times, frame = [], None

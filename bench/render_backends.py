@@ -26,13 +26,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from render import CASES, R_MOON, poses  # noqa: E402  (bench/render.py)
-
-from traj2events.camera import Camera  # noqa: E402
-from traj2events.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.tiles import LodSettings, TileSet  # noqa: E402
+from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
 
 FRAME = 10  # of the stretch: tiles and buffers are warm by then
 NAMES = ("braking", "descent")
@@ -40,14 +34,8 @@ NAMES = ("braking", "descent")
 
 def save(folder: Path, backend: str, size: int, budget: float) -> None:
     folder.mkdir(parents=True, exist_ok=True)
-    camera = Camera(size, size, 45.0)
     for name, (state, sun, extent) in zip(NAMES, CASES.values()):
-        terrain = ProceduralTerrain(TerrainParams(seed=1))
-        tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
-        path = poses(state, 2 * FRAME)
-        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as r:
-            for pose in path:
-                tiles.select(pose, camera)
+        with stretch_renderer(state, sun, extent, size, 2 * FRAME, budget, backend) as (r, path, _):
             times, kept = [], None
             for k, pose in enumerate(path):
                 start = time.perf_counter()

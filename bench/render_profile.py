@@ -24,13 +24,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from render import CASES, R_MOON, poses  # noqa: E402  (bench/render.py)
-
-from traj2events.camera import Camera  # noqa: E402
-from traj2events.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.tiles import LodSettings, TileSet  # noqa: E402
+from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
 
 
 def timed(log: list[float], function):
@@ -52,15 +46,9 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=1024)
     args = parser.parse_args()
     os.environ.setdefault("LP_NUM_THREADS", "1")
-    camera = Camera(args.size, args.size, 45.0)
     for name, (state, sun, extent) in CASES.items():
-        tiles = TileSet(ProceduralTerrain(TerrainParams(seed=1)), sun.direction, R_MOON, extent, LodSettings())
-        path = poses(state, args.frames)
-        with TerrainRenderer(
-            tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=args.backend
-        ) as r:
-            for pose in path:
-                tiles.select(pose, camera)
+        with stretch_renderer(state, sun, extent, args.size, args.frames, 2.0, args.backend) as (r, path, _):
+            tiles = r.tiles
             for pose in path[:5]:
                 r.render(pose)  # uploads, compiles
             total, start, finish, select = [], [], [], []

@@ -29,23 +29,10 @@ def draw_stretch(backend: str, size: int, n_frames: int, barrier) -> list[float]
     """Seconds of each render call along the braking stretch, after all workers are ready."""
     os.environ.setdefault("LP_NUM_THREADS", "1")
     sys.path.insert(0, str(BENCH))
-    from render import CASES, R_MOON, poses  # bench/render.py (it puts src on the path)
-
-    from traj2events.camera import Camera
-    from traj2events.reflectance import ReflectanceParams
-    from traj2events.render import TerrainRenderer
-    from traj2events.terrain import ProceduralTerrain, TerrainParams
-    from traj2events.tiles import LodSettings, TileSet
+    from render import CASES, stretch_renderer  # bench/render.py (it puts src on the path)
 
     state, sun, extent = next(iter(CASES.values()))
-    camera = Camera(size, size, 45.0)
-    tiles = TileSet(
-        ProceduralTerrain(TerrainParams(seed=1)), sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=2.0)
-    )
-    path = poses(state, n_frames)
-    with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as r:
-        for pose in path:
-            tiles.select(pose, camera)
+    with stretch_renderer(state, sun, extent, size, n_frames, 2.0, backend) as (r, path, _):
         r.render(path[0])  # uploads every tile of the first frame
         barrier.wait()
         times = []
