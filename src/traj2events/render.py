@@ -436,7 +436,6 @@ class TerrainRenderer:
             **self._uniforms,
             "V": view_rotation(pose),
             "P": projection_matrix(self.camera, near, far),
-            "boresight": np.asarray(pose.rotation, float)[:, 2],
         }
         return pose, self._gl.draw(instances, uniforms), len(keys)
 

@@ -12,7 +12,6 @@ uniform int vertices_per_tile;              // a slot's vertices: every tile has
 uniform mat4 V;            // the view rotation only (camera at the origin)
 uniform mat4 P;
 
-out vec3 frag_offset;   // world position minus camera position (m), kept small for precision
 out float frag_radiance;
 out float frag_lit;
 
@@ -46,9 +45,10 @@ void main()
 {
     int vertex = int(tile.w) * vertices_per_tile + gl_VertexID;
     vec4 position_lit = texelFetch(vertex_position_lit, vertex);
-    frag_offset = position_lit.xyz + tile.xyz;   // tiles are only translated
+    // World position minus camera position (m), kept small for precision; tiles are only translated.
+    vec3 offset = position_lit.xyz + tile.xyz;
     vec3 n = normalize(texelFetch(vertex_normal, vertex).xyz);
-    vec3 to_camera = -normalize(frag_offset);
+    vec3 to_camera = -normalize(offset);
     float mu0 = dot(n, sun_dir);
     float mu = dot(n, to_camera);
     float cos_g = clamp(dot(sun_dir, to_camera), -1.0, 1.0);
@@ -68,5 +68,5 @@ void main()
     }
     frag_radiance = rf * irradiance / PI;
     frag_lit = clamp(position_lit.w, 0.0, 1.0);  // from the horizon march
-    gl_Position = P * V * vec4(frag_offset, 1.0);
+    gl_Position = P * V * vec4(offset, 1.0);
 }
