@@ -414,3 +414,28 @@ def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels):
     np.testing.assert_array_equal(events["p"], on[order])
     if labels:
         np.testing.assert_array_equal(out_label, label[order])
+
+
+def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
+    """The kernel reuses the gain along a run of pixels with the same two inputs: every
+    pixel still gets the first-order step of its own pair, as numpy computes it, where a
+    run breaks in either frame alone, on -0.0 and with a scale."""
+    from traj2events.emulator import _NO_TABLE, _advance
+
+    rng = np.random.default_rng(5)
+    i0 = np.repeat(rng.choice([0.0, 0.5, 2.0], 60), rng.integers(1, 6, 60)).astype(np.float32)
+    i1 = i0.copy()
+    i1[::7] = 3.0  # the run breaks in the second frame only
+    i0[3::11] = 1.5  # ... or in the first only
+    i0[5::13] = -0.0
+    n, scale, cutoff_hz, dt = i0.size, 41.0, 3.0, 0.01
+    filtered, base = rng.uniform(0.0, 5.0, n), np.zeros(n)
+    f0 = filtered.copy()
+    theta = np.full(n, 100.0, np.float32)  # no crossings: only the low-pass is looked at
+    work = [np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
+    _advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), cutoff_hz, dt, scale,
+             *work, _NO_TABLE, _NO_TABLE, _NO_TABLE, np.zeros(n, np.int64))  # fmt: skip
+    dn0, dn1 = i0.astype(np.float64) * scale, i1.astype(np.float64) * scale
+    target = np.where(dn1 <= 20.0, dn1 * (np.log(20.0) / 20.0), np.log(np.maximum(dn1, 20.0)))
+    gain = -np.expm1(-(2.0 * np.pi * dt) * (cutoff_hz * (0.5 * (dn0 + dn1) + 20.0) / 275.0))
+    np.testing.assert_array_equal(filtered, f0 + gain * (target - f0))

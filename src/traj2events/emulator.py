@@ -134,12 +134,15 @@ def _advance(
     their count, x0 and x1 in the same slots (only those: less memory traffic than full
     frames); returns how many. For 8-bit input the log and the gain come from tables
     (`log_lut[I]`, `gain_lut[I0 + I1]`: every value they can take), else (empty tables)
-    they are computed per pixel."""
+    they are computed per pixel, the gain reused while a run of pixels has the same two
+    inputs (shadows and sky are runs of zeros: half a low-Sun frame)."""
     knee_slope = np.log(KNEE_DN) / KNEE_DN
     two_pi_dt = 2.0 * np.pi * dt
     tables = log_lut.size > 0
     labels = leak_drift.size > 0
     n_active = 0
+    run0 = run1 = np.float64(np.nan)  # the inputs of the last gain computed (NaN: none yet)
+    run_gain = 1.0
     for i in range(intensity1.size):
         if tables:
             target = log_lut[np.int64(intensity1[i])]
@@ -147,11 +150,14 @@ def _advance(
         else:
             i1 = np.float64(intensity1[i]) * scale
             target = i1 * knee_slope if i1 <= KNEE_DN else np.log(i1)
-            if cutoff_hz > 0.0:
+            if cutoff_hz <= 0.0:
+                gain = 1.0
+            elif intensity0[i] == run0 and intensity1[i] == run1:
+                gain = run_gain  # the same inputs give the same bits: expm1 is the costly part
+            else:
                 f_c = cutoff_hz * (0.5 * (np.float64(intensity0[i]) * scale + i1) + 20.0) / 275.0
                 gain = -np.expm1(-two_pi_dt * f_c)
-            else:
-                gain = 1.0
+                run0, run1, run_gain = intensity0[i], intensity1[i], gain
         f0 = filtered[i]
         f1 = f0 + gain * (target - f0)
         a = f0 - base[i]
