@@ -9,6 +9,11 @@ timed) and `_finish` (waiting for the read-back and copying it out, stars). Then
 top functions over the same frames. On a GPU, `_finish` is the GPU's time the CPU still
 waits for; on OSMesa the read-back into the pixel buffer is synchronous, so llvmpipe's
 drawing falls in `_start`.
+
+Also, where the extension exists (llvmpipe has it), OpenGL's pipeline statistics of one
+frame (vertices shaded, triangles in and out of clipping, fragment-shader invocations:
+llvmpipe counts the 16 lanes of every 4 x 4 block it shades), and the median frame with
+the rasteriser discarding everything: the vertex stage alone (shading, clipping).
 """
 
 from __future__ import annotations
@@ -39,6 +44,50 @@ def timed(log: list[float], function):
     return wrapper
 
 
+STATISTICS = (
+    "VERTICES_SUBMITTED",
+    "VERTEX_SHADER_INVOCATIONS",
+    "CLIPPING_INPUT_PRIMITIVES",
+    "CLIPPING_OUTPUT_PRIMITIVES",
+    "FRAGMENT_SHADER_INVOCATIONS",
+)
+
+
+def pipeline_statistics(render) -> dict[str, int]:
+    """ARB_pipeline_statistics_query's counts over `render()` (empty where the context
+    lacks the extension)."""
+    from OpenGL import GL as gl
+    from OpenGL.GL.ARB import pipeline_statistics_query as arb
+
+    if not arb.glInitPipelineStatisticsQueryARB():
+        return {}
+    queries = gl.glGenQueries(len(STATISTICS))
+    for query, name in zip(queries, STATISTICS):
+        gl.glBeginQuery(getattr(arb, f"GL_{name}_ARB"), query)
+    render()
+    for name in STATISTICS:
+        gl.glEndQuery(getattr(arb, f"GL_{name}_ARB"))
+    counts = {name.lower(): int(gl.glGetQueryObjectuiv(q, gl.GL_QUERY_RESULT)) for q, name in zip(queries, STATISTICS)}
+    gl.glDeleteQueries(len(queries), queries)
+    return counts
+
+
+def vertex_stage_ms(renderer, path) -> float:
+    """Median ms per frame with GL_RASTERIZER_DISCARD: vertex shading and clipping only."""
+    from OpenGL import GL as gl
+
+    times = []
+    gl.glEnable(gl.GL_RASTERIZER_DISCARD)
+    try:
+        for pose in path:
+            start = time.perf_counter()
+            renderer.render(pose)
+            times.append(time.perf_counter() - start)
+    finally:
+        gl.glDisable(gl.GL_RASTERIZER_DISCARD)
+    return 1e3 * statistics.median(times)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--backend", default="auto", help="auto, egl or osmesa")
@@ -62,6 +111,10 @@ def main() -> None:
                 f"{frame.n_triangles} triangles; median ms per frame: render {ms['total']:.2f} = start "
                 f"{ms['start']:.2f} (selection {1e3 * statistics.median(select):.2f}) + finish {ms['finish']:.2f}"
             )
+            counts = pipeline_statistics(lambda: r.render(path[len(path) // 2]))
+            if counts:
+                print("pipeline statistics of one frame: " + ", ".join(f"{k} {v}" for k, v in counts.items()))
+                print(f"vertex stage alone (rasteriser discarding): {vertex_stage_ms(r, path):.2f} ms per frame")
             profile = cProfile.Profile()
             profile.enable()
             for pose in path:
