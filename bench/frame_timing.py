@@ -12,7 +12,11 @@ flight's frame counts (fixed and adaptive alike) and their pooled events weigh e
 of the flight by its events: the comparison at equal frames that clips within one phase
 cannot make (there a flight's motion hardly changes, and adaptive timing spends frames as
 a fixed rate would). For each adaptive bound it also prints the fixed rate's error at the
-same frame count, interpolated log-log between the fixed rates around it.
+same frame count, interpolated log-log between the fixed rates around it. And a bound on
+what any timing rule can buy there: the best fixed rate per window, chosen knowing every
+window's errors (a small knapsack), for the smallest pooled median at no more frames than
+fixed 100 fps. A rule that sets its rate from the scene cannot beat that by much: it can
+only also vary the rate inside a 0.2 s window.
 
 --whole: the render stage itself (`stages.render.render_trajectory`) over whole
 trajectories with fixed timing and with each adaptive bound: frames rendered, seconds,
@@ -23,7 +27,8 @@ Clips of 1 s of each trajectory: mid-flight (from t_f / 2) and the last second b
 touchdown. For each clip, events of the clean preset (no noise, so noise does not hide
 timing) from the linear radiance of:
   - a dense reference rendered at --reference-fps;
-  - fixed 50, 100, 200 and 400 fps (every n-th frame of the reference: the same renders);
+  - fixed 50, 80, 100, 125, 200, 250, 400, 500 and 1000 fps (every n-th frame of the
+    reference: the same renders);
   - adaptive timing (traj2events.frame_timing) with several bounds, the fixed --fps frames
     included, rendered at the times it picks.
 Per variant: frames, render seconds (fixed: frames x the reference's mean seconds per
@@ -59,7 +64,7 @@ from traj2events.render import TerrainRenderer  # noqa: E402
 from traj2events.stages.render import RenderSettings, render_between  # noqa: E402
 from traj2events.upsample import ReintegratedStates  # noqa: E402
 
-FIXED_FPS = (50, 100, 200, 400)
+FIXED_FPS = (50, 80, 100, 125, 200, 250, 400, 500, 1000)
 ADAPTIVE = {
     "adaptive, log 2": FrameTiming("adaptive", max_log_change=2.0),
     "adaptive, log 1": FrameTiming("adaptive", max_log_change=1.0),
@@ -324,6 +329,56 @@ def print_pooled(pooled: dict[str, list[dict]], title: str = "all clips", window
             same = ", ".join(f"{x:.0f}" for x in interpolate_fixed(fixed, frames)) if fixed else ""
         print(f"| {name} | {frames} | {frames / base:.2f} | {events:+.1%} | {summary[name][1]:.0f} | "
               f"{summary[name][2]:.0f} | {same} |")  # fmt: skip
+    if windows:
+        rates, dt = best_rate_per_window(pooled, base, closing)
+        frames = sum(pooled[r][w]["stream"].frames - closing for w, r in enumerate(rates))
+        used = ", ".join(
+            f"{rates.count(r)} at {r.split()[1]}" for r in dict.fromkeys(sorted(rates, key=lambda r: int(r.split()[1])))
+        )
+        print(f"| best fixed rate per window, knowing the errors ({used}) | {frames} | {frames / base:.2f} | "
+              f"| {np.median(dt):.0f} | {np.percentile(dt, 90):.0f} | |")  # fmt: skip
+
+
+def best_rate_per_window(pooled: dict[str, list[dict]], budget: int, closing: int) -> tuple[list[str], np.ndarray]:
+    """The fixed rate for each window (names of `pooled`'s fixed rows, window by window)
+    whose pooled events have the smallest median |dt| with at most `budget` frames in all,
+    and those events' |dt|. For a candidate median m, a knapsack over the windows (frames
+    as weights) finds the schedule with the fewest events above m less half the events;
+    the median is at most m where that is <= 0. m is bisected over the values seen."""
+    rates = [k for k in pooled if k.startswith("fixed")]
+    n_windows = len(pooled[rates[0]])
+    frames = np.array([[pooled[r][w]["stream"].frames - closing for r in rates] for w in range(n_windows)])
+    errors = [[np.sort(pooled[r][w]["dt_us"]) for r in rates] for w in range(n_windows)]
+
+    def schedule(m: float) -> tuple[float, list[int]]:
+        """(least sum of events above m less half the events, the rate index per window)."""
+        best = np.full(budget + 1, np.inf)
+        best[0] = 0.0
+        picks = []
+        for w in range(n_windows):
+            cost = [len(e) - np.searchsorted(e, m, side="right") - 0.5 * len(e) for e in errors[w]]
+            new, pick = np.full(budget + 1, np.inf), np.full(budget + 1, -1)
+            for r, (f, c) in enumerate(zip(frames[w], cost)):
+                if f <= budget:
+                    shifted = best[: budget + 1 - f] + c
+                    better = shifted < new[f:]
+                    new[f:][better], pick[f:][better] = shifted[better], r
+            best, picks = new, [*picks, pick]
+        end = int(np.argmin(best))
+        chosen = []
+        for w in reversed(range(n_windows)):  # walk the choices back from the best end state
+            r = int(picks[w][end])
+            chosen.append(r)
+            end -= int(frames[w][r])
+        return float(best.min()), chosen[::-1]
+
+    candidates = np.unique(np.concatenate([e for row in errors for e in row]))
+    lo, hi = 0, len(candidates) - 1
+    while lo < hi:  # the smallest candidate median the budget can reach
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if schedule(float(candidates[mid]))[0] <= 0 else (mid + 1, hi)
+    chosen = schedule(float(candidates[lo]))[1]
+    return [rates[r] for r in chosen], np.concatenate([errors[w][r] for w, r in enumerate(chosen)])
 
 
 def interpolate_fixed(fixed: list[tuple[int, float, float]], frames: int) -> tuple[float, float]:

@@ -1,0 +1,256 @@
+"""Benchmark: a candidate renderer, coarse geometry shaded per pixel from a texture of finer
+levels, against the renderer as it is.
+
+  LP_NUM_THREADS=1 taskset -c 1 python bench/render_textured.py [--frames 10] [--rounds 2]
+
+On OSMesa (llvmpipe), a frame's cost is set by the number of triangles, ~150 ns each on
+one core, and at the default budget of 2 px per cell they are tiny: 1.27 M for 1 M pixels
+(docs/benchmarks.md). The candidate draws the tiles of a coarser budget (8 px per cell)
+and gives each one a texture of the normals and lit fractions of its descendants `finer`
+levels down, built by the same TileSet (`finer` 2: shading every ~2 px, as budget 2). The
+fragment shader evaluates the package's reflectance law per pixel from that texture.
+Geometry, silhouettes and depth stay those of the coarse tiles.
+
+For bench/render.py's two poses: median ms per frame (tiles built and uploaded before; the
+variants alternated over --rounds), triangles, and the error against budget 1 (RMS
+radiance difference over the mean; median relative depth difference). This is a
+measurement of an idea, not a renderer of the package: the shader is assembled here from
+the package's terrain.vert.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from importlib import resources
+from pathlib import Path
+
+os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+os.environ.setdefault("LP_NUM_THREADS", "1")
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import numpy as np  # noqa: E402
+from render import CASES, R_MOON, poses  # noqa: E402  (bench/render.py)
+
+import traj2events.render as render_module  # noqa: E402
+from traj2events.camera import Camera  # noqa: E402
+from traj2events.reflectance import ReflectanceParams  # noqa: E402
+from traj2events.render import TerrainRenderer  # noqa: E402
+from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
+from traj2events.tiles import LodSettings, TileSet  # noqa: E402
+
+VERTEX = """#version 330 core
+layout(location = 0) in vec4 tile;  // per instance: origin minus camera (m), slot
+uniform samplerBuffer vertex_position_lit;
+uniform samplerBuffer vertex_uv;    // per vertex of a tile: where it sits in the shading texture
+uniform int vertices_per_tile;
+uniform mat4 V;
+uniform mat4 P;
+out vec2 uv;
+flat out float layer;
+out vec3 to_camera_m;
+void main()
+{
+    vec3 offset = texelFetch(vertex_position_lit, int(tile.w) * vertices_per_tile + gl_VertexID).xyz + tile.xyz;
+    uv = texelFetch(vertex_uv, gl_VertexID).xy;
+    layer = tile.w;
+    to_camera_m = -offset;
+    gl_Position = P * V * vec4(offset, 1.0);
+}
+"""
+
+
+def fragment_shader() -> str:
+    """The package's reflectance law (terrain.vert's uniforms, functions and per-vertex
+    body), evaluated per pixel with the normal and lit fraction from the texture."""
+    law = (resources.files("traj2events") / "shaders" / "terrain.vert").read_text()
+    head = law[law.index("uniform vec3 sun_dir;") : law.index("void main()")]
+    start, end = "    vec3 n = normalize(texelFetch(vertex_normal, vertex).xyz);\n", "    frag_radiance = rf"
+    if start not in law or end not in law:
+        raise RuntimeError("terrain.vert changed: update bench/render_textured.py's shader assembly")
+    body = law[law.index(start) + len(start) : law.index(end)]
+    body = body.replace("-normalize(offset)", "normalize(to_camera_m)")
+    return (
+        "#version 330 core\nin vec2 uv;\nflat in float layer;\nin vec3 to_camera_m;\n"
+        "uniform sampler2DArray shading;  // per tile: normal xyz, lit fraction\n"
+        "uniform float radiance_max;\nout vec4 frag_color;\n"
+        + head
+        + "void main()\n{\n    vec4 texel = texture(shading, vec3(uv, layer));\n    vec3 n = normalize(texel.xyz);\n"
+        + body
+        + "    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);\n"
+        + "    frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);\n}\n"
+    )
+
+
+def compile_program(gl) -> int:
+    program = gl.glCreateProgram()
+    for kind, text in ((gl.GL_VERTEX_SHADER, VERTEX), (gl.GL_FRAGMENT_SHADER, fragment_shader())):
+        shader = gl.glCreateShader(kind)
+        gl.glShaderSource(shader, text)
+        gl.glCompileShader(shader)
+        if not gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS):
+            raise RuntimeError(gl.glGetShaderInfoLog(shader).decode())
+        gl.glAttachShader(program, shader)
+        gl.glDeleteShader(shader)
+    gl.glLinkProgram(program)
+    if not gl.glGetProgramiv(program, gl.GL_LINK_STATUS):
+        raise RuntimeError(gl.glGetProgramInfoLog(program).decode())
+    return program
+
+
+class TexturedRenderer(TerrainRenderer):
+    """TerrainRenderer whose tiles are shaded from a texture of their descendants `finer`
+    levels down (normals and lit fractions, RGBA16F, one layer per slot)."""
+
+    def __init__(self, tiles: TileSet, camera: Camera, sun, reflectance, finer: int, layers: int = 600):
+        self.finer, self.layers = finer, layers
+        compile_package = render_module._compile_program
+        render_module._compile_program = compile_program
+        try:
+            super().__init__(tiles, camera, sun, reflectance, max_cached_tiles=layers - 100, backend="osmesa")
+        finally:
+            render_module._compile_program = compile_package
+        gl, cells = self._gl.gl, tiles.lod.cells
+        self.side = cells * 2**finer + 1
+        # Each vertex's texture coordinates: grid vertex (i, j) is fine sample 2^finer (i, j);
+        # a skirt vertex takes those of the grid vertex it hangs from (tiles._add_skirts' ring).
+        n = cells + 1
+        index = np.arange(n * n).reshape(n, n)
+        ring = np.concatenate([index[0, :], index[1:, -1], index[-1, -2::-1], index[-2:0:-1, 0]])
+        vertex = np.arange(self._gl.vertices_per_tile)
+        vertex = np.where(vertex < n * n, vertex, ring[np.clip(vertex - n * n, 0, len(ring) - 1)])
+        i, j = np.divmod(vertex, n)
+        uv = np.zeros((len(vertex), 4), np.float32)
+        uv[:, 0] = (j * 2**finer + 0.5) / self.side  # s runs along a row (j)
+        uv[:, 1] = (i * 2**finer + 0.5) / self.side
+        self.uv_buffer, self.uv_texture, self.shading = gl.glGenBuffers(1), *gl.glGenTextures(2)
+        gl.glBindBuffer(gl.GL_TEXTURE_BUFFER, self.uv_buffer)
+        gl.glBufferData(gl.GL_TEXTURE_BUFFER, uv.nbytes, uv, gl.GL_STATIC_DRAW)
+        self._bind()  # leaves unit 3, the texture array, active
+        gl.glActiveTexture(gl.GL_TEXTURE2)
+        gl.glTexBuffer(gl.GL_TEXTURE_BUFFER, gl.GL_RGBA32F, self.uv_buffer)
+        gl.glActiveTexture(gl.GL_TEXTURE3)
+        gl.glTexImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, gl.GL_RGBA16F, self.side, self.side, layers, 0, gl.GL_RGBA,
+                        gl.GL_FLOAT, None)  # fmt: skip
+        parameters = {
+            gl.GL_TEXTURE_MIN_FILTER: gl.GL_LINEAR,
+            gl.GL_TEXTURE_MAG_FILTER: gl.GL_LINEAR,
+            gl.GL_TEXTURE_WRAP_S: gl.GL_CLAMP_TO_EDGE,
+            gl.GL_TEXTURE_WRAP_T: gl.GL_CLAMP_TO_EDGE,
+        }
+        for name, value in parameters.items():
+            gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
+        gl.glUseProgram(self._gl.program)
+        self._gl.uniform("vertex_uv", 2)
+        self._gl.uniform("shading", 3)
+        draw = self._gl.draw
+
+        def draw_textured(instances, uniforms):
+            self._bind()
+            return draw(instances, uniforms)
+
+        self._gl.draw = draw_textured
+
+    def _bind(self) -> None:
+        gl = self._gl.gl
+        gl.glActiveTexture(gl.GL_TEXTURE2)
+        gl.glBindTexture(gl.GL_TEXTURE_BUFFER, self.uv_texture)
+        gl.glActiveTexture(gl.GL_TEXTURE3)
+        gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading)
+
+    def shading_of(self, key) -> np.ndarray:
+        """(side, side, 4) normals and lit fraction of the tile's descendants `finer` levels
+        down (fewer where the quadtree ends, then resampled to the side)."""
+        level, i, j = key
+        k = min(self.finer, self.tiles.max_level() - level)
+        cells, m = self.tiles.lod.cells, 2**k
+        n = cells + 1
+        out = np.zeros((cells * m + 1, cells * m + 1, 4), np.float32)
+        for a in range(m):
+            for b in range(m):
+                t = self.tiles.tile((level + k, i * m + a, j * m + b))
+                block = (slice(a * cells, a * cells + n), slice(b * cells, b * cells + n))
+                out[block + (slice(0, 3),)] = t.normals[: n * n].reshape(n, n, 3)
+                out[block + (3,)] = t.lit[: n * n].reshape(n, n)
+        if len(out) != self.side:
+            pick = np.round(np.linspace(0, len(out) - 1, self.side)).astype(int)
+            out = out[pick][:, pick]
+        return out
+
+    def _slot(self, key):
+        new = key not in self._slots
+        slot = super()._slot(key)
+        if new:
+            if slot >= self.layers:
+                raise RuntimeError(f"more than {self.layers} tiles: raise --layers")
+            gl = self._gl.gl
+            self._bind()
+            gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, slot, self.side, self.side, 1, gl.GL_RGBA,
+                               gl.GL_FLOAT, self.shading_of(key))  # fmt: skip
+        return slot
+
+
+def errors(frame, reference) -> tuple[float, float]:
+    """(RMS radiance difference / mean radiance, median relative depth difference) over the
+    reference's ground pixels."""
+    ground = reference.depth_m > 0
+    radiance = np.sqrt(np.mean((frame.radiance - reference.radiance)[ground] ** 2)) / reference.radiance[ground].mean()
+    return float(radiance), float(np.median(np.abs(frame.depth_m[ground] / reference.depth_m[ground] - 1)))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--frames", type=int, default=10)
+    parser.add_argument("--rounds", type=int, default=2, help="the variants alternated this many times")
+    parser.add_argument("--size", type=int, default=1024)
+    args = parser.parse_args()
+    variants = {  # name: (budget, finer levels for the texture; 0: the package's renderer)
+        "budget 1 (reference)": (1.0, 0),
+        "budget 2 (default)": (2.0, 0),
+        "budget 8": (8.0, 0),
+        "budget 8, texture 2 levels finer": (8.0, 2),
+        "budget 8, texture 3 levels finer": (8.0, 3),
+        "budget 4, texture 1 level finer": (4.0, 1),
+    }
+    camera = Camera(args.size, args.size, 45.0)
+    print("| pose | variant | ms per frame (rounds) | triangles | radiance error | depth error |")
+    print("|---|---|---|---|---|---|")
+    for name, (state, sun, extent) in CASES.items():
+        terrain = ProceduralTerrain(TerrainParams(seed=1))
+        path = poses(state, args.frames)
+        renderers = {}
+        for variant, (budget, finer) in variants.items():
+            tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
+            if finer:
+                renderers[variant] = TexturedRenderer(tiles, camera, sun, ReflectanceParams(), finer)
+            else:
+                renderers[variant] = TerrainRenderer(tiles, camera, sun, ReflectanceParams(), 20000, backend="osmesa")
+        times = {variant: [] for variant in variants}
+        last = {}
+        try:
+            for variant, renderer in renderers.items():
+                for pose in path:
+                    renderer.render(pose)  # tiles built and uploaded
+            for _ in range(args.rounds):
+                for variant, renderer in renderers.items():
+                    per_frame = []
+                    for pose in path:
+                        start = time.perf_counter()
+                        last[variant] = renderer.render(pose)
+                        per_frame.append(time.perf_counter() - start)
+                    times[variant].append(1e3 * statistics.median(per_frame))
+        finally:
+            for renderer in renderers.values():
+                renderer.close()
+        reference = last["budget 1 (reference)"]
+        for variant, frame in last.items():
+            radiance, depth = errors(frame, reference)
+            rounds = " / ".join(f"{t:.1f}" for t in times[variant])
+            print(f"| {name} | {variant} | {rounds} | {frame.n_triangles} | {radiance:.3f} | {depth:.1e} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
