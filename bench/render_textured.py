@@ -15,8 +15,8 @@ For bench/render.py's two poses: median ms per frame (tiles built and uploaded b
 variants alternated over --rounds), seconds of the first pass over the poses (building and
 uploading the tiles, and the shading textures), triangles, and the error against budget 1 (RMS
 radiance difference over the mean; median relative depth difference). This is a
-measurement of an idea, not a renderer of the package: the shader is assembled here from
-the package's terrain.vert.
+measurement of an idea, not a renderer of the package; its fragment shader includes the
+package's reflectance.glsl.
 """
 
 from __future__ import annotations
@@ -26,7 +26,6 @@ import os
 import statistics
 import sys
 import time
-from importlib import resources
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
@@ -39,7 +38,7 @@ from render import CASES, R_MOON, poses  # noqa: E402  (bench/render.py)
 import traj2events.render as render_module  # noqa: E402
 from traj2events.camera import Camera  # noqa: E402
 from traj2events.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
+from traj2events.render import TerrainRenderer, expand_includes  # noqa: E402
 from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
 from traj2events.tiles import LodSettings, TileSet  # noqa: E402
 
@@ -64,31 +63,27 @@ void main()
 """
 
 
-def fragment_shader() -> str:
-    """The package's reflectance law (terrain.vert's uniforms, functions and per-vertex
-    body), evaluated per pixel with the normal and lit fraction from the texture."""
-    law = (resources.files("traj2events") / "shaders" / "terrain.vert").read_text()
-    head = law[law.index("uniform vec3 sun_dir;") : law.index("void main()")]
-    start, end = "    vec3 n = normalize(texelFetch(vertex_normal, vertex).xyz);\n", "    frag_radiance = rf"
-    if start not in law or end not in law:
-        raise RuntimeError("terrain.vert changed: update bench/render_textured.py's shader assembly")
-    body = law[law.index(start) + len(start) : law.index(end)]
-    body = body.replace("-normalize(offset)", "normalize(to_camera_m)")
-    return (
-        "#version 330 core\nin vec2 uv;\nflat in float layer;\nin vec3 to_camera_m;\n"
-        "uniform sampler2DArray shading;  // per tile: normal xyz, lit fraction\n"
-        "uniform float radiance_max;\nout vec4 frag_color;\n"
-        + head
-        + "void main()\n{\n    vec4 texel = texture(shading, vec3(uv, layer));\n    vec3 n = normalize(texel.xyz);\n"
-        + body
-        + "    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);\n"
-        + "    frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);\n}\n"
-    )
+FRAGMENT = """#version 330 core
+in vec2 uv;
+flat in float layer;
+in vec3 to_camera_m;
+uniform sampler2DArray shading;  // per tile: normal xyz, lit fraction
+uniform float radiance_max;
+out vec4 frag_color;
+#include "reflectance.glsl"
+void main()
+{
+    vec4 texel = texture(shading, vec3(uv, layer));
+    float rf = reflectance_factor(normalize(texel.xyz), normalize(to_camera_m));
+    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);
+    frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
+}
+"""
 
 
 def compile_program(gl) -> int:
     program = gl.glCreateProgram()
-    for kind, text in ((gl.GL_VERTEX_SHADER, VERTEX), (gl.GL_FRAGMENT_SHADER, fragment_shader())):
+    for kind, text in ((gl.GL_VERTEX_SHADER, VERTEX), (gl.GL_FRAGMENT_SHADER, expand_includes(FRAGMENT))):
         shader = gl.glCreateShader(kind)
         gl.glShaderSource(shader, text)
         gl.glCompileShader(shader)

@@ -39,7 +39,7 @@ def test_render_fingerprint_includes_the_shaders():
     import ast
 
     tree = ast.parse(fingerprint.module_path("traj2events.render").read_text())
-    assert {p.name for p in fingerprint.data_files(tree)} == {"terrain.vert", "terrain.frag"}
+    assert {p.name for p in fingerprint.data_files(tree)} == {"terrain.vert", "terrain.frag", "reflectance.glsl"}
 
 
 @pytest.fixture()

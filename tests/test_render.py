@@ -356,3 +356,12 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
         alone, _ = render(ProceduralTerrain(TerrainParams(seed=6)), camera, pose)
         assert np.array_equal(frame.radiance, alone.radiance) and np.array_equal(frame.depth_m, alone.depth_m)
         assert frame.n_tiles == alone.n_tiles > 0
+
+
+def test_shaders_take_the_reflectance_law_from_one_file():
+    from traj2events.render import expand_includes, shader_source
+
+    vertex = shader_source("terrain.vert")
+    assert "#include" not in vertex and vertex.count("float reflectance_factor(") == 1
+    assert vertex.startswith("#version 330 core\n")  # GLSL wants it first: the law comes after
+    assert expand_includes('x\n#include "reflectance.glsl"\ny\n') == "x\n" + shader_source("reflectance.glsl") + "y\n"

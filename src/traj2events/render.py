@@ -328,11 +328,26 @@ class _GLScene:
         gl.glDeleteProgram(self.program)
 
 
+def expand_includes(source: str) -> str:
+    """GLSL `source` with each `#include "file"` line replaced by shaders/file. GLSL has no
+    includes; this keeps the reflectance law in one file for every stage that evaluates it."""
+    folder = resources.files("traj2events") / "shaders"
+    lines = source.splitlines(keepends=True)
+    return "".join(
+        (folder / line.split('"')[1]).read_text() if line.startswith("#include ") else line for line in lines
+    )
+
+
+def shader_source(name: str) -> str:
+    """shaders/`name`, includes expanded."""
+    return expand_includes((resources.files("traj2events") / "shaders" / name).read_text())
+
+
 def _compile_program(gl) -> int:
     program = gl.glCreateProgram()
     for kind, name in ((gl.GL_VERTEX_SHADER, "terrain.vert"), (gl.GL_FRAGMENT_SHADER, "terrain.frag")):
         shader = gl.glCreateShader(kind)
-        gl.glShaderSource(shader, (resources.files("traj2events") / "shaders" / name).read_text())
+        gl.glShaderSource(shader, shader_source(name))
         gl.glCompileShader(shader)
         if not gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS):
             raise RuntimeError(f"shaders/{name}: {gl.glGetShaderInfoLog(shader).decode()}")

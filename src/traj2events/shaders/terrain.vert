@@ -3,7 +3,7 @@
 // pixels, so interpolating radiance across a triangle changes it by < 1e-3 and saves
 // evaluating Hapke for every pixel), and positions relative to the camera. One instance
 // per tile: its vertices are fetched from its slot of the shared vertex buffers.
-// The laws mirror reflectance.py (the numpy reference the tests compare with).
+// The laws: reflectance.glsl.
 layout(location = 0) in vec4 tile;  // per instance (tile): xyz its origin minus the camera position (m), w its slot
 
 uniform samplerBuffer vertex_position_lit;  // per vertex: position minus its tile's origin (m), lit fraction (0..1)
@@ -15,31 +15,7 @@ uniform mat4 P;
 out float frag_radiance;
 out float frag_lit;
 
-uniform vec3 sun_dir;        // unit, toward the Sun (world)
-uniform float irradiance;    // W/m^2 at the Moon
-uniform int model;           // 0 Hapke, 1 Lunar-Lambert
-uniform float w;             // Hapke single-scattering albedo
-uniform float b;
-uniform float c;
-uniform float b0;
-uniform float hw;            // opposition width h
-uniform float albedo;        // Lunar-Lambert
-
-const float PI = 3.14159265358979;
-
-float chandrasekhar_h(float x, float w_)
-{
-    float gamma = sqrt(1.0 - w_);
-    float r0 = (1.0 - gamma) / (1.0 + gamma);
-    float log_term = x > 0.0 ? log((1.0 + x) / x) : 0.0;
-    return 1.0 / (1.0 - w_ * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log_term));
-}
-
-// One Henyey-Greenstein lobe in phase angle: peaks at g = 0 (backscatter) for b > 0.
-float hg(float b_, float cos_g)
-{
-    return (1.0 - b_ * b_) / pow(1.0 - 2.0 * b_ * cos_g + b_ * b_, 1.5);
-}
+#include "reflectance.glsl"
 
 void main()
 {
@@ -49,24 +25,7 @@ void main()
     vec3 offset = position_lit.xyz + tile.xyz;
     vec3 n = normalize(texelFetch(vertex_normal, vertex).xyz);
     vec3 to_camera = -normalize(offset);
-    float mu0 = dot(n, sun_dir);
-    float mu = dot(n, to_camera);
-    float cos_g = clamp(dot(sun_dir, to_camera), -1.0, 1.0);
-    float rf = 0.0;
-    if (mu0 > 0.0 && mu > 0.0) {
-        if (model == 0) {
-            float g = acos(cos_g);
-            float opposition = b0 / (1.0 + tan(0.5 * g) / hw);
-            float phase = 0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g);
-            float multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0;
-            rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple);
-        } else {
-            float g = degrees(acos(cos_g));
-            float limb = clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
-            rf = albedo * (2.0 * limb * mu0 / (mu0 + mu) + (1.0 - limb) * mu0);
-        }
-    }
-    frag_radiance = rf * irradiance / PI;
+    frag_radiance = reflectance_factor(n, to_camera) * irradiance / PI;
     frag_lit = clamp(position_lit.w, 0.0, 1.0);  // from the horizon march
     gl_Position = P * V * vec4(offset, 1.0);
 }
