@@ -9,7 +9,9 @@ one core, and at the default budget of 2 px per cell they are tiny: 1.27 M for 1
 and gives each one a texture of the normals and lit fractions of its descendants `finer`
 levels down, built by the same TileSet (`finer` 2: shading every ~2 px, as budget 2). The
 fragment shader evaluates the package's reflectance law per pixel from that texture.
-Geometry, silhouettes and depth stay those of the coarse tiles.
+Geometry, silhouettes and depth stay those of the coarse tiles. One more variant reads the
+texture without evaluating the law, to split the time between the two (its image is not a
+rendering: ignore its error).
 
 For bench/render.py's two poses: median ms per frame (tiles built and uploaded before; the
 variants alternated over --rounds), seconds of the first pass over the poses (building and
@@ -79,11 +81,16 @@ void main()
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
 }
 """
+# The same read without the law (the lit fraction as radiance): splits a frame's time
+# between reading the texture and evaluating the law. Its image is not a rendering.
+READ_ONLY = FRAGMENT.replace(
+    "float rf = reflectance_factor(normalize(texel.xyz), normalize(to_camera_m));", "float rf = PI / irradiance;"
+)
 
 
-def compile_program(gl) -> int:
+def compile_program(gl, fragment: str) -> int:
     program = gl.glCreateProgram()
-    for kind, text in ((gl.GL_VERTEX_SHADER, VERTEX), (gl.GL_FRAGMENT_SHADER, expand_includes(FRAGMENT))):
+    for kind, text in ((gl.GL_VERTEX_SHADER, VERTEX), (gl.GL_FRAGMENT_SHADER, expand_includes(fragment))):
         shader = gl.glCreateShader(kind)
         gl.glShaderSource(shader, text)
         gl.glCompileShader(shader)
@@ -101,10 +108,10 @@ class TexturedRenderer(TerrainRenderer):
     """TerrainRenderer whose tiles are shaded from a texture of their descendants `finer`
     levels down (normals and lit fractions, RGBA16F, one layer per slot)."""
 
-    def __init__(self, tiles: TileSet, camera: Camera, sun, reflectance, finer: int, layers: int = 600):
+    def __init__(self, tiles: TileSet, camera: Camera, sun, reflectance, finer: int, law=True, layers: int = 600):
         self.finer, self.layers = finer, layers
         compile_package = render_module._compile_program
-        render_module._compile_program = compile_program
+        render_module._compile_program = lambda gl: compile_program(gl, FRAGMENT if law else READ_ONLY)
         try:
             super().__init__(tiles, camera, sun, reflectance, max_cached_tiles=layers - 100, backend="osmesa")
         finally:
@@ -203,13 +210,14 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=2, help="the variants alternated this many times")
     parser.add_argument("--size", type=int, default=1024)
     args = parser.parse_args()
-    variants = {  # name: (budget, finer levels for the texture; 0: the package's renderer)
-        "budget 1 (reference)": (1.0, 0),
-        "budget 2 (default)": (2.0, 0),
-        "budget 8": (8.0, 0),
-        "budget 8, texture 2 levels finer": (8.0, 2),
-        "budget 8, texture 3 levels finer": (8.0, 3),
-        "budget 4, texture 1 level finer": (4.0, 1),
+    variants = {  # name: (budget, finer levels for the texture (0: the package's renderer), law per pixel)
+        "budget 1 (reference)": (1.0, 0, True),
+        "budget 2 (default)": (2.0, 0, True),
+        "budget 8": (8.0, 0, True),
+        "budget 8, texture 2 levels finer": (8.0, 2, True),
+        "budget 8, texture 3 levels finer": (8.0, 3, True),
+        "budget 8, texture 3 levels finer, read only (no law: timing only)": (8.0, 3, False),
+        "budget 4, texture 1 level finer": (4.0, 1, True),
     }
     camera = Camera(args.size, args.size, 45.0)
     print("| pose | variant | ms per frame (rounds) | first pass, s | triangles | radiance error | depth error |")
@@ -218,10 +226,10 @@ def main() -> None:
         terrain = ProceduralTerrain(TerrainParams(seed=1))
         path = poses(state, args.frames)
         renderers = {}
-        for variant, (budget, finer) in variants.items():
+        for variant, (budget, finer, law) in variants.items():
             tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
             if finer:
-                renderers[variant] = TexturedRenderer(tiles, camera, sun, ReflectanceParams(), finer)
+                renderers[variant] = TexturedRenderer(tiles, camera, sun, ReflectanceParams(), finer, law)
             else:
                 renderers[variant] = TerrainRenderer(tiles, camera, sun, ReflectanceParams(), 20000, backend="osmesa")
         times = {variant: [] for variant in variants}
