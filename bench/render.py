@@ -81,6 +81,17 @@ def stretch_renderer(state, sun, extent, size, n_frames, budget, backend, terrai
         yield renderer, path, time.perf_counter() - start
 
 
+def frame_errors(frame, reference) -> tuple[float, float]:
+    """(RMS radiance difference / mean radiance over the reference's ground pixels, median
+    relative depth difference over the pixels both frames see ground in)."""
+    ground = reference.depth_m > 0
+    both = ground & (frame.depth_m > 0)
+    mean = max(float(reference.radiance[ground].mean()), 1e-9)
+    radiance = np.sqrt(np.mean((frame.radiance - reference.radiance)[ground] ** 2)) / mean
+    depth = np.median(np.abs(frame.depth_m[both] / reference.depth_m[both] - 1)) if both.any() else np.nan
+    return float(radiance), float(depth)
+
+
 def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backend):
     terrain = ProceduralTerrain(TerrainParams(seed=1))
     results = {}
@@ -108,17 +119,13 @@ def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backe
             frame=frame,
         )
     ref = results[reference]["frame"]
-    ground = ref.depth_m > 0
     print(f"\n{name}, {size} x {size}, Hapke + shadows, one core ({n_frames} frames; {drawn_by})")
     print(
         f"{'px/cell':>8} {'s/frame':>8} {'triangles':>10} {'tiles':>6} {'LOD saves':>10} {'build s':>8} "
         f"{'radiance err':>13} {'depth err':>10}"
     )
     for budget, r in results.items():
-        f = r["frame"]
-        both = ground & (f.depth_m > 0)
-        rad_err = np.sqrt(np.mean((f.radiance - ref.radiance)[ground] ** 2)) / max(ref.radiance[ground].mean(), 1e-9)
-        depth_err = np.median(np.abs(f.depth_m[both] / ref.depth_m[both] - 1)) if both.any() else np.nan
+        rad_err, depth_err = frame_errors(r["frame"], ref)
         print(
             f"{budget:8.1f} {r['seconds']:8.3f} {r['triangles']:10d} {r['tiles']:6d} "
             f"{r['uniform'] / r['triangles']:9.1f}x "

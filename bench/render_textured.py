@@ -15,10 +15,10 @@ rendering: ignore its error).
 
 For bench/render.py's two poses: median ms per frame (tiles built and uploaded before; the
 variants alternated over --rounds), seconds of the first pass over the poses (building and
-uploading the tiles, and the shading textures), triangles, and the error against budget 1 (RMS
-radiance difference over the mean; median relative depth difference). This is a
-measurement of an idea, not a renderer of the package; its fragment shader includes the
-package's reflectance.glsl.
+uploading the tiles, and the shading textures), triangles, and the error against budget 1
+(bench/render.py's `frame_errors`: RMS radiance difference over the mean; median relative
+depth difference where both see ground). This is a measurement of an idea, not a renderer
+of the package; its fragment shader includes the package's reflectance.glsl.
 """
 
 from __future__ import annotations
@@ -35,14 +35,14 @@ os.environ.setdefault("LP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from render import CASES, R_MOON, poses  # noqa: E402  (bench/render.py)
+from render import CASES, R_MOON, frame_errors, poses  # noqa: E402  (bench/render.py)
 
 import traj2events.render as render_module  # noqa: E402
 from traj2events.camera import Camera  # noqa: E402
 from traj2events.reflectance import ReflectanceParams  # noqa: E402
 from traj2events.render import TerrainRenderer, expand_includes  # noqa: E402
 from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.tiles import LodSettings, TileSet  # noqa: E402
+from traj2events.tiles import LodSettings, TileSet, border_ring  # noqa: E402
 
 VERTEX = """#version 330 core
 layout(location = 0) in vec4 tile;  // per instance: origin minus camera (m), slot
@@ -119,12 +119,10 @@ class TexturedRenderer(TerrainRenderer):
         gl, cells = self._gl.gl, tiles.lod.cells
         self.side = cells * 2**finer + 1
         # Each vertex's texture coordinates: grid vertex (i, j) is fine sample 2^finer (i, j);
-        # a skirt vertex takes those of the grid vertex it hangs from (tiles._add_skirts' ring).
+        # a skirt vertex takes those of the grid vertex it hangs from.
         n = cells + 1
-        index = np.arange(n * n).reshape(n, n)
-        ring = np.concatenate([index[0, :], index[1:, -1], index[-1, -2::-1], index[-2:0:-1, 0]])
-        vertex = np.arange(self._gl.vertices_per_tile)
-        vertex = np.where(vertex < n * n, vertex, ring[np.clip(vertex - n * n, 0, len(ring) - 1)])
+        vertex = np.concatenate([np.arange(n * n), border_ring(n)])
+        assert len(vertex) == self._gl.vertices_per_tile
         i, j = np.divmod(vertex, n)
         uv = np.zeros((len(vertex), 4), np.float32)
         uv[:, 0] = (j * 2**finer + 0.5) / self.side  # s runs along a row (j)
@@ -196,14 +194,6 @@ class TexturedRenderer(TerrainRenderer):
         return slot
 
 
-def errors(frame, reference) -> tuple[float, float]:
-    """(RMS radiance difference / mean radiance, median relative depth difference) over the
-    reference's ground pixels."""
-    ground = reference.depth_m > 0
-    radiance = np.sqrt(np.mean((frame.radiance - reference.radiance)[ground] ** 2)) / reference.radiance[ground].mean()
-    return float(radiance), float(np.median(np.abs(frame.depth_m[ground] / reference.depth_m[ground] - 1)))
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=10)
@@ -253,7 +243,7 @@ def main() -> None:
                 renderer.close()
         reference = last["budget 1 (reference)"]
         for variant, frame in last.items():
-            radiance, depth = errors(frame, reference)
+            radiance, depth = frame_errors(frame, reference)
             rounds = " / ".join(f"{t:.1f}" for t in times[variant])
             print(
                 f"| {name} | {variant} | {rounds} | {first_pass[variant]:.1f} | {frame.n_triangles} | {radiance:.3f} "

@@ -245,10 +245,16 @@ def _grid_faces(n: int) -> np.ndarray:
     return np.stack([a, b, d, a, d, c], 1).reshape(-1, 3).astype(np.uint32)
 
 
+def border_ring(n: int) -> np.ndarray:
+    """The border vertices of an (n x n) vertex grid, once each, in order around it: the
+    vertices a tile's skirt hangs from (skirt vertex k below grid vertex border_ring(n)[k])."""
+    idx = np.arange(n * n).reshape(n, n)
+    return np.concatenate([idx[0, :], idx[1:, -1], idx[-1, -2::-1], idx[-2:0:-1, 0]])
+
+
 def _add_skirts(verts, norms, lit, faces, n, depth_m, radius_m):
     """A strip below each edge of the (n x n) grid, hanging toward the Moon's centre."""
-    idx = np.arange(n * n).reshape(n, n)
-    ring = np.concatenate([idx[0, :], idx[1:, -1], idx[-1, -2::-1], idx[-2:0:-1, 0]])
+    ring = border_ring(n)
     down = np.array([0.0, 0.0, radius_m]) - verts[ring]
     down /= np.linalg.norm(down, axis=1, keepdims=True)
     skirt = verts[ring] + depth_m * down
