@@ -77,12 +77,11 @@ def vertex_stage_ms(renderer, path) -> float:
     from OpenGL import GL as gl
 
     times = []
+    render = timed(times, renderer.render)
     gl.glEnable(gl.GL_RASTERIZER_DISCARD)
     try:
         for pose in path:
-            start = time.perf_counter()
-            renderer.render(pose)
-            times.append(time.perf_counter() - start)
+            render(pose)
     finally:
         gl.glDisable(gl.GL_RASTERIZER_DISCARD)
     return 1e3 * statistics.median(times)
