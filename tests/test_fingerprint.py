@@ -39,7 +39,13 @@ def test_render_fingerprint_includes_the_shaders():
     import ast
 
     tree = ast.parse(fingerprint.module_path("traj2events.render").read_text())
-    assert {p.name for p in fingerprint.data_files(tree)} == {"terrain.vert", "terrain.frag", "reflectance.glsl"}
+    assert {p.name for p in fingerprint.data_files(tree)} == {
+        "terrain.vert",
+        "terrain.frag",
+        "terrain_textured.vert",
+        "terrain_textured.frag",
+        "reflectance.glsl",
+    }
 
 
 @pytest.fixture()

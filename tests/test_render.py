@@ -124,13 +124,16 @@ def test_egl_and_osmesa_draw_the_same_pixels(tmp_path):
         assert np.sqrt(np.mean((radiance_egl - radiance_osmesa) ** 2)) / radiance_osmesa.mean() < 5e-3
 
 
-def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch):
+@pytest.mark.parametrize(
+    "lod", [LodSettings(), LodSettings(pixels_per_cell=4.0, shading_levels=1)], ids=["vertex", "pixel"]
+)
+def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch, lod):
     camera = Camera(48, 48, 45.0)
     pose = camera_pose(state(altitude=400.0, pitch=50.0))
-    reference, tiles = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose)
+    reference, tiles = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose, lod=lod)
     assert reference.n_tiles > 8
     monkeypatch.setattr(render_module, "_INITIAL_SLOTS", 2)  # grows (copying its slots) three times or more
-    grown, _ = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose)
+    grown, _ = render(ProceduralTerrain(TerrainParams(seed=4)), camera, pose, lod=lod)
     assert np.array_equal(grown.radiance, reference.radiance) and np.array_equal(grown.depth_m, reference.depth_m)
 
 
@@ -183,14 +186,22 @@ def test_a_crater_centre_appears_where_the_camera_model_puts_it():
     np.testing.assert_allclose(seen, predicted, atol=0.5)
 
 
+SHADINGS = {"vertex": LodSettings(), "pixel": LodSettings(shading_levels=1)}
+
+
+@pytest.mark.parametrize("shading", SHADINGS)
 @pytest.mark.parametrize("model", ["hapke", "lunar-lambert"])
-def test_flat_plane_radiance_follows_the_reflectance_law(model):
+def test_flat_plane_radiance_follows_the_reflectance_law(model, shading):
+    """Per vertex (the radiance interpolated across cells of 2 px, ~2 deg here) and per
+    pixel (only the phase term interpolated): within 0.2 % of the law at every pixel."""
     flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
     sun = Sun(1.496e11, 30.0, 25.0)
     reflectance = ReflectanceParams(model=model)
     camera = Camera(64, 48, 60.0)
     pose = camera_pose(state(altitude=100.0, pitch=40.0, yaw=20.0, roll=5.0))
-    frame, _ = render(flat, camera, pose, radius=1e12, half_extent=5e3, sun=sun, reflectance=reflectance)
+    frame, _ = render(
+        flat, camera, pose, radius=1e12, half_extent=5e3, sun=sun, reflectance=reflectance, lod=SHADINGS[shading]
+    )
     x_s, y_s = camera.pixel_coordinates()
     rays = camera.back_project(*np.broadcast_arrays(x_s, y_s))
     points = pose.position + (rays * frame.depth_m[..., None]) @ pose.rotation.T
@@ -271,7 +282,15 @@ def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
     assert np.array_equal(again.radiance, first.radiance)
 
 
-def test_rendered_crater_shadow_has_the_analytic_length():
+@pytest.mark.parametrize(
+    "lod",
+    [
+        LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0),
+        LodSettings(min_spacing_m=0.25, pixels_per_cell=4.0, shading_levels=2),
+    ],
+    ids=["vertex", "pixel"],
+)
+def test_rendered_crater_shadow_has_the_analytic_length(lod):
     # Parabolic bowl (radius 50 m, depth 20 m), Sun from +x at 10 deg: the rim's shadow
     # covers the floor from the rim at x = +50 m for 2R - R^2 tan(e) / d = 78 m.
     spacing, radius, depth, elevation = 0.5, 50.0, 20.0, 10.0
@@ -289,7 +308,7 @@ def test_rendered_crater_shadow_has_the_analytic_length():
         radius=1e12,
         half_extent=2e3,
         sun=sun,
-        lod=LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0),
+        lod=lod,
     )
     row = 128  # through the centre (y ~ 0)
     x_s, _ = camera.pixel_coordinates()
@@ -365,3 +384,33 @@ def test_shaders_take_the_reflectance_law_from_one_file():
     assert "#include" not in vertex and vertex.count("float reflectance_factor(") == 1
     assert vertex.startswith("#version 330 core\n")  # GLSL wants it first: the law comes after
     assert expand_includes('x\n#include "reflectance.glsl"\ny\n') == "x\n" + shader_source("reflectance.glsl") + "y\n"
+
+
+def test_shading_per_pixel_keeps_the_drawn_geometry():
+    """Shading levels change the shading only: the same tiles, the same depth, and a
+    radiance close to that of tiles as fine as the texture."""
+    camera = Camera(96, 96, 45.0)
+    pose = camera_pose(state(x=-3000.0, altitude=2000.0, pitch=30.0))
+    terrain = ProceduralTerrain(TerrainParams(seed=4))
+    coarse, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=8.0))
+    shaded, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=8.0, shading_levels=2))
+    fine, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=2.0))
+    reference, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=1.0))
+    assert shaded.n_tiles == coarse.n_tiles < fine.n_tiles
+    np.testing.assert_allclose(shaded.depth_m, coarse.depth_m, rtol=1e-6)
+
+    def error(frame):
+        return np.sqrt(np.mean((frame.radiance - reference.radiance) ** 2)) / reference.radiance.mean()
+
+    # The texture holds the normals and shadows of 2 px cells: it shades like 2 px tiles,
+    # not like the 8 px ones it is drawn on.
+    assert error(shaded) < 1.2 * error(fine) < 0.6 * error(coarse)
+
+
+def test_more_tiles_than_the_shading_texture_holds_is_a_clear_error(monkeypatch):
+    monkeypatch.setattr(render_module, "_SHADING_BYTES", 3 * 8 * 17**2)  # three layers of 17^2 texels
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), SUN.direction, R_MOON, 140e3,
+                    LodSettings(cells=8, shading_levels=1))  # fmt: skip
+    with TerrainRenderer(tiles, Camera(48, 48, 45.0), SUN, ReflectanceParams(), backend="osmesa") as renderer:
+        with pytest.raises(RuntimeError, match="render.lod.pixels_per_cell or lower render.lod.shading_levels"):
+            renderer.render(camera_pose(state(altitude=400.0, pitch=50.0)))

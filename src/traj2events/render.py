@@ -19,6 +19,14 @@ the GPU) and its slot, from which the vertex shader fetches the vertices. The ou
 single-sample float32 two-channel framebuffer: radiance (W m^-2 sr^-1) and depth along the
 boresight (m, computed in the shader; 0 for sky). It is read back through a pixel buffer,
 asynchronously: `render_sequence` draws each frame before handing over the previous one.
+
+Shading (`render.lod.shading_levels`): 0 evaluates the reflectance law at the vertices of
+the drawn tiles and interpolates the radiance (shaders/terrain.*). k > 0 gives every slot
+a layer of a texture array holding the normals and lit fractions of its tile's
+descendants k levels finer (TileSet.shading_texture), and evaluates the law per pixel
+from it (shaders/terrain_textured.*): the geometry (silhouettes, depth) is the drawn
+tiles', the shading that of tiles 2^k times finer. On a CPU rasteriser a frame's cost is
+its triangle count, so coarse tiles shaded per pixel are faster for the same shading.
 """
 
 from __future__ import annotations
@@ -36,7 +44,7 @@ from .camera import Camera, CameraPose, opengl_camera_to_world
 from .illumination import Sun
 from .reflectance import ReflectanceParams, max_radiance_factor
 from .stars import StarField, add_stars
-from .tiles import TileKey, TileSet, depth_range
+from .tiles import TileKey, TileSet, border_ring, depth_range
 
 if not hasattr(np, "infty"):
     np.infty = np.inf  # pyrender 0.1.45 still uses the NumPy 1 alias
@@ -44,6 +52,7 @@ if not hasattr(np, "infty"):
 BACKENDS = ("auto", "egl", "osmesa")
 _EGL_EXTENSIONS = 0x3055
 _INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
+_SHADING_BYTES = 512 * 2**20  # cap on the shading texture array (bounds the slots kept)
 
 
 def _check_pyopengl() -> None:
@@ -171,13 +180,24 @@ def view_rotation(pose: CameraPose) -> np.ndarray:
 class _GLScene:
     """The OpenGL objects of one context: program, framebuffer, tile slots, instances."""
 
-    def __init__(self, width: int, height: int, faces: np.ndarray, vertices_per_tile: int):
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        faces: np.ndarray,
+        vertices_per_tile: int,
+        shading_uv: np.ndarray | None = None,
+        shading_side: int = 0,
+    ):
+        """`shading_uv`: (vertices_per_tile, 2) where each vertex of a tile sits in its
+        (shading_side x shading_side) shading texture, to shade per pixel; None: per vertex."""
         from OpenGL import GL as gl
 
         self.gl, self.width, self.height = gl, width, height
         self.vertices_per_tile = vertices_per_tile
         self.n_indices = faces.size
-        self.program = _compile_program(gl)
+        self.textured = shading_uv is not None
+        self.program = _compile_program(gl, "terrain_textured" if self.textured else "terrain")
         self.locations = {}
         self.vao = gl.glGenVertexArrays(1)
         gl.glBindVertexArray(self.vao)
@@ -189,11 +209,22 @@ class _GLScene:
         gl.glEnableVertexAttribArray(0)
         gl.glVertexAttribPointer(0, 4, gl.GL_FLOAT, gl.GL_FALSE, 16, None)
         gl.glVertexAttribDivisor(0, 1)
+        if self.textured:
+            self.uv_buffer = gl.glGenBuffers(1)
+            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.uv_buffer)
+            gl.glBufferData(gl.GL_ARRAY_BUFFER, np.ascontiguousarray(shading_uv, np.float32), gl.GL_STATIC_DRAW)
+            gl.glEnableVertexAttribArray(1)
+            gl.glVertexAttribPointer(1, 2, gl.GL_FLOAT, gl.GL_FALSE, 8, None)
+            self.shading_side, self.shading_texture = shading_side, 0
+            layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
+            self.slot_limit = max(1, min(layers, _SHADING_BYTES // (8 * shading_side**2)))  # RGBA16F texels
+        else:
+            self.slot_limit = 2**31 // (vertices_per_tile * 16)  # OpenGL's buffer offsets
         # Per-vertex data: (position - tile origin, lit) and (normal, 0), one texel each.
         self.capacity = 0
         self.vertex_buffers = list(gl.glGenBuffers(2))
         self.vertex_textures = list(gl.glGenTextures(2))
-        self._allocate(_INITIAL_SLOTS)
+        self._allocate(min(_INITIAL_SLOTS, self.slot_limit))
         self._framebuffer()
         self.image_bytes = width * height * 2 * 4  # (radiance, depth) float32
         self.pixel_buffers: list[int] = []
@@ -202,6 +233,8 @@ class _GLScene:
         self.uniform("vertex_position_lit", 0)
         self.uniform("vertex_normal", 1)
         self.uniform("vertices_per_tile", vertices_per_tile)
+        if self.textured:
+            self.uniform("shading", 2)
 
     def _framebuffer(self) -> None:
         gl = self.gl
@@ -235,16 +268,52 @@ class _GLScene:
             gl.glActiveTexture(gl.GL_TEXTURE0 + unit)
             gl.glBindTexture(gl.GL_TEXTURE_BUFFER, self.vertex_textures[unit])
             gl.glTexBuffer(gl.GL_TEXTURE_BUFFER, gl.GL_RGBA32F, new)
+        if self.textured:
+            self._allocate_shading(slots)
         self.capacity = slots
 
-    def upload(self, slot: int, position_lit: np.ndarray, normal: np.ndarray) -> None:
+    def _allocate_shading(self, slots: int) -> None:
+        """A shading texture array of `slots` layers (RGBA16F: normal xyz, lit), keeping
+        the layers already filled (copied on the GPU)."""
+        gl, side = self.gl, self.shading_side
+        new = gl.glGenTextures(1)
+        gl.glActiveTexture(gl.GL_TEXTURE2)
+        gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, new)
+        gl.glTexImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, gl.GL_RGBA16F, side, side, slots, 0, gl.GL_RGBA, gl.GL_FLOAT, None)
+        for name, value in (
+            (gl.GL_TEXTURE_MIN_FILTER, gl.GL_LINEAR),  # one level: bilinear between texels
+            (gl.GL_TEXTURE_MAG_FILTER, gl.GL_LINEAR),
+            (gl.GL_TEXTURE_WRAP_S, gl.GL_CLAMP_TO_EDGE),
+            (gl.GL_TEXTURE_WRAP_T, gl.GL_CLAMP_TO_EDGE),
+            (gl.GL_TEXTURE_MAX_LEVEL, 0),
+        ):
+            gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
+        if self.capacity:
+            gl.glCopyImageSubData(self.shading_texture, gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
+                                  new, gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, side, side, self.capacity)  # fmt: skip
+            gl.glDeleteTextures([self.shading_texture])
+        self.shading_texture = new
+
+    def upload(self, slot: int, position_lit: np.ndarray, normal: np.ndarray, shading: np.ndarray | None) -> None:
+        """Fills `slot`: its vertices, and its layer of the shading texture when shaded per pixel."""
         gl = self.gl
+        if slot >= self.slot_limit:
+            raise RuntimeError(
+                f"a frame needs more than {self.slot_limit} tiles, what the shading texture holds: "
+                "raise render.lod.pixels_per_cell or lower render.lod.shading_levels"
+            )
         if slot >= self.capacity:
-            self._allocate(max(2 * self.capacity, slot + 1))
+            self._allocate(min(max(2 * self.capacity, slot + 1), self.slot_limit))
         offset = slot * self.vertices_per_tile * 16
         for buffer, data in zip(self.vertex_buffers, (position_lit, normal)):
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, buffer)
             gl.glBufferSubData(gl.GL_ARRAY_BUFFER, offset, data.nbytes, data)
+        if self.textured:
+            side = self.shading_side
+            gl.glActiveTexture(gl.GL_TEXTURE2)
+            gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
+            gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, slot, side, side, 1, gl.GL_RGBA, gl.GL_FLOAT,
+                               np.ascontiguousarray(shading, np.float32))  # fmt: skip
 
     def uniform(self, name: str, value) -> None:
         gl = self.gl
@@ -281,6 +350,9 @@ class _GLScene:
         for unit, texture in enumerate(self.vertex_textures):
             gl.glActiveTexture(gl.GL_TEXTURE0 + unit)
             gl.glBindTexture(gl.GL_TEXTURE_BUFFER, texture)
+        if self.textured:
+            gl.glActiveTexture(gl.GL_TEXTURE2)
+            gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
         gl.glBindVertexArray(self.vao)
         if len(instances):
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
@@ -322,6 +394,9 @@ class _GLScene:
         gl.glDeleteRenderbuffers(2, [self.colour, self.depth])
         gl.glDeleteTextures(self.vertex_textures)
         gl.glDeleteBuffers(4, [*self.vertex_buffers, self.index_buffer, self.instance_buffer])
+        if self.textured:
+            gl.glDeleteTextures([self.shading_texture])
+            gl.glDeleteBuffers(1, [self.uv_buffer])
         if self.pixel_buffers:
             gl.glDeleteBuffers(len(self.pixel_buffers), self.pixel_buffers)
         gl.glDeleteVertexArrays(1, [self.vao])
@@ -343,9 +418,10 @@ def shader_source(name: str) -> str:
     return expand_includes((resources.files("traj2events") / "shaders" / name).read_text())
 
 
-def _compile_program(gl) -> int:
+def _compile_program(gl, stem: str) -> int:
+    """The program of shaders/`stem`.vert and shaders/`stem`.frag."""
     program = gl.glCreateProgram()
-    for kind, name in ((gl.GL_VERTEX_SHADER, "terrain.vert"), (gl.GL_FRAGMENT_SHADER, "terrain.frag")):
+    for kind, name in ((gl.GL_VERTEX_SHADER, f"{stem}.vert"), (gl.GL_FRAGMENT_SHADER, f"{stem}.frag")):
         shader = gl.glCreateShader(kind)
         gl.glShaderSource(shader, shader_source(name))
         gl.glCompileShader(shader)
@@ -357,6 +433,18 @@ def _compile_program(gl) -> int:
     if not gl.glGetProgramiv(program, gl.GL_LINK_STATUS):
         raise RuntimeError(f"shaders: {gl.glGetProgramInfoLog(program).decode()}")
     return program
+
+
+def shading_coordinates(cells: int, levels: int) -> tuple[np.ndarray, int]:
+    """((vertices, 2) texture coordinates of a tile's vertices in its shading texture, the
+    texture's side): grid vertex (a, b) sits at texel (a, b) 2^levels, at the texel's centre
+    (s along b, t along a, as TileSet.shading_texture lays them out); a skirt vertex takes
+    those of the grid vertex it hangs from."""
+    n, side = cells + 1, cells * 2**levels + 1
+    vertex = np.concatenate([np.arange(n * n), border_ring(n)])
+    a, b = np.divmod(vertex, n)
+    uv = np.stack([b * 2**levels + 0.5, a * 2**levels + 0.5], axis=1) / side
+    return uv.astype(np.float32), side
 
 
 class TerrainRenderer:
@@ -383,7 +471,10 @@ class TerrainRenderer:
 
         self.gl_renderer = gl.glGetString(gl.GL_RENDERER).decode()
         n_vertices = len(tiles.tile((0, 0, 0)).vertices)  # the same for every tile
-        self._gl = _GLScene(camera.width, camera.height, tiles.tile((0, 0, 0)).faces, n_vertices)
+        self.shading_levels = tiles.lod.shading_levels
+        uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
+        self._gl = _GLScene(camera.width, camera.height, tiles.tile((0, 0, 0)).faces, n_vertices, uv, side)
+        self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
         self._uniforms = {
             "sun_dir": sun.direction,
             "irradiance": float(sun.irradiance_w_m2),
@@ -409,7 +500,8 @@ class TerrainRenderer:
             position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
             normal = np.zeros((len(t.vertices), 4), np.float32)
             normal[:, :3] = t.normals
-            self._gl.upload(slot, position_lit, normal)
+            shading = self.tiles.shading_texture(key, self.shading_levels) if self.shading_levels else None
+            self._gl.upload(slot, position_lit, normal, shading)
             self._slots[key] = slot
         return self._slots[key]
 

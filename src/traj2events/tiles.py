@@ -61,6 +61,7 @@ class LodSettings:
     margin: int = _LOD["margin"]  # cells of extra grid toward the Sun for the shadow march
     pixels_per_cell: float = _LOD["pixels_per_cell"]
     min_spacing_m: float = _LOD["min_spacing_m"]
+    shading_levels: int = _LOD["shading_levels"]  # 0: law per vertex; k: per pixel, normals k levels finer
     skirt_cells: float = 2.0  # skirt depth in cells of the tile
     foreshortening: bool = True  # measure a cell by its projected area, not its width
 
@@ -175,6 +176,32 @@ class TileSet:
         radius = float(np.max(np.linalg.norm(verts - centre, axis=1)))
         return Tile(key, spacing, centre, radius, verts - centre, norms, lit, faces, shadow, h[core])
 
+    def shading_texture(self, key: TileKey, levels: int) -> np.ndarray:
+        """(side, side, 4) float32, side = cells 2^levels + 1: the unit normals (xyz) and lit
+        fractions of the tile's descendants `levels` levels down, texel [a, b] at the tile's
+        grid point (a, b) / 2^levels (a along x, b along y). Where the quadtree ends sooner,
+        the finest descendants there, linearly resampled. Descendants built for it are
+        dropped again: only what the renderer draws (and their ancestors) stays cached."""
+        level, i, j = key
+        k = min(levels, self.max_level() - level)
+        cells, m = self.lod.cells, 2**k
+        n = cells + 1
+        before = set(self._cache)
+        out = np.zeros((cells * m + 1, cells * m + 1, 4), np.float32)
+        for a in range(m):
+            for b in range(m):
+                t = self.tile((level + k, i * m + a, j * m + b))
+                block = (slice(a * cells, a * cells + n), slice(b * cells, b * cells + n))
+                out[block + (slice(0, 3),)] = t.normals[: n * n].reshape(n, n, 3)
+                out[block + (3,)] = t.lit[: n * n].reshape(n, n)
+        for built in set(self._cache) - before - {key}:
+            del self._cache[built]
+        side = cells * 2**levels + 1
+        if len(out) != side:
+            out = _resample_linear(out, side)
+            out[..., :3] /= np.linalg.norm(out[..., :3], axis=-1, keepdims=True)
+        return out
+
     # --- selection --------------------------------------------------------------------
 
     def select(self, pose: CameraPose, camera: Camera) -> list[TileKey]:
@@ -234,6 +261,17 @@ def depth_range(dists: np.ndarray, radii: np.ndarray, camera: Camera) -> tuple[f
     near = max(float(np.min(dists - radii)) * np.cos(half_diag) * 0.99, 1e-3)
     far = float(np.max(dists + radii)) * 1.01 + 1.0
     return near, far
+
+
+def _resample_linear(grid: np.ndarray, side: int) -> np.ndarray:
+    """(n, n, c) samples of a square, linearly interpolated onto (side, side, c) over the
+    same square (corners kept)."""
+    at = np.linspace(0.0, len(grid) - 1, side)
+    lo = np.minimum(at.astype(int), len(grid) - 2)
+    f = (at - lo)[:, None, None]
+    rows = grid[lo] * (1 - f) + grid[lo + 1] * f
+    f = f.reshape(1, -1, 1)
+    return (rows[:, lo] * (1 - f) + rows[:, lo + 1] * f).astype(np.float32)
 
 
 def _grid_faces(n: int) -> np.ndarray:

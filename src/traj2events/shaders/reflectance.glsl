@@ -26,27 +26,41 @@ float hg(float b_, float cos_g)
     return (1.0 - b_ * b_) / pow(1.0 - 2.0 * b_ * cos_g + b_ * b_, 1.5);
 }
 
+// The part of the law that depends on the phase angle alone (Hapke: (1 + B(g)) P(g);
+// Lunar-Lambert: L(g)): a coarse triangle's pixels can take it interpolated from its
+// vertices, since it varies with directions only (terrain_textured.vert).
+float phase_term(float cos_g)
+{
+    cos_g = clamp(cos_g, -1.0, 1.0);
+    if (model == 0) {
+        float g = acos(cos_g);
+        float opposition = b0 / (1.0 + tan(0.5 * g) / hw);
+        return (1.0 + opposition) * (0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g));
+    }
+    float g = degrees(acos(cos_g));
+    return clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
+}
+
 // Reflectance factor r_F (radiance = r_F * irradiance / PI) of a surface with unit normal
-// n seen along unit to_camera (toward the camera) under sun_dir; 0 where either is below
-// the surface's horizon.
-float reflectance_factor(vec3 n, vec3 to_camera)
+// n seen along unit to_camera (toward the camera) under sun_dir, given phase_term of their
+// phase angle; 0 where either is below the surface's horizon.
+float reflectance_factor_of_phase(vec3 n, vec3 to_camera, float phase)
 {
     float mu0 = dot(n, sun_dir);
     float mu = dot(n, to_camera);
-    float cos_g = clamp(dot(sun_dir, to_camera), -1.0, 1.0);
     float rf = 0.0;
     if (mu0 > 0.0 && mu > 0.0) {
         if (model == 0) {
-            float g = acos(cos_g);
-            float opposition = b0 / (1.0 + tan(0.5 * g) / hw);
-            float phase = 0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g);
             float multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0;
-            rf = 0.25 * w * mu0 / (mu0 + mu) * ((1.0 + opposition) * phase + multiple);
+            rf = 0.25 * w * mu0 / (mu0 + mu) * (phase + multiple);
         } else {
-            float g = degrees(acos(cos_g));
-            float limb = clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
-            rf = albedo * (2.0 * limb * mu0 / (mu0 + mu) + (1.0 - limb) * mu0);
+            rf = albedo * (2.0 * phase * mu0 / (mu0 + mu) + (1.0 - phase) * mu0);
         }
     }
     return rf;
+}
+
+float reflectance_factor(vec3 n, vec3 to_camera)
+{
+    return reflectance_factor_of_phase(n, to_camera, phase_term(dot(sun_dir, to_camera)));
 }

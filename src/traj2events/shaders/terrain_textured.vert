@@ -1,0 +1,30 @@
+#version 330 core
+// traj2events terrain shaded per pixel, vertex stage: coarse tiles whose normals and lit
+// fractions come from a texture of finer levels (render.lod.shading_levels > 0). Here:
+// positions relative to the camera, where each vertex sits in its tile's shading texture,
+// and the law's phase term, which depends on directions only and so varies little across
+// a triangle of a few pixels (the per-pixel rest: terrain_textured.frag).
+layout(location = 0) in vec4 tile;  // per instance (tile): xyz its origin minus the camera position (m), w its slot
+layout(location = 1) in vec2 uv;    // per vertex of a tile: its place in the tile's shading texture
+
+uniform samplerBuffer vertex_position_lit;  // per vertex: position minus its tile's origin (m), lit (unused here)
+uniform int vertices_per_tile;
+uniform mat4 V;            // the view rotation only (camera at the origin)
+uniform mat4 P;
+
+out vec2 frag_uv;
+flat out float frag_layer;  // the tile's slot: its layer of the shading texture array
+out vec3 frag_to_camera_m;
+out float frag_phase;
+
+#include "reflectance.glsl"
+
+void main()
+{
+    vec3 offset = texelFetch(vertex_position_lit, int(tile.w) * vertices_per_tile + gl_VertexID).xyz + tile.xyz;
+    frag_uv = uv;
+    frag_layer = tile.w;
+    frag_to_camera_m = -offset;
+    frag_phase = phase_term(dot(sun_dir, -normalize(offset)));
+    gl_Position = P * V * vec4(offset, 1.0);
+}
