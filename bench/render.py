@@ -6,11 +6,12 @@
 One core (Mesa llvmpipe with LP_NUM_THREADS=1). For a braking-like pose (2 km up, pitched
 55 deg, Sun at 7 deg) and a descent-like one (150 m, near nadir, Sun at 2 deg), Hapke and
 shadows on: for each level-of-detail budget (pixels per grid cell; smaller = more
-triangles) the median seconds per frame over `--frames` frames along a short stretch of
-flight (tiles built once beforehand, as in a trajectory; their build time is reported
-apart), the triangles drawn, what level of detail saves (triangles a uniform grid at the
-finest drawn spacing would need over the same tiles), and the error against a reference
-render at budget `--reference` (RMS of the radiance difference / mean radiance; median relative
+triangles; shaded per vertex: bench/render_shading.py measures shading per pixel) the
+median seconds per frame over `--frames` frames along a short stretch of flight (tiles
+built once beforehand, as in a trajectory; their build time is reported apart), the
+triangles drawn, what level of detail saves (triangles a uniform grid at the finest drawn
+spacing would need over the same tiles), and the error against a reference render at
+budget `--reference` (RMS of the radiance difference / mean radiance; median relative
 depth difference). Also bytes per frame on disk (frames.h5 radiance + depth, FFV1 video),
 and the paper config's cost (500 trajectories x ~7500 frames).
 """
@@ -65,14 +66,15 @@ def poses(state: np.ndarray, n: int, fps: float = 100.0) -> list:
 
 
 @contextlib.contextmanager
-def stretch_renderer(state, sun, extent, size, n_frames, budget, backend, terrain=None):
+def stretch_renderer(state, sun, extent, size, n_frames, budget, backend, terrain=None, shading_levels=0):
     """A renderer over one case's stretch of `n_frames` poses (`size`^2, 45 deg field of
-    view, Hapke, `budget` px/cell), every tile the stretch needs built beforehand, as a
-    trajectory's first frames would: yields (renderer, poses, seconds the tiles took to
-    build). `terrain`: one shared between calls (None: seed 1's)."""
+    view, Hapke, `budget` px/cell, shaded per vertex unless `shading_levels`), every tile
+    the stretch needs built beforehand, as a trajectory's first frames would: yields
+    (renderer, poses, seconds the tiles took to build). `terrain`: one shared between calls (None: seed 1's)."""
     camera = Camera(size, size, 45.0)
     terrain = ProceduralTerrain(TerrainParams(seed=1)) if terrain is None else terrain
-    tiles = TileSet(terrain, sun.direction, R_MOON, extent, LodSettings(pixels_per_cell=budget))
+    lod = LodSettings(pixels_per_cell=budget, shading_levels=shading_levels)
+    tiles = TileSet(terrain, sun.direction, R_MOON, extent, lod)
     path = poses(state, n_frames)
     with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as renderer:
         start = time.perf_counter()

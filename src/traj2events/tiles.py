@@ -92,6 +92,7 @@ class TileSet:
         self.faces = _grid_faces(lod.cells + 1)
         self.disk = TileCache(cache_dir, self.heights_identity()) if cache_dir else None
         self.n_evaluated = 0  # tiles whose terrain was evaluated here (not read from the disk cache)
+        self.n_built = 0  # tiles built here (again after an eviction), read from the disk cache or not
 
     def heights_identity(self) -> dict:
         """What a tile's heights depend on: the terrain, the quadtree and the Sun's side
@@ -123,6 +124,7 @@ class TileSet:
     def tile(self, key: TileKey) -> Tile:
         if key not in self._cache:
             self._cache[key] = self._build(key)
+            self.n_built += 1
         return self._cache[key]
 
     def evict(self, keep: set[TileKey]) -> None:
