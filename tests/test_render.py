@@ -18,6 +18,10 @@ from traj2events.tiles import LodSettings, TileSet
 
 R_MOON = 1737400.0
 SUN = Sun(1.496e11, 105.0, 7.0)
+# Shaded per pixel, as by default, but with textures one level finer, not three: for the
+# tests of slots, eviction and stars, which do not depend on the shading and would spend
+# most of their time building descendants at these small image sizes.
+QUICK = LodSettings(pixels_per_cell=8.0, shading_levels=1)
 
 
 def state(x=0.0, y=0.0, altitude=1000.0, roll=0.0, pitch=0.0, yaw=0.0):
@@ -125,7 +129,7 @@ def test_egl_and_osmesa_draw_the_same_pixels(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "lod", [LodSettings(), LodSettings(pixels_per_cell=4.0, shading_levels=1)], ids=["vertex", "pixel"]
+    "lod", [LodSettings(shading_levels=0), LodSettings(pixels_per_cell=4.0, shading_levels=1)], ids=["vertex", "pixel"]
 )
 def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch, lod):
     camera = Camera(48, 48, 45.0)
@@ -186,7 +190,10 @@ def test_a_crater_centre_appears_where_the_camera_model_puts_it():
     np.testing.assert_allclose(seen, predicted, atol=0.5)
 
 
-SHADINGS = {"vertex": LodSettings(), "pixel": LodSettings(shading_levels=1)}
+SHADINGS = {
+    "vertex": LodSettings(pixels_per_cell=2.0, shading_levels=0),
+    "pixel": LodSettings(pixels_per_cell=2.0, shading_levels=1),
+}
 
 
 @pytest.mark.parametrize("shading", SHADINGS)
@@ -268,7 +275,7 @@ def test_horizon_at_the_tilt_limit_splits_sky_and_ground():
 
 def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
     camera = Camera(32, 32, 45.0)
-    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, LodSettings())
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, QUICK)
     with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend="osmesa") as renderer:
         for x in (-3000.0, -1500.0, 0.0):
             frame = renderer.render(camera_pose(state(x=x, altitude=300.0, pitch=30.0)))
@@ -277,7 +284,10 @@ def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
         # Slots freed and filled again: the first view is drawn as a fresh renderer draws it.
         again = renderer.render(camera_pose(state(x=-3000.0, altitude=300.0, pitch=30.0)))
     first, _ = render(
-        ProceduralTerrain(TerrainParams(seed=6)), camera, camera_pose(state(x=-3000.0, altitude=300.0, pitch=30.0))
+        ProceduralTerrain(TerrainParams(seed=6)),
+        camera,
+        camera_pose(state(x=-3000.0, altitude=300.0, pitch=30.0)),
+        lod=QUICK,
     )
     assert np.array_equal(again.radiance, first.radiance)
 
@@ -285,7 +295,7 @@ def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
 @pytest.mark.parametrize(
     "lod",
     [
-        LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0),
+        LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0, shading_levels=0),
         LodSettings(min_spacing_m=0.25, pixels_per_cell=4.0, shading_levels=2),
     ],
     ids=["vertex", "pixel"],
@@ -342,11 +352,11 @@ def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
     camera = Camera(64, 64, 45.0)
     pose = camera_pose(state(x=-5000.0, altitude=2000.0, pitch=80.0))  # horizon across the image
     terrain = ProceduralTerrain(TerrainParams(seed=4))
-    tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, LodSettings())
+    tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, QUICK)
     stars = StarField.draw(5.0, seed=1)  # ~ 1400 over the sky: ~60 in a 45 deg view
     with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend="osmesa") as renderer:
         starry = renderer.render(pose)
-    plain, _ = render(terrain, camera, pose)
+    plain, _ = render(terrain, camera, pose, lod=QUICK)
     ground = plain.depth_m > 0
     assert np.array_equal(starry.depth_m, plain.depth_m)
     assert np.array_equal(starry.radiance[ground], plain.radiance[ground])
@@ -363,7 +373,7 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
     camera = Camera(40, 32, 45.0)
     poses = [camera_pose(state(x=x, altitude=300.0, pitch=30.0)) for x in (-3000.0, -1500.0, 0.0, 1500.0)]
     between = camera_pose(state(x=-800.0, altitude=250.0, pitch=20.0))
-    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, LodSettings())
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, QUICK)
     with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend="osmesa") as renderer:
         frames, extra = [], None
         for k, frame in enumerate(renderer.render_sequence(iter(poses))):
@@ -372,7 +382,7 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
                 extra = renderer.render(between)
         assert len(renderer._gl.pixel_buffers) == 2  # two frames in flight at most
     for pose, frame in [*zip(poses, frames), (between, extra)]:
-        alone, _ = render(ProceduralTerrain(TerrainParams(seed=6)), camera, pose)
+        alone, _ = render(ProceduralTerrain(TerrainParams(seed=6)), camera, pose, lod=QUICK)
         assert np.array_equal(frame.radiance, alone.radiance) and np.array_equal(frame.depth_m, alone.depth_m)
         assert frame.n_tiles == alone.n_tiles > 0
 
@@ -392,10 +402,10 @@ def test_shading_per_pixel_keeps_the_drawn_geometry():
     camera = Camera(96, 96, 45.0)
     pose = camera_pose(state(x=-3000.0, altitude=2000.0, pitch=30.0))
     terrain = ProceduralTerrain(TerrainParams(seed=4))
-    coarse, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=8.0))
+    coarse, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=8.0, shading_levels=0))
     shaded, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=8.0, shading_levels=2))
-    fine, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=2.0))
-    reference, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=1.0))
+    fine, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=2.0, shading_levels=0))
+    reference, _ = render(terrain, camera, pose, lod=LodSettings(pixels_per_cell=1.0, shading_levels=0))
     assert shaded.n_tiles == coarse.n_tiles < fine.n_tiles
     np.testing.assert_allclose(shaded.depth_m, coarse.depth_m, rtol=1e-6)
 
