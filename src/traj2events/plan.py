@@ -21,8 +21,8 @@ BYTES_PER_PX = {
 EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # measured on the default dataset
 # Seconds of one core: per frame (a fixed part and a per-pixel part), per motion field;
 # at 1024^2 from bench/workflow_cost.py (CPU time of the whole commands, encoders included).
-RENDER_S = (0.012, 2.6e-7)  # 128^2: 15 ms/frame, 1024^2: 0.25-0.31 s/frame with the two encoders (session 14)
-EVENTS_S = (0.0005, 6.6e-8)  # the whole events command (decoding, emulation, writing): 0.07 s at 1024^2
+RENDER_S = (0.012, 1.4e-7)  # 1024^2: 0.16 s/frame with the two encoders, shaded per pixel (session 15)
+EVENTS_S = (0.0005, 1.1e-7)  # the whole events command (decoding, emulation, writing): 0.08-0.15 s at 1024^2
 FIELD_S_PER_PX = 1.0e-7  # motion field with the terrain-true field: 0.08-0.12 s at 1024^2 (sessions 11-12)
 # Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
 # the smoke descent trajectory (694 frames) at 128^2 and 512^2, the motion field at 256^2
