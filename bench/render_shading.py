@@ -51,6 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import numpy as np  # noqa: E402
 from render import CASES, R_MOON, frame_errors, poses  # noqa: E402  (bench/render.py)
 
+import traj2events.render as render_module  # noqa: E402
 from traj2events.camera import Camera  # noqa: E402
 from traj2events.config import load_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
@@ -231,7 +232,12 @@ def main() -> None:
     parser.add_argument("--trajectory", type=Path, help="a trajectory.h5: fly it instead of the two stretches")
     parser.add_argument("--config", default="config/paper.yaml", help="--trajectory: the camera and scene")
     parser.add_argument("--every", type=int, default=250, help="--trajectory: every n-th pose")
+    parser.add_argument(
+        "--shading-mib", type=int, help="the shading texture array's cap (render._SHADING_BYTES), MiB: more slots"
+    )
     args = parser.parse_args()
+    if args.shading_mib:
+        render_module._SHADING_BYTES = args.shading_mib * 2**20
     run_trajectory(args) if args.trajectory else run_poses(args)
 
 
