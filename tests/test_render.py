@@ -129,7 +129,9 @@ def test_egl_and_osmesa_draw_the_same_pixels(tmp_path):
 
 
 @pytest.mark.parametrize(
-    "lod", [LodSettings(shading_levels=0), LodSettings(pixels_per_cell=4.0, shading_levels=1)], ids=["vertex", "pixel"]
+    "lod",
+    [LodSettings(pixels_per_cell=2.0, shading_levels=0), LodSettings(pixels_per_cell=4.0, shading_levels=1)],
+    ids=["vertex", "pixel"],
 )
 def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch, lod):
     camera = Camera(48, 48, 45.0)

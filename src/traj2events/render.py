@@ -464,7 +464,7 @@ class TerrainRenderer:
         """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black
         sky. `backend`: auto | egl | osmesa (resolve_backend)."""
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
-        self.max_cached_tiles, self.stars = max_cached_tiles, stars
+        self.stars = stars
         self.backend = resolve_backend(backend)
         self._platform = _context(self.backend, camera.width, camera.height)
         from OpenGL import GL as gl
