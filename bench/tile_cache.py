@@ -4,16 +4,18 @@
       [--config config/paper.yaml] [--every 25]
 
 At the config's camera size, the tiles every `--every`-th pose of each trajectory needs
-are selected (and so built), as a render job does. The first trajectory fills an empty
-cache; then the second runs twice, alternated: with that cache, and without one. For each
-run: tiles built (terrain evaluated), tiles read from the cache, seconds, cache size on
-disk; and the largest difference of the drawn tiles' vertices between the cached run and
-the uncached one (0: the tiles are the same bytes).
+are selected (and so built), and each drawn tile's shading texture made once (when the
+config shades per pixel, `render.lod.shading_levels` > 0), as a render job does. The
+first trajectory fills an empty cache; then the second runs twice, alternated: with that
+cache, and without one. For each run: tiles built (terrain evaluated), tiles read from
+the cache, shading textures made and read, seconds, cache size on disk; and whether the
+cached run's drawn tiles (vertices) and textures are the same bytes as the uncached run's.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import platform
 import shutil
 import sys
@@ -31,14 +33,25 @@ from traj2events.stages.render import RenderSettings  # noqa: E402
 
 
 def fly(trajectory: Path, config: dict, every: int, cache: Path | None):
-    """(tiles, drawn keys, seconds) of selecting every `every`-th pose's tiles."""
+    """(tiles, {drawn key: its shading texture's digest}, seconds) of selecting every
+    `every`-th pose's tiles and making each drawn tile's shading texture once."""
     tr = read_trajectory(trajectory)
     camera, tiles, _, _ = RenderSettings.from_config(config, str(tr.attrs["scenario"])).build(cache)
-    drawn = set()
+    levels = tiles.lod.shading_levels
+    drawn: dict = {}
     start = time.perf_counter()
     for k in range(0, len(tr.t), every):
-        drawn.update(tiles.select(camera.pose(tr.state[k]), camera))
+        for key in tiles.select(camera.pose(tr.state[k]), camera):
+            if key not in drawn:
+                texture = tiles.shading_texture(key, levels) if levels else np.zeros(0)
+                drawn[key] = hashlib.sha256(texture.tobytes()).hexdigest()
     return tiles, drawn, time.perf_counter() - start
+
+
+def textures(tiles) -> tuple[int, int]:
+    """(shading textures made, read) through the tile cache (0, 0 without one)."""
+    disk = tiles.texture_disk(tiles.lod.shading_levels) if tiles.lod.shading_levels else None
+    return (disk.n_written, disk.n_read) if disk else (0, 0)
 
 
 def main() -> None:
@@ -53,14 +66,20 @@ def main() -> None:
         f"# tile cache: {args.config} ({config['camera']['width']}^2), every {args.every}th pose; "
         f"{platform.node()}, {time.strftime('%Y-%m-%d')}"
     )
-    print("| run | tiles built | read from cache | s | cache MB |")
-    print("|---|---|---|---|---|")
+    print("| run | tiles built | read from cache | textures made, read | s | cache MB |")
+    print("|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         cache = Path(tmp) / "tile_cache"
+
+        def row(trajectory, name, tiles, seconds):
+            read = tiles.disk.n_read if tiles.disk else 0
+            made, read_textures = textures(tiles)
+            size = sum(p.stat().st_size for p in cache.rglob("*.npy")) / 1e6
+            print(f"| {trajectory} ({name}) | {tiles.n_evaluated} | {read} | {made}, {read_textures} "
+                  f"| {seconds:.1f} | {size:.0f} |", flush=True)  # fmt: skip
+
         tiles, _, seconds = fly(args.first, config, args.every, cache)
-        size = sum(p.stat().st_size for p in cache.rglob("*.npy")) / 1e6
-        built, read = tiles.n_evaluated, tiles.disk.n_read
-        print(f"| {args.first} (empty cache) | {built} | {read} | {seconds:.1f} | {size:.0f} |")
+        row(args.first, "empty cache", tiles, seconds)
         filled = Path(tmp) / "filled"
         shutil.copytree(cache, filled)
         runs = {}
@@ -70,13 +89,13 @@ def main() -> None:
                     shutil.rmtree(cache)
                     shutil.copytree(filled, cache)
                 tiles, drawn, seconds = fly(args.second, config, args.every, folder)
-                read = tiles.disk.n_read if tiles.disk else 0
-                size = sum(p.stat().st_size for p in cache.rglob("*.npy")) / 1e6
-                print(f"| {args.second} ({name}) | {tiles.n_evaluated} | {read} | {seconds:.1f} | {size:.0f} |")
+                row(args.second, name, tiles, seconds)
                 runs[name] = (tiles, drawn)
-        (cached, drawn), (plain, _) = runs["cached"], runs["no cache"]
+        (cached, drawn), (plain, plain_drawn) = runs["cached"], runs["no cache"]
         worst = max(float(np.max(np.abs(cached.tile(k).vertices - plain.tile(k).vertices))) for k in drawn)
         print(f"\nlargest vertex difference, cached against built here, over {len(drawn)} drawn tiles: {worst} m")
+        same = sum(drawn[k] == plain_drawn[k] for k in drawn)
+        print(f"shading textures the same bytes, cached against made here: {same} of {len(drawn)}")
 
 
 if __name__ == "__main__":

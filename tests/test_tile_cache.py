@@ -55,6 +55,28 @@ def test_another_terrain_or_sun_side_has_its_own_folder(tmp_path):
     assert b.n_evaluated == b.n_cached and c.n_evaluated == c.n_cached
 
 
+def test_shading_textures_read_back_are_the_textures_built_without_their_descendants(tmp_path):
+    reference, keys = tiles(None)
+    drawn = keys[:3]
+    first, _ = tiles(tmp_path)
+    built = {key: first.shading_texture(key, 2) for key in drawn}
+    second, _ = tiles(tmp_path)
+    before = second.n_built
+    for key in drawn:
+        texture = second.shading_texture(key, 2)
+        assert texture.dtype == np.float16 and np.array_equal(texture, built[key]), key
+        assert np.array_equal(texture, reference.shading_texture(key, 2)), key  # as without a cache
+    assert second.n_built == before  # no descendant built: the 16 per texture were read whole
+    disk = second.texture_disk(2)
+    assert disk.n_read == len(drawn) and disk.folder != second.disk.folder
+    identity = json.loads((disk.folder / "identity.json").read_text())
+    assert identity["levels"] == 2 and identity["heights"]["terrain"]["procedural"]["seed"] == 1
+    # Another Sun elevation on the same side shares the heights, not the shadows.
+    other, _ = tiles(tmp_path, sun=Sun(1.496e11, 100.0, 9.0))
+    assert other.disk.folder == second.disk.folder and other.texture_disk(2).folder != disk.folder
+    assert other.texture_disk(1).folder != other.texture_disk(2).folder
+
+
 def test_an_elevation_grid_is_keyed_by_its_values(tmp_path):
     heights = np.zeros((50, 50))
     one = TileCache(tmp_path, GridTerrain(heights, 2.0, (-50.0, -50.0)).identity())

@@ -312,8 +312,8 @@ class _GLScene:
             side = self.shading_side
             gl.glActiveTexture(gl.GL_TEXTURE2)
             gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
-            gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, slot, side, side, 1, gl.GL_RGBA, gl.GL_FLOAT,
-                               np.ascontiguousarray(shading, np.float32))  # fmt: skip
+            gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, slot, side, side, 1, gl.GL_RGBA, gl.GL_HALF_FLOAT,
+                               np.ascontiguousarray(shading, np.float16))  # fmt: skip
 
     def uniform(self, name: str, value) -> None:
         gl = self.gl

@@ -15,7 +15,8 @@ meet with skirts (a strip hanging below each tile edge) instead of cracks.
 
 Building a tile is mostly evaluating the terrain's heights on its grid: with a tile cache
 (`cache_dir`, formats/tile_cache.py) those are stored once and read by every later
-TileSet with the same terrain, quadtree and Sun side, in this process or another.
+TileSet with the same terrain, quadtree and Sun side, in this process or another. A drawn
+tile's shading texture (4^levels descendants built for it) is stored there too, whole.
 
 Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
 grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights
@@ -90,7 +91,9 @@ class TileSet:
         self.lod = lod
         self._cache: dict[TileKey, Tile] = {}
         self.faces = _grid_faces(lod.cells + 1)
+        self.cache_dir = cache_dir
         self.disk = TileCache(cache_dir, self.heights_identity()) if cache_dir else None
+        self.texture_disks: dict[int, TileCache] = {}  # by shading levels
         self.n_evaluated = 0  # tiles whose terrain was evaluated here (not read from the disk cache)
         self.n_built = 0  # tiles built here (again after an eviction), read from the disk cache or not
 
@@ -109,6 +112,30 @@ class TileSet:
             "sun_side": [bool(self.sun_dir[0] > 0), bool(self.sun_dir[1] > 0)],
             "code": code_fingerprint("traj2events.terrain"),
         }
+
+    def shading_identity(self, levels: int) -> dict:
+        """What a drawn tile's shading texture depends on: its descendants' heights, the
+        exact Sun direction and the Moon's radius (their shadows and normals), where the
+        quadtree ends, the levels, and the tile code (illumination and terrain with it)."""
+        from .fingerprint import code_fingerprint
+
+        return {
+            "kind": "shading_texture",
+            "heights": self.heights_identity(),
+            "sun_dir": [float(v) for v in self.sun_dir],
+            "radius_m": float(self.radius_m),
+            "min_spacing_m": float(self.lod.min_spacing_m),
+            "levels": int(levels),
+            "code": code_fingerprint("traj2events.tiles"),
+        }
+
+    def texture_disk(self, levels: int) -> TileCache | None:
+        """The tile cache's folder of shading textures `levels` finer (None: no tile cache)."""
+        if self.cache_dir is None:
+            return None
+        if levels not in self.texture_disks:
+            self.texture_disks[levels] = TileCache(self.cache_dir, self.shading_identity(levels))
+        return self.texture_disks[levels]
 
     # --- geometry ---------------------------------------------------------------------
 
@@ -179,11 +206,23 @@ class TileSet:
         return Tile(key, spacing, centre, radius, verts - centre, norms, lit, faces, shadow, h[core])
 
     def shading_texture(self, key: TileKey, levels: int) -> np.ndarray:
-        """(side, side, 4) float32, side = cells 2^levels + 1: the unit normals (xyz) and lit
-        fractions of the tile's descendants `levels` levels down, texel [a, b] at the tile's
-        grid point (a, b) / 2^levels (a along x, b along y). Where the quadtree ends sooner,
-        the finest descendants there, linearly resampled. Descendants built for it are
-        dropped again: only what the renderer draws (and their ancestors) stays cached."""
+        """(side, side, 4) float16 (the renderer's texel format), side = cells 2^levels + 1:
+        the unit normals (xyz) and lit fractions of the tile's descendants `levels` levels
+        down, texel [a, b] at the tile's grid point (a, b) / 2^levels (a along x, b along y).
+        Where the quadtree ends sooner, the finest descendants there, linearly resampled.
+        Descendants built for it are dropped again: only what the renderer draws (and their
+        ancestors) stays cached. With a tile cache, read from it when stored there."""
+        side = self.lod.cells * 2**levels + 1
+        disk = self.texture_disk(levels)
+        texture = disk.load(key, (side, side, 4), np.float16) if disk else None
+        if texture is None:
+            texture = self._compose_shading(key, levels).astype(np.float16)
+            if disk:
+                disk.save(key, texture)
+        return texture
+
+    def _compose_shading(self, key: TileKey, levels: int) -> np.ndarray:
+        """shading_texture's texels, float32, from the descendants."""
         level, i, j = key
         k = min(levels, self.max_level() - level)
         cells, m = self.lod.cells, 2**k

@@ -1,5 +1,6 @@
-"""The tile cache on disk (`render.tile_cache`): the terrain heights of built tiles,
-shared by every render job whose tiles are the same (all trajectories of a scenario).
+"""The tile cache on disk (`render.tile_cache`): the terrain heights of built tiles, and
+the shading textures of drawn ones, shared by every render job whose tiles are the same
+(all trajectories of a scenario).
 
 A tile's heights (its grid extended for normals and the shadow march, float64) are the
 costly part of building it (the procedural craters, boulders and roughness); the shadows,
@@ -9,6 +10,12 @@ values), on the quadtree (root half-extent, cells, margin), on the sides where a
 grid extends toward the Sun (the signs of the Sun direction's x and y) and on the
 terrain code: a folder is named by a hash of all of these (written out beside the tiles
 in identity.json), so a changed setting or code never reads another's tiles.
+
+A shading texture (tiles.TileSet.shading_texture: the normals and lit fractions of a drawn
+tile's descendants, float16) costs the building of those descendants, 4^levels tiles with
+their shadow marches. It is stored whole, in a folder of its own keyed by the heights'
+identity plus what the shading adds: the exact Sun direction, the Moon's radius, the
+levels and the tile and illumination code.
 
 One .npy per tile, `{folder}/{level}/{i}_{j}.npy`, written to a temporary name and
 renamed: concurrent jobs (a cluster's, on a shared file system) never read half a tile,
@@ -52,19 +59,19 @@ class TileCache:
         level, i, j = key
         return self.folder / str(level) / f"{i}_{j}.npy"
 
-    def load(self, key: tuple[int, int, int], shape: tuple[int, int]) -> np.ndarray | None:
-        """The tile's stored heights, or None (not stored, unreadable or not `shape`)."""
+    def load(self, key: tuple[int, int, int], shape: tuple[int, ...], dtype=np.float64) -> np.ndarray | None:
+        """The tile's stored array, or None (not stored, unreadable, or not `shape` and `dtype`)."""
         try:
-            heights = np.load(self.path(key), allow_pickle=False)
+            array = np.load(self.path(key), allow_pickle=False)
         except (OSError, ValueError):
             return None
-        if heights.shape != shape or heights.dtype != np.float64:
+        if array.shape != shape or array.dtype != dtype:
             return None
         self.n_read += 1
-        return heights
+        return array
 
-    def save(self, key: tuple[int, int, int], heights: np.ndarray) -> None:
-        if self._write(self.path(key), lambda f: np.save(f, heights, allow_pickle=False)):
+    def save(self, key: tuple[int, int, int], array: np.ndarray) -> None:
+        if self._write(self.path(key), lambda f: np.save(f, array, allow_pickle=False)):
             self.n_written += 1
 
     @staticmethod

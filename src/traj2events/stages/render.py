@@ -240,6 +240,8 @@ def render_trajectory(
     log(f"{n} frames and {added} adaptive ones in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
     if tiles.disk is not None:
         log(f"tiles: {tiles.n_evaluated} built, {tiles.disk.n_read} read from the tile cache {tiles.disk.folder}")
+        for textures in tiles.texture_disks.values():
+            log(f"shading textures: {textures.n_written} made, {textures.n_read} read from {textures.folder}")
 
 
 # frames.h5's attribute order (kept, so the same scene gives the same bytes).
