@@ -234,25 +234,26 @@ def test_same_config_same_bytes(built, tmp_path):
     assert_same_dataset(built, tmp_path)
 
 
-@pytest.mark.parametrize("marker", ["logs/*/sample_trajectories.log", "*/*/.frames.h5.*.part", "*/*/.events.h5.*.part"])
-def test_a_killed_run_recovers_as_the_readme_says(built, tmp_path, marker):
-    """SIGKILL while sampling (its log has started), rendering or emulating (their
-    temporaries exist); then --unlock and the same command, as the README says."""
+def test_a_killed_run_recovers_as_the_readme_says(built, tmp_path):
+    """SIGKILL while sampling (its log has started), then while rendering and while
+    emulating (their temporaries exist), each time followed by --unlock and the same
+    command, as the README says: one run killed three times, so the dataset is built once."""
     shutil.copy(built / "config.yaml", tmp_path / "config.yaml")
     cmd = [str(SNAKEMAKE), "-s", str(ROOT / "Snakefile"), "--directory", str(tmp_path), "--cores", "2",
            "--configfile", str(tmp_path / "config.yaml")]  # fmt: skip
-    run = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                           start_new_session=True)  # fmt: skip
-    deadline, seen = time.monotonic() + 300, False
-    while run.poll() is None and time.monotonic() < deadline and not seen:
-        seen = bool(list((tmp_path / "results").glob(marker)))  # that stage is running
-        time.sleep(0.01)
-    assert seen and run.poll() is None, f"the run ended before {marker} appeared"
-    os.killpg(run.pid, signal.SIGKILL)  # Snakemake and its jobs, as a killed session would
-    run.wait()
-    locked = snakemake(tmp_path, check=False)
-    assert locked.returncode != 0 and "unlock" in locked.stdout + locked.stderr  # the README's first step
-    snakemake(tmp_path, "--unlock")
+    for marker in ("logs/*/sample_trajectories.log", "*/*/.frames.h5.*.part", "*/*/.events.h5.*.part"):
+        run = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                               start_new_session=True)  # fmt: skip
+        deadline, seen = time.monotonic() + 300, False
+        while run.poll() is None and time.monotonic() < deadline and not seen:
+            seen = bool(list((tmp_path / "results").glob(marker)))  # that stage is running
+            time.sleep(0.01)
+        assert seen and run.poll() is None, f"the run ended before {marker} appeared"
+        os.killpg(run.pid, signal.SIGKILL)  # Snakemake and its jobs, as a killed session would
+        run.wait()
+        locked = snakemake(tmp_path, check=False)
+        assert locked.returncode != 0 and "unlock" in locked.stdout + locked.stderr, marker  # the README's first step
+        snakemake(tmp_path, "--unlock")
     snakemake(tmp_path)
     assert not [p for p in (tmp_path / "results").rglob("*") if ".part" in p.name]  # no debris
     assert_same_dataset(built, tmp_path)
