@@ -5,11 +5,12 @@
 
 At the config's camera size, the tiles every `--every`-th pose of each trajectory needs
 are selected (and so built), and each drawn tile's shading texture made once (when the
-config shades per pixel, `render.lod.shading_levels` > 0), as a render job does. The
-first trajectory fills an empty cache; then the second runs twice, alternated: with that
-cache, and without one. For each run: tiles built (terrain evaluated), tiles read from
-the cache, shading textures made and read, seconds, cache size on disk; and whether the
-cached run's drawn tiles (vertices) and textures are the same bytes as the uncached run's.
+config shades per pixel, `render.lod.shading_levels` > 0), as a render job does. The first
+trajectory fills an empty cache; then the second runs twice, alternated: with that cache,
+with only its heights (the cache before session 16), and without one. For each run: tiles
+built (terrain evaluated), tiles read from the cache, shading textures made and read,
+seconds, cache size on disk; and whether the cached run's drawn tiles (vertices) and
+textures are the same bytes as the uncached run's.
 """
 
 from __future__ import annotations
@@ -32,11 +33,14 @@ from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 
 
-def fly(trajectory: Path, config: dict, every: int, cache: Path | None):
+def fly(trajectory: Path, config: dict, every: int, cache: Path | None, textures_cached: bool = True):
     """(tiles, {drawn key: its shading texture's digest}, seconds) of selecting every
-    `every`-th pose's tiles and making each drawn tile's shading texture once."""
+    `every`-th pose's tiles and making each drawn tile's shading texture once;
+    `textures_cached` False: the cache keeps heights only (as before session 16)."""
     tr = read_trajectory(trajectory)
     camera, tiles, _, _ = RenderSettings.from_config(config, str(tr.attrs["scenario"])).build(cache)
+    if not textures_cached:
+        tiles.texture_disk = lambda levels: None
     levels = tiles.lod.shading_levels
     drawn: dict = {}
     start = time.perf_counter()
@@ -84,11 +88,15 @@ def main() -> None:
         shutil.copytree(cache, filled)
         runs = {}
         for _ in range(2):
-            for name, folder in (("cached", cache), ("no cache", None)):
+            for name, folder, textures_cached in (
+                ("cached", cache, True),
+                ("heights cached only", cache, False),
+                ("no cache", None, False),
+            ):
                 if folder is not None:  # every cached run starts from the first trajectory's cache
                     shutil.rmtree(cache)
                     shutil.copytree(filled, cache)
-                tiles, drawn, seconds = fly(args.second, config, args.every, folder)
+                tiles, drawn, seconds = fly(args.second, config, args.every, folder, textures_cached)
                 row(args.second, name, tiles, seconds)
                 runs[name] = (tiles, drawn)
         (cached, drawn), (plain, plain_drawn) = runs["cached"], runs["no cache"]
