@@ -22,7 +22,9 @@ Poses (the default): bench/render.py's braking and descent stretches of --frames
 (seconds printed), then the variants are alternated --rounds times: median ms per frame.
 
 --trajectory: a whole flight at the config's camera, every --every-th pose. A first pass
-at the reference budget fills a tile cache (heights), as a scenario's earlier jobs do.
+at the reference budget fills a tile cache (heights), as a scenario's earlier jobs do;
+shading textures are not cached, so each variant's tile building is that of ground no
+earlier job has textured (bench/tile_cache.py measures the textures cached).
 Then each variant flies the poses once (tile building, texture making, uploads and the
 first draws), and the variants are alternated over the same poses for the frame times.
 Per variant: tiles built, the first pass's seconds less its frames' (= tile building over
@@ -173,6 +175,9 @@ def run_trajectory(args) -> None:
             lod = {**base.lod, "pixels_per_cell": budget, "shading_levels": levels}
             size = {"width": base.width * factor, "height": base.height * factor}
             camera, tiles, sun, reflectance = dataclasses.replace(base, lod=lod, **size).build(cache)
+            # Heights shared, shading textures not: variants with the same levels make the
+            # same textures, and a later one must not read an earlier one's.
+            tiles.texture_disk = lambda levels: None
             return TerrainRenderer(tiles, camera, sun, reflectance, backend="osmesa")
 
         reference = renderer(f"{args.reference}:0", args.supersample)

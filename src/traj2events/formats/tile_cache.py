@@ -14,8 +14,8 @@ in identity.json), so a changed setting or code never reads another's tiles.
 A shading texture (tiles.TileSet.shading_texture: the normals and lit fractions of a drawn
 tile's descendants, float16) costs the building of those descendants, 4^levels tiles with
 their shadow marches. It is stored whole, in a folder of its own keyed by the heights'
-identity plus what the shading adds: the exact Sun direction, the Moon's radius, the
-levels and the tile and illumination code.
+identity plus what the shading adds: the exact Sun direction, the Moon's radius, where
+the quadtree ends (`min_spacing_m`), the levels and the tile and illumination code.
 
 One .npy per tile, `{folder}/{level}/{i}_{j}.npy`, written to a temporary name and
 renamed: concurrent jobs (a cluster's, on a shared file system) never read half a tile,
