@@ -393,16 +393,20 @@ def test_input_scale_on_float32_frames_is_the_float64_product_byte_for_byte():
 
 @pytest.mark.parametrize("width, height", [(1024, 1024), (346, 260), (1, 7), (640, 1)])
 @pytest.mark.parametrize("labels", [False, True])
-def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels):
+@pytest.mark.parametrize("times", ["to hours", "dense", "crowded"])
+def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels, times):
     """_assemble's key (t us, y, x, p[, label]) decodes to the very events it encodes, in
-    (t, y, x, p) order: t from 0 (the first key inside t = 0's range) to hours, every
-    corner pixel, both polarities, on image widths that are not powers of two."""
+    (t, y, x, p) order: every corner pixel, both polarities, on image widths that are not
+    powers of two; t from 0 (the first key inside t = 0's range) to hours (buckets of 2^s
+    us), over fewer microseconds than events (a bucket per us, sorted by insertion), or
+    crowded into a few microseconds (buckets too disordered for insertion)."""
     from traj2events.emulator import _assemble
 
     rng = np.random.default_rng(width + height)
     n_pixels = width * height
     n = 20_000
-    t_us = np.concatenate([[0, 0, 1, 3_600_000_000], rng.integers(0, 5_000, n - 4)])
+    last_us = {"to hours": 3_600_000_000, "dense": 5_000, "crowded": 3}[times]
+    t_us = np.concatenate([[0, 0, 1, last_us], rng.integers(0, min(last_us, 5_000), n - 4)])
     pix = np.concatenate([[n_pixels - 1, 1, 0, n_pixels - 1], rng.integers(0, n_pixels, n - 4)])
     on = rng.random(n) < 0.5
     label = rng.integers(0, 4, n).astype(np.uint8) if labels else None
@@ -414,6 +418,24 @@ def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels):
     np.testing.assert_array_equal(events["p"], on[order])
     if labels:
         np.testing.assert_array_equal(out_label, label[order])
+
+
+def test_event_keys_sort_like_numpy_where_buckets_are_nearly_in_order():
+    """The signal's events come in pixel order, the noise's after them: the insertion path
+    (few descents per bucket) and an empty input give np.sort's keys."""
+    from traj2events.emulator import _NO_LABELS, _sorted_keys
+
+    rng = np.random.default_rng(3)
+    n_pixels = 1024 * 1024
+    signal = np.sort(rng.choice(n_pixels, 50_000, replace=False))
+    noise = rng.integers(0, n_pixels, 300)
+    pix = np.concatenate([signal, noise])
+    t_s = rng.integers(0, 10_000, pix.size) * 1e-6
+    on = rng.random(pix.size) < 0.5
+    keys = _sorted_keys(pix, t_s, on, _NO_LABELS, n_pixels)
+    expected = np.sort(np.rint(t_s * 1e6).astype(np.int64) * (2 * n_pixels) + pix * 2 + on)
+    np.testing.assert_array_equal(keys, expected)
+    assert _sorted_keys(pix[:0], t_s[:0], on[:0], _NO_LABELS, n_pixels).size == 0
 
 
 def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
