@@ -237,6 +237,12 @@ def test_stream_invariants_and_chunking_does_not_change_a_byte():
     emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
     parts = [emu.process(frames[a:b], times[a:b]) for a, b in ((0, 1), (1, 7), (7, 8), (8, 40))]
     assert np.concatenate(parts).tobytes() == whole.tobytes()
+    # One frame interval at a time: the same events, each interval's within its own times.
+    emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
+    intervals = [events for a, b in ((0, 7), (7, 40)) for events, _ in emu.intervals(frames[a:b], times[a:b])]
+    assert len(intervals) == 39 and np.concatenate(intervals).tobytes() == whole.tobytes()
+    for k, events in enumerate(intervals):
+        assert ((events["t"] >= round(times[k] * 1e6)) & (events["t"] <= round(times[k + 1] * 1e6))).all()
 
 
 def test_bad_input_is_named():

@@ -26,8 +26,10 @@ def random_events(n=5000, seed=0, width=40, height=30, span_us=2_500_000):
 
 
 def write(path, events, chunks=1, duration_us=2_600_000):
+    """events.h5 of `events` appended in `chunks` equal parts, or in parts of the given sizes."""
     writer = EventsWriter(path, 40, 30, {"preset": "paper", "seed": 3}, chunk=1024)
-    for part in np.array_split(events, chunks):
+    parts = np.split(events, np.cumsum(chunks)[:-1]) if isinstance(chunks, list) else np.array_split(events, chunks)
+    for part in parts:
         writer.append(part)
     writer.close(duration_us)
 
@@ -52,7 +54,11 @@ def test_chunking_does_not_change_the_file(tmp_path):
     events = random_events()
     write(tmp_path / "one.h5", events, chunks=1)
     write(tmp_path / "many.h5", events, chunks=13)
+    # The writer's 1024-event chunks filled exactly, skipped over (whole ones straight from a
+    # part) and left partial at the end.
+    write(tmp_path / "uneven.h5", events, chunks=[1, 1023, 1024, 1500, 1452])
     assert (tmp_path / "one.h5").read_bytes() == (tmp_path / "many.h5").read_bytes()
+    assert (tmp_path / "one.h5").read_bytes() == (tmp_path / "uneven.h5").read_bytes()
     back, attrs = read_events(tmp_path / "one.h5")
     assert back.tobytes() == events.tobytes()
     window = read_events_window(tmp_path / "one.h5", 1_000_500, 1_010_500)

@@ -42,6 +42,7 @@ compiled on first use and cached beside this file.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import Iterator
 
 import numpy as np
 from llvmlite import ir
@@ -570,16 +571,19 @@ class EventEmulator:
         """Feed frames (K, H, W) in DN (8-bit values, or float DN-equivalents, e.g. from
         `radiance_to_dn`), times `input_scale`, with their times (K,) in s; events up to
         the last one."""
-        return self._process(frames_dn, times_s)[0]
+        return self._joined(self.intervals(frames_dn, times_s))[0]
 
     def process_with_labels(self, frames_dn: np.ndarray, times_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """As `process`, and each event's label (uint8, `formats.events.EVENT_LABELS`): the
         same events, byte for byte. Needs `labels=True` from the start."""
         if not self.labels:
             raise ValueError("EventEmulator: labels need labels=True when the emulator is made")
-        return self._process(frames_dn, times_s)
+        return self._joined(self.intervals(frames_dn, times_s))
 
-    def _process(self, frames_dn: np.ndarray, times_s: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    def intervals(self, frames_dn: np.ndarray, times_s: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray | None]]:
+        """As `process` (with labels: `process_with_labels`), one frame interval's events
+        (and labels, else None) at a time: the same events, with memory for one interval's
+        events instead of the chunk's (a writer can take each as it comes)."""
         frames = np.asarray(frames_dn)
         times = np.asarray(times_s, dtype=np.float64)
         if frames.ndim != 3 or frames.shape[1:] != (self.height, self.width) or len(times) != len(frames):
@@ -587,7 +591,6 @@ class EventEmulator:
                 f"frames: expected (K, {self.height}, {self.width}) with K timestamps, "
                 f"got {frames.shape} and {times.shape}"
             )
-        chunks = []
         # min and max propagate NaN: two passes, no temporary arrays.
         if frames.dtype.kind == "f" and frames.size and not (frames.min() >= 0 and frames.max() < np.inf):
             bad = int(
@@ -613,9 +616,15 @@ class EventEmulator:
                 continue
             if not t > self._t:
                 raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
-            chunks.append(self._interval_events(intensity, float(t)))
+            events, labels = self._interval_events(intensity, float(t))
+            yield events, labels
         if self._intensity is not None and self._intensity.base is not None:
             self._intensity = self._intensity.copy()  # kept for the next call: not a view of this chunk
+
+    def _joined(
+        self, intervals: Iterator[tuple[np.ndarray, np.ndarray | None]]
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        chunks = list(intervals)
         # Joined as bytes: NumPy copies the 13-byte packed records one by one, bytes in bulk (3-4x).
         events = (
             np.concatenate([c[0].view(np.uint8) for c in chunks]).view(EVENT_DTYPE)

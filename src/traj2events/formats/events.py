@@ -50,7 +50,9 @@ class EventsWriter:
         self._file.create_dataset("t_offset", data=np.int64(t_offset_us), track_times=False)
         set_attrs(self._file, {"width": width, "height": height, **attrs})
         self.t_offset_us = t_offset_us
-        self.n = 0
+        self.n = 0  # events appended
+        self._written = 0  # events in the file: whole chunks, so that HDF5 compresses each chunk once
+        self._buffer = {name: np.empty(chunk, ds.dtype) for name, ds in self._sets.items()}
         self._ms_to_idx: list[np.ndarray] = []
         self._next_ms = 0
         self._last_t = np.iinfo(np.int64).min
@@ -71,16 +73,40 @@ class EventsWriter:
             ms = np.arange(self._next_ms, last_ms + 1, dtype=np.int64)
             self._ms_to_idx.append(self.n + np.searchsorted(t, ms * 1000, side="left"))
             self._next_ms = last_ms + 1
-        columns = {"x": events["x"], "y": events["y"], "t": t, "p": events["p"], "label": labels}
-        for name, ds in self._sets.items():
-            values = columns[name]
-            ds.resize((self.n + len(t),))
-            ds[self.n :] = values
-        self.n += len(t)
+        self._take({"x": events["x"], "y": events["y"], "t": t, "p": events["p"], "label": labels})
         self._last_t = int(t[-1])
+
+    def _take(self, columns: dict) -> None:
+        """Columns into the file a whole chunk at a time (a chunk written in parts would be
+        compressed, read back and compressed again); the rest waits in the buffer."""
+        chunk = len(self._buffer["t"])
+        n, start = len(columns["t"]), 0
+        while start < n:
+            buffered = self.n - self._written
+            if buffered == 0 and n - start >= chunk:  # whole chunks straight from the columns
+                whole = (n - start) // chunk * chunk
+                self.n += whole
+                self._write({name: columns[name][start : start + whole] for name in self._sets})
+                start += whole
+                continue
+            take = min(n - start, chunk - buffered)
+            for name, buffer in self._buffer.items():
+                buffer[buffered : buffered + take] = columns[name][start : start + take]
+            start += take
+            self.n += take
+            if buffered + take == chunk:
+                self._write(self._buffer)
+
+    def _write(self, columns: dict) -> None:
+        n = min(len(columns["t"]), self.n - self._written)
+        for name, ds in self._sets.items():
+            ds.resize((self._written + n,))
+            ds[self._written :] = columns[name][:n]
+        self._written += n
 
     def close(self, duration_us: int, exc=(None, None, None)) -> None:
         if exc[0] is None:
+            self._write(self._buffer)  # the last, partial chunk
             # Milliseconds after the last event, up to the end of the recording, index past the end.
             end_ms = int(max(duration_us - self.t_offset_us, 0) // 1000)
             if end_ms >= self._next_ms:

@@ -99,14 +99,15 @@ def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorPar
 
 
 def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
-    width, height, video_fps, _ = video_info(path)
+    info = video_info(path)
+    width, height, video_fps, _ = info
     fps = fps or video_fps
     if not fps > 0:
         raise ValueError(f"events: {path} gives no frame rate; give --fps")
 
     def video():
         k = 0
-        for frames in iter_video(path, chunk):
+        for frames in iter_video(path, chunk, info):
             yield frames, (k + np.arange(len(frames))) / fps
             k += len(frames)
 
@@ -171,13 +172,12 @@ def emulate(
     }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
     writer = EventsWriter(output, source.width, source.height, attrs, labels=labels)
-    process = emulator.process_with_labels if labels else lambda *chunk: (emulator.process(*chunk), None)
     try:
         for frames, times in source.chunks:
-            events, event_labels = process(frames, times)
-            writer.append(events, event_labels)
+            for events, event_labels in emulator.intervals(frames, times):  # memory: one interval's events
+                writer.append(events, event_labels)
+                n_events += len(events)
             n_frames += len(frames)
-            n_events += len(events)
             t_last = float(times[-1])
             if n_frames % progress_every < len(frames):
                 log(f"  {n_frames} frames, {n_events} events, {n_frames / (time.perf_counter() - start):.0f} frames/s")
