@@ -160,9 +160,15 @@ class FramesFile:
         return self._file["depth_m"][:, i, j]
 
     def radiance_chunks(self, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
-        """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames."""
+        """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames.
+        The chunks share one array, each valid until the next is read (copy one to keep
+        it): a new array per chunk cost more in page faults than HDF5's decompression."""
+        radiance = self._file["radiance"]
+        buffer = np.empty((min(chunk, self.shape[0]), *self.shape[1:]), radiance.dtype)
         for start in range(0, self.shape[0], chunk):
-            yield self._file["radiance"][start : start + chunk], self.t[start : start + chunk]
+            k = min(chunk, self.shape[0] - start)
+            radiance.read_direct(buffer, np.s_[start : start + k], np.s_[:k])
+            yield buffer[:k], self.t[start : start + k]
 
     def close(self) -> None:
         self._file.close()

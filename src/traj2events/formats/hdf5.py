@@ -211,7 +211,7 @@ class ChunkReader:
     decompressing its chunk here (`read_direct_chunk`, the filter's library) straight into
     the result, without HDF5's filter pipeline copies: a 1024^2 float32 depth map in ~1.8 ms
     instead of ~2.5. Any other dataset is read through h5py. (For runs of items h5py's
-    own slicing is as fast: `FramesFile.radiance_chunks` uses it.)"""
+    own `read_direct` is as fast: `FramesFile.radiance_chunks` uses it.)"""
 
     def __init__(self, dataset: h5py.Dataset):
         self.dataset = dataset
