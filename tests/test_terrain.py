@@ -216,13 +216,17 @@ def test_boulders_appear_in_the_height_only_where_the_grid_resolves_them():
 
 def test_compiled_crater_pass_on_a_grid_equals_the_profiles_crater_by_crater():
     """Tiles (regular grids) take the compiled pass; scattered points take the per-crater
-    numpy profiles (tested against Pike's shapes above): the same heights, bit for bit."""
+    numpy profiles (tested against Pike's shapes above): the same heights, to 1e-12 m. Bit
+    for bit where NumPy's float64 power and exp are glibc's, as the compiled pass's are; on
+    CPUs with AVX-512 NumPy uses its own SIMD kernels, which differ by an ulp (seen: 8.9e-16
+    m on an AMD EPYC)."""
     terrain = ProceduralTerrain(TerrainParams(seed=1, fresh_fraction=0.5))
     for x0, y0, spacing in ((-3000.0, 200.0, 2.0), (-20.0, -20.0, 0.05), (500.0, 900.0, 8.0)):
         x, y = np.meshgrid(x0 + spacing * np.arange(48), y0 + spacing * np.arange(40), indexing="ij")
         on_grid = terrain.crater_relief_m(x, y, spacing)
         scattered = terrain.crater_relief_m(x.ravel(), y.ravel(), spacing)  # 1-D: no grid, the numpy path
-        assert np.abs(on_grid).max() > 0 and on_grid.ravel().tobytes() == scattered.tobytes()
+        assert np.abs(on_grid).max() > 0.1
+        np.testing.assert_allclose(on_grid.ravel(), scattered, rtol=0, atol=1e-12)
 
 
 def hash_uniform(seed, stream, i, j):
