@@ -490,8 +490,9 @@ def _assemble(
     pix: np.ndarray, t_s: np.ndarray, on: np.ndarray, label: np.ndarray | None, width: int, n_pixels: int
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """Events (structured) in (t, y, x, p) order, and their labels if given: one key per
-    event, one sort (equal keys are identical events, so the sort need not be stable; the
-    label is the key's lowest digit, so the order of the events is the same either way)."""
+    event, sorted (`_sorted_keys`; equal keys are identical events, so the order among them
+    does not matter; the label is the key's lowest digit, so the order of the events is the
+    same either way)."""
     key = _sorted_keys(pix, t_s, on, _NO_LABELS if label is None else label, n_pixels)
     out = np.empty(key.size, EVENT_DTYPE)
     out_label = _NO_LABELS if label is None else np.empty(key.size, np.uint8)
