@@ -59,6 +59,15 @@ def test_same_seed_same_bytes_and_clear_errors(tmp_path):
     for name in ("a", "b"):
         emulate_file(tmp_path / "in.mkv", tmp_path / f"{name}.h5", preset="paper", seed=5)
     assert (tmp_path / "a.h5").read_bytes() == (tmp_path / "b.h5").read_bytes()
+    # frames.h5 read 3 frames at a time (into one reused array) or all at once: the same bytes.
+    with h5py.File(tmp_path / "frames.h5", "w") as f:
+        f["t"] = np.arange(len(frames)) / 50.0
+        f["radiance"] = frames.astype(np.float32) / 255.0 * 40.0
+        f.attrs["display_white_w_m2_sr"] = 40.0
+    for chunk in (3, 64):
+        emulate_file(tmp_path / "frames.h5", tmp_path / f"c{chunk}.h5", preset="paper", chunk=chunk, seed=5)
+    assert len(read_events(tmp_path / "c3.h5")[0]) > 100
+    assert (tmp_path / "c3.h5").read_bytes() == (tmp_path / "c64.h5").read_bytes()
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match="holds no .png"):
         emulate_file(tmp_path / "empty", tmp_path / "x.h5", fps=10.0)
