@@ -1,8 +1,11 @@
 """Benchmark: where one frame's render time goes, per backend.
 
   python bench/render_profile.py [--backend egl] [--frames 100] [--size 1024]
+      [--pixels-per-cell 8] [--shading-levels 3]
 
-For bench/render.py's two poses at budget 2 (tiles built beforehand), the median
+For bench/render.py's two poses at the default level of detail (render.lod: 8 px per cell
+shaded per pixel 3 levels finer; budget 2 unshaded was the default before session 15),
+tiles built beforehand, the median
 milliseconds per frame of `TerrainRenderer.render`, split into its two halves: `_start`
 (tile selection, uploads, issuing the draw and the read-back; the selection alone is also
 timed) and `_finish` (waiting for the read-back and copying it out, stars). Then cProfile's
@@ -30,6 +33,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
+
+from traj2events.tiles import LodSettings  # noqa: E402
 
 
 def timed(log: list[float], function):
@@ -92,10 +97,18 @@ def main() -> None:
     parser.add_argument("--backend", default="auto", help="auto, egl or osmesa")
     parser.add_argument("--frames", type=int, default=100)
     parser.add_argument("--size", type=int, default=1024)
+    parser.add_argument(
+        "--pixels-per-cell", type=float, default=LodSettings.pixels_per_cell, help="render.lod.pixels_per_cell"
+    )
+    parser.add_argument(
+        "--shading-levels", type=int, default=LodSettings.shading_levels, help="render.lod.shading_levels"
+    )
     args = parser.parse_args()
     os.environ.setdefault("LP_NUM_THREADS", "1")
+    budget, levels = args.pixels_per_cell, args.shading_levels
     for name, (state, sun, extent) in CASES.items():
-        with stretch_renderer(state, sun, extent, args.size, args.frames, 2.0, args.backend) as (r, path, _):
+        stretch = stretch_renderer(state, sun, extent, args.size, args.frames, budget, args.backend, None, levels)
+        with stretch as (r, path, _):
             tiles = r.tiles
             for pose in path[:5]:
                 r.render(pose)  # uploads, compiles
@@ -106,7 +119,8 @@ def main() -> None:
                 frame = timed(total, r.render)(pose)
             ms = {k: 1e3 * statistics.median(v) for k, v in dict(total=total, start=start, finish=finish).items()}
             print(
-                f"\n{name}, {args.size}^2, budget 2: {r.backend} ({r.gl_renderer}); {frame.n_tiles} tiles, "
+                f"\n{name}, {args.size}^2, {budget:g} px per cell shaded {levels} levels finer: {r.backend} "
+                f"({r.gl_renderer}); {frame.n_tiles} tiles, "
                 f"{frame.n_triangles} triangles; median ms per frame: render {ms['total']:.2f} = start "
                 f"{ms['start']:.2f} (selection {1e3 * statistics.median(select):.2f}) + finish {ms['finish']:.2f}"
             )
