@@ -617,8 +617,7 @@ class EventEmulator:
                 continue
             if not t > self._t:
                 raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
-            events, labels = self._interval_events(intensity, float(t))
-            yield events, labels
+            yield self._interval_events(intensity, float(t))
         if self._intensity is not None and self._intensity.base is not None:
             self._intensity = self._intensity.copy()  # kept for the next call: not a view of this chunk
 

@@ -85,9 +85,9 @@ class EventsWriter:
             buffered = self.n - self._written
             if buffered == 0 and n - start >= chunk:  # whole chunks straight from the columns
                 whole = (n - start) // chunk * chunk
-                self.n += whole
-                self._write({name: columns[name][start : start + whole] for name in self._sets})
+                self._write({name: columns[name][start : start + whole] for name in self._sets}, whole)
                 start += whole
+                self.n += whole
                 continue
             take = min(n - start, chunk - buffered)
             for name, buffer in self._buffer.items():
@@ -95,10 +95,10 @@ class EventsWriter:
             start += take
             self.n += take
             if buffered + take == chunk:
-                self._write(self._buffer)
+                self._write(self._buffer, chunk)
 
-    def _write(self, columns: dict) -> None:
-        n = min(len(columns["t"]), self.n - self._written)
+    def _write(self, columns: dict, n: int) -> None:
+        """The first `n` events of `columns` onto the end of the file."""
         for name, ds in self._sets.items():
             ds.resize((self._written + n,))
             ds[self._written :] = columns[name][:n]
@@ -106,7 +106,7 @@ class EventsWriter:
 
     def close(self, duration_us: int, exc=(None, None, None)) -> None:
         if exc[0] is None:
-            self._write(self._buffer)  # the last, partial chunk
+            self._write(self._buffer, self.n - self._written)  # the last, partial chunk
             # Milliseconds after the last event, up to the end of the recording, index past the end.
             end_ms = int(max(duration_us - self.t_offset_us, 0) // 1000)
             if end_ms >= self._next_ms:
