@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from traj2events.tiles import _grid_faces
+from traj2events.tiles import _grid_faces, long_sweep_lit
 
 
 def test_grid_faces_draw_each_cell_as_two_triangles_in_turn():
@@ -22,11 +22,11 @@ def test_grid_faces_draw_each_cell_as_two_triangles_in_turn():
     assert np.all(signed_area == signed_area[0]) and signed_area[0] != 0
 
 
-def _tiles(**lod):
+def _tiles(sun=(0.3, 0.4, -0.2), **lod):
     from traj2events.terrain import ProceduralTerrain, TerrainParams
     from traj2events.tiles import LodSettings, TileSet
 
-    sun = np.array([0.3, 0.4, -0.2]) / np.linalg.norm([0.3, 0.4, -0.2])
+    sun = np.array(sun) / np.linalg.norm(sun)
     return TileSet(ProceduralTerrain(TerrainParams(seed=3)), sun, 1737400.0, 4000.0, LodSettings(cells=8, **lod))
 
 
@@ -35,23 +35,40 @@ def _half(values) -> np.ndarray:
     return np.asarray(values, np.float32).astype(np.float16)
 
 
-def test_a_shading_texture_holds_the_descendants_normals_and_lit_at_their_grid_points():
+def test_a_shading_texture_holds_the_descendants_normals_at_their_grid_points():
     tiles = _tiles(min_spacing_m=0.5)
     key, levels, n = (2, 1, 2), 2, 9  # 8 cells: 9 x 9 vertices a tile
     texture = tiles.shading_texture(key, levels)
     assert texture.shape == (8 * 4 + 1, 8 * 4 + 1, 4) and texture.dtype == np.float16
-    kept = set(tiles._cache)
+    assert {k for k in tiles._cache if k[0] > 2} == set()  # no descendant was built for it
     for a, b in ((0, 0), (1, 3), (3, 2)):  # descendant (4, 4 + a, 8 + b): texels 8a.., 8b..
         child = tiles.tile((4, 4 + a, 8 + b))
-        normals, lit = child.normals[: n * n].reshape(n, n, 3), child.lit[: n * n].reshape(n, n)
-        block = texture[8 * a : 8 * a + n, 8 * b : 8 * b + n]
-        # Shared edges hold the later neighbour's values: compare the inside of each block.
-        # Each texel is the nearest half-float (the texture's format) to the float32 value.
-        np.testing.assert_array_equal(block[1:-1, 1:-1, :3], _half(normals[1:-1, 1:-1]))
-        np.testing.assert_array_equal(block[1:-1, 1:-1, 3], _half(lit[1:-1, 1:-1]))
-    assert 0.0 < texture[..., 3].mean() <= 1.0
-    # The descendants built for it were dropped again: the cache keeps the tile and its ancestors.
-    assert {k for k in kept if k[0] > 2} == set()
+        normals = child.normals[: n * n].reshape(n, n, 3)
+        block = texture[8 * a : 8 * a + n, 8 * b : 8 * b + n, :3].astype(np.float32)
+        # The same heights at the same spacing: equal to the nearest half float, within the
+        # float32 rounding of the grid's coordinates (one half-float step at most).
+        np.testing.assert_allclose(block, _half(normals), rtol=0, atol=2.0**-11)
+    np.testing.assert_allclose(np.linalg.norm(texture[..., :3].astype(float), axis=-1), 1.0, atol=2e-3)
+
+
+def test_a_shading_texture_casts_shadows_across_the_descendants_edges():
+    """The texture's lit fractions are one long sweep's at the fine spacing (to the half
+    float); its descendants', each swept over its own grid and margin with a coarser
+    obstruction beyond, are 10x further off."""
+    # A low Sun and a short margin: shadows reach across many descendants' edges.
+    tiles = _tiles(sun=(0.3, -0.4, -0.05), min_spacing_m=0.5, margin=4)
+    key, levels, n = (4, 7, 8), 2, 9
+    lit = tiles.shading_texture(key, levels)[..., 3].astype(np.float32)
+    reference = long_sweep_lit(tiles, key, levels)
+    descendants = np.empty_like(lit)
+    for a in range(4):
+        for b in range(4):
+            child = tiles.tile((6, 28 + a, 32 + b))
+            descendants[8 * a : 8 * a + n, 8 * b : 8 * b + n] = child.lit[: n * n].reshape(n, n)
+    assert 0.05 < reference.mean() < 0.95  # some shadow, some light
+    ours, theirs = np.abs(lit - reference).mean(), np.abs(descendants - reference).mean()
+    assert ours < theirs / 10 and theirs > 0.01, (ours, theirs)
+    np.testing.assert_allclose(lit, reference, atol=1e-3, err_msg="not the long sweep's shadows")
 
 
 def test_where_the_quadtree_ends_the_shading_texture_is_the_finest_tile_resampled():

@@ -16,7 +16,7 @@ meet with skirts (a strip hanging below each tile edge) instead of cracks.
 Building a tile is mostly evaluating the terrain's heights on its grid: with a tile cache
 (`cache_dir`, formats/tile_cache.py) those are stored once and read by every later
 TileSet with the same terrain, quadtree and Sun side, in this process or another. A drawn
-tile's shading texture (4^levels descendants built for it) is stored there too, whole.
+tile's shading texture (its area evaluated `levels` levels finer) is stored there too, whole.
 
 Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
 grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights
@@ -164,20 +164,30 @@ class TileSet:
             if key not in needed:
                 del self._cache[key]
 
+    def _origin(self, key: TileKey) -> tuple[float, float]:
+        """(x, y) of a tile's first grid point, m."""
+        level, i, j = key
+        spacing = self.tile_spacing_m(level)
+        return -self.half_extent_m + i * self.lod.cells * spacing, -self.half_extent_m + j * self.lod.cells * spacing
+
+    def _extended_axes(self, level: int, origin: tuple[float, float], cells: int):
+        """(x, y, lo_x, lo_y): the axes of `cells` x `cells` cells at `level`'s spacing from
+        `origin`, extended one cell around (for normals) and `margin` more toward the Sun
+        (for the shadow march; none at level 0, the whole terrain), and the index of
+        `origin` on each."""
+        spacing = self.tile_spacing_m(level)
+        m = self.lod.margin if level > 0 else 0
+        lo_x, hi_x = (1, 1 + m) if self.sun_dir[0] > 0 else (1 + m, 1)
+        lo_y, hi_y = (1, 1 + m) if self.sun_dir[1] > 0 else (1 + m, 1)
+        x = origin[0] + spacing * np.arange(-lo_x, cells + 1 + hi_x)
+        y = origin[1] + spacing * np.arange(-lo_y, cells + 1 + hi_y)
+        return x, y, lo_x, lo_y
+
     def _build(self, key: TileKey) -> Tile:
         level, i, j = key
         n = self.lod.cells
         spacing = self.tile_spacing_m(level)
-        x0 = -self.half_extent_m + i * n * spacing
-        y0 = -self.half_extent_m + j * n * spacing
-        # Extended grid: one cell around (for normals), `margin` more toward the Sun.
-        m = self.lod.margin
-        lo_x, hi_x = (1, 1 + m) if self.sun_dir[0] > 0 else (1 + m, 1)
-        lo_y, hi_y = (1, 1 + m) if self.sun_dir[1] > 0 else (1 + m, 1)
-        if level == 0:
-            lo_x = hi_x = lo_y = hi_y = 1
-        x = x0 + spacing * np.arange(-lo_x, n + 1 + hi_x)
-        y = y0 + spacing * np.arange(-lo_y, n + 1 + hi_y)
+        x, y, lo_x, lo_y = self._extended_axes(level, self._origin(key), n)
         xx, yy = np.meshgrid(x, y, indexing="ij")
         h = self.disk.load(key, xx.shape) if self.disk else None
         if h is None:
@@ -188,11 +198,7 @@ class TileSet:
         beyond = no_obstruction if level == 0 else self.tile((level - 1, i >> 1, j >> 1)).shadow.obstruction_at
         shadow = shadow_field(x, y, h, self.sun_dir, self.radius_m, beyond)
         points = surface_points(xx, yy, h, self.radius_m)
-        # Normals by central differences of the surface points (outward = toward -z near the site).
-        d_dx = points[2:, 1:-1] - points[:-2, 1:-1]
-        d_dy = points[1:-1, 2:] - points[1:-1, :-2]
-        normals = np.cross(d_dy, d_dx)
-        normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+        normals = _grid_normals(points)
         core = (slice(lo_x, lo_x + n + 1), slice(lo_y, lo_y + n + 1))
         inner = (slice(lo_x - 1, lo_x - 1 + n + 1), slice(lo_y - 1, lo_y - 1 + n + 1))
         verts = points[core].reshape(-1, 3)
@@ -207,11 +213,11 @@ class TileSet:
 
     def shading_texture(self, key: TileKey, levels: int) -> np.ndarray:
         """(side, side, 4) float16 (the renderer's texel format), side = cells 2^levels + 1:
-        the unit normals (xyz) and lit fractions of the tile's descendants `levels` levels
-        down, texel [a, b] at the tile's grid point (a, b) / 2^levels (a along x, b along y).
-        Where the quadtree ends sooner, the finest descendants there, linearly resampled.
-        Descendants built for it are dropped again: only what the renderer draws (and their
-        ancestors) stays cached. With a tile cache, read from it when stored there."""
+        the unit normals (xyz) and lit fractions of the tile's area at the spacing of its
+        descendants `levels` levels down, texel [a, b] at the tile's grid point
+        (a, b) / 2^levels (a along x, b along y). Where the quadtree ends sooner, the
+        finest level there, linearly resampled. With a tile cache, read from it when
+        stored there."""
         side = self.lod.cells * 2**levels + 1
         disk = self.texture_disk(levels)
         texture = disk.load(key, (side, side, 4), np.float16) if disk else None
@@ -222,22 +228,30 @@ class TileSet:
         return texture
 
     def _compose_shading(self, key: TileKey, levels: int) -> np.ndarray:
-        """shading_texture's texels, float32, from the descendants."""
-        level, i, j = key
+        """shading_texture's texels, float32. Level by level below the tile, the terrain on
+        one grid over the whole tile (plus the margin toward the Sun) at that level's
+        spacing, and its shadow swept with the level above's obstruction beyond: the
+        descendants' heights and normals, with shadows cast across their edges at the fine
+        spacing (4^levels descendants, each swept alone, took ~5x longer)."""
+        level = key[0]
         k = min(levels, self.max_level() - level)
-        cells, m = self.lod.cells, 2**k
-        n = cells + 1
-        before = set(self._cache)
-        out = np.zeros((cells * m + 1, cells * m + 1, 4), np.float32)
-        for a in range(m):
-            for b in range(m):
-                t = self.tile((level + k, i * m + a, j * m + b))
-                block = (slice(a * cells, a * cells + n), slice(b * cells, b * cells + n))
-                out[block + (slice(0, 3),)] = t.normals[: n * n].reshape(n, n, 3)
-                out[block + (3,)] = t.lit[: n * n].reshape(n, n)
-        for built in set(self._cache) - before - {key}:
-            del self._cache[built]
-        side = cells * 2**levels + 1
+        tile = self.tile(key)
+        n = self.lod.cells * 2**k
+        if k == 0:
+            out = np.concatenate([tile.normals[: (n + 1) ** 2], tile.lit[: (n + 1) ** 2, None]], axis=1)
+            out = out.reshape(n + 1, n + 1, 4).astype(np.float32)
+        else:
+            origin, field = self._origin(key), tile.shadow
+            for down in range(1, k + 1):
+                x, y, lo_x, lo_y = self._extended_axes(level + down, origin, self.lod.cells * 2**down)
+                xx, yy = np.meshgrid(x, y, indexing="ij")
+                h = self.terrain.height_m(xx, yy, self.tile_spacing_m(level + down))
+                field = shadow_field(x, y, h, self.sun_dir, self.radius_m, field.obstruction_at)
+            out = np.empty((n + 1, n + 1, 4), np.float32)
+            inner = (slice(lo_x - 1, lo_x + n), slice(lo_y - 1, lo_y + n))
+            out[..., :3] = _grid_normals(surface_points(xx, yy, h, self.radius_m))[inner]
+            out[..., 3] = field.lit[lo_x : lo_x + n + 1, lo_y : lo_y + n + 1]
+        side = self.lod.cells * 2**levels + 1
         if len(out) != side:
             out = _resample_linear(out, side)
             out[..., :3] /= np.linalg.norm(out[..., :3], axis=-1, keepdims=True)
@@ -302,6 +316,45 @@ def depth_range(dists: np.ndarray, radii: np.ndarray, camera: Camera) -> tuple[f
     near = max(float(np.min(dists - radii)) * np.cos(half_diag) * 0.99, 1e-3)
     far = float(np.max(dists + radii)) * 1.01 + 1.0
     return near, far
+
+
+def long_sweep_lit(tiles: TileSet, key: TileKey, levels: int, widths: int = 4) -> np.ndarray:
+    """A reference for shading textures' shadows (tests, bench/shading_texture.py): lit
+    fractions at `key`'s grid points `levels` levels finer (fewer where the quadtree ends)
+    from one sweep at that spacing over the tile and `widths` tile widths toward the Sun,
+    with no tile edge in between; beyond, the finest ancestor's obstruction."""
+    level, i, j = key
+    levels = min(levels, tiles.max_level() - level)
+    n = tiles.lod.cells * 2**levels
+    spacing = tiles.tile_spacing_m(level + levels)
+    x0 = -tiles.half_extent_m + i * tiles.lod.cells * tiles.tile_spacing_m(level)
+    y0 = -tiles.half_extent_m + j * tiles.lod.cells * tiles.tile_spacing_m(level)
+    ext = widths * n
+    lo_x, hi_x = (0, ext) if tiles.sun_dir[0] > 0 else (ext, 0)
+    lo_y, hi_y = (0, ext) if tiles.sun_dir[1] > 0 else (ext, 0)
+    x = x0 + spacing * np.arange(-lo_x, n + 1 + hi_x)
+    y = y0 + spacing * np.arange(-lo_y, n + 1 + hi_y)
+    xx, yy = np.meshgrid(x, y, indexing="ij")
+    h = tiles.terrain.height_m(xx, yy, spacing)
+    ancestors = [tiles.tile((level - up, i >> up, j >> up)).shadow for up in range(level + 1)]
+
+    def beyond(px, py):  # the finest ancestor's obstruction where its grid holds the point
+        o = np.full(np.shape(px), -np.inf)
+        for shadow in ancestors:
+            o = np.where(np.isneginf(o), shadow.obstruction_at(px, py), o)
+        return o
+
+    field = shadow_field(x, y, h, tiles.sun_dir, tiles.radius_m, beyond)
+    return field.lit[lo_x : lo_x + n + 1, lo_y : lo_y + n + 1]
+
+
+def _grid_normals(points: np.ndarray) -> np.ndarray:
+    """Unit normals at the inner points of an (n0, n1, 3) grid of surface points, by
+    central differences (outward: toward -z near the site); (n0 - 2, n1 - 2, 3)."""
+    d_dx = points[2:, 1:-1] - points[:-2, 1:-1]
+    d_dy = points[1:-1, 2:] - points[1:-1, :-2]
+    normals = np.cross(d_dy, d_dx)
+    return normals / np.linalg.norm(normals, axis=-1, keepdims=True)
 
 
 def _resample_linear(grid: np.ndarray, side: int) -> np.ndarray:
