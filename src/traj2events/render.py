@@ -23,7 +23,7 @@ asynchronously: `render_sequence` draws each frame before handing over the previ
 Shading (`render.lod.shading_levels`): 0 evaluates the reflectance law at the vertices of
 the drawn tiles and interpolates the radiance (shaders/terrain.*). k > 0 gives every slot
 a layer of a texture array holding the normals and lit fractions of its tile's
-descendants k levels finer (TileSet.shading_texture), and evaluates the law per pixel
+area k levels finer (TileSet.shading_texture), and evaluates the law per pixel
 from it (shaders/terrain_textured.*): the geometry (silhouettes, depth) is the drawn
 tiles', the shading that of tiles 2^k times finer. On a CPU rasteriser a frame's cost is
 its triangle count, so coarse tiles shaded per pixel are faster for the same shading.
