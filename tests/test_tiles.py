@@ -83,3 +83,11 @@ def test_where_the_quadtree_ends_the_shading_texture_is_the_finest_tile_resample
     np.testing.assert_allclose(np.linalg.norm(texture[..., :3].astype(float), axis=-1), 1.0, atol=1e-3)  # unit between
     midpoint = (tile.lit[:81].reshape(9, 9)[2, 5] + tile.lit[:81].reshape(9, 9)[3, 5]) / 2
     assert texture[10, 20, 3] == _half(midpoint)  # linear: halfway between two grid points
+    # One level above the deepest: the texture is made one level finer, then resampled.
+    above = (deepest[0] - 1, 3, 5)
+    texture = tiles.shading_texture(above, 2)
+    assert texture.shape == (33, 33, 4)
+    for a, b in ((0, 0), (1, 1)):  # the deepest descendants' grid points, every 2 texels
+        child = tiles.tile((deepest[0], 6 + a, 10 + b)).normals[:81].reshape(9, 9, 3)
+        block = texture[16 * a : 16 * a + 17 : 2, 16 * b : 16 * b + 17 : 2, :3].astype(np.float32)
+        np.testing.assert_allclose(block[1:-1, 1:-1], _half(child[1:-1, 1:-1]), rtol=0, atol=2.0**-11)
