@@ -118,7 +118,7 @@ def _positive(option: str, value: float | None) -> None:
 
 
 def cmd_events(args) -> int:
-    from .stages.events import emulate, emulator_params, export_events, frame_source
+    from .stages.events import CHUNK_FRAMES, emulate, emulator_params, export_events, frame_source
 
     for option, value in (("--fps", args.fps), ("--white", args.white), ("--window-ms", args.window_ms)):
         _positive(option, value)
@@ -139,7 +139,8 @@ def cmd_events(args) -> int:
     if args.white is not None and args.input_scale != "display":
         raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
     sensor = _sensor(args.sensor) if args.input_scale == "sensor" else None
-    source = frame_source(args.input, args.chunk, args.fps, args.white, sensor)
+    chunk = CHUNK_FRAMES if args.chunk is None else args.chunk
+    source = frame_source(args.input, chunk, args.fps, args.white, sensor)
     from .progress import log
 
     log(
@@ -153,7 +154,7 @@ def cmd_events(args) -> int:
         args.output,
         args.preset,
         str(args.input),
-        progress_every=args.chunk * 10,
+        progress_every=chunk * 10,
         labels=args.labels,
     )
     if args.frames_png:
@@ -395,7 +396,11 @@ def build_parser() -> argparse.ArgumentParser:
         default=events["labels"],
         help="also write each event's cause (events/label: signal, shot_noise, leak, hot_pixel) (default %(default)s)",
     )
-    p.add_argument("--chunk", type=int, default=64, help="frames held in memory at once (default 64)")
+    p.add_argument(
+        "--chunk",
+        type=int,
+        help="frames read at a time (default: stages.events.CHUNK_FRAMES, 16; the events do not change)",
+    )
     p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
     p.add_argument(
         "--window-ms", type=float, default=events["window_ms"], help="event-frame window, ms (default %(default)s)"

@@ -30,10 +30,10 @@ FIELD_S_PER_PX = 1.0e-7  # motion field with the terrain-true field: 0.08-0.12 s
 MEMORY_MB = {
     "render": (1000.0, 4.5e-3),  # 1.15 GB at 128^2, 2.25 GB at 512^2 (tiles in view grow with it)
     "motion_field": (300.0, 4e-4),  # 68 MB at 256^2 with terrain, 0.27 GB at 1024^2 sphere only: one field at a time
-    # events: one interval's events at a time (session 17): 0.20 / 0.24 / 0.34 / 0.75 GB at
-    # 128^2 / 256^2 / 512^2 / 1024^2, sensor path with labels (1 s descent clip; 0.57 / 2.15 GB
-    # at 512^2 / 1024^2 before); the 64-frame read buffer is ~0.26 kB per pixel of it
-    "events": (200.0, 5.5e-4),
+    # events: one interval's events at a time, 16 frames read at a time (session 18): 0.20 /
+    # 0.22 / 0.29 / 0.49 GB at 128^2 / 256^2 / 512^2 / 1024^2, sensor path with labels (1 s
+    # descent clip; 0.20 / 0.24 / 0.34 / 0.74 GB reading 64 frames at a time)
+    "events": (230.0, 2.6e-4),
     "sample_trajectories": (500.0, 0.0),  # plus 500 MB per process
 }
 # Adaptive timing (render.timing) renders extra frames for the emulator where the scene
