@@ -91,3 +91,9 @@ def test_where_the_quadtree_ends_the_shading_texture_is_the_finest_tile_resample
         child = tiles.tile((deepest[0], 6 + a, 10 + b)).normals[:81].reshape(9, 9, 3)
         block = texture[16 * a : 16 * a + 17 : 2, 16 * b : 16 * b + 17 : 2, :3].astype(np.float32)
         np.testing.assert_allclose(block[1:-1, 1:-1], _half(child[1:-1, 1:-1]), rtol=0, atol=2.0**-11)
+
+
+def test_a_shading_texture_under_the_zenith_sun_is_lit_and_under_a_set_sun_dark():
+    for sun, lit in (((0.0, 0.0, -1.0), 1.0), ((0.3, 0.4, 0.2), 0.0)):  # z down: -1 overhead, > 0 below
+        texture = _tiles(sun=sun, min_spacing_m=0.5).shading_texture((2, 1, 2), 2)
+        assert np.all(texture[..., 3] == lit), sun
