@@ -97,3 +97,15 @@ def test_a_shading_texture_under_the_zenith_sun_is_lit_and_under_a_set_sun_dark(
     for sun, lit in (((0.0, 0.0, -1.0), 1.0), ((0.3, 0.4, 0.2), 0.0)):  # z down: -1 overhead, > 0 below
         texture = _tiles(sun=sun, min_spacing_m=0.5).shading_texture((2, 1, 2), 2)
         assert np.all(texture[..., 3] == lit), sun
+
+
+def test_building_time_counts_nested_builds_once():
+    import time
+
+    tiles = _tiles(min_spacing_m=0.5)
+    start = time.perf_counter()
+    tiles.tile((5, 10, 11))  # builds its five ancestors inside it
+    tiles.shading_texture((5, 10, 11), 2)  # builds nothing new but its fine grids
+    wall = time.perf_counter() - start
+    assert tiles.n_built == 6
+    assert 0.5 * wall < tiles.building_s <= wall  # not once per nesting level

@@ -26,6 +26,9 @@ and nearby fine relief at the tile's own.
 
 from __future__ import annotations
 
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -96,6 +99,8 @@ class TileSet:
         self.texture_disks: dict[int, TileCache] = {}  # by shading levels
         self.n_evaluated = 0  # tiles whose terrain was evaluated here (not read from the disk cache)
         self.n_built = 0  # tiles built here (again after an eviction), read from the disk cache or not
+        self.building_s = 0.0  # wall seconds building tiles and shading textures, or reading them from the cache
+        self._depth = 0  # nesting of _timed (a tile's parents are built inside it)
 
     def heights_identity(self) -> dict:
         """What a tile's heights depend on: the terrain, the quadtree and the Sun's side
@@ -150,9 +155,22 @@ class TileSet:
 
     def tile(self, key: TileKey) -> Tile:
         if key not in self._cache:
-            self._cache[key] = self._build(key)
+            with self._timed():
+                self._cache[key] = self._build(key)
             self.n_built += 1
         return self._cache[key]
+
+    @contextmanager
+    def _timed(self) -> Iterator[None]:
+        """Adds the outermost block's wall time to `building_s` (nested ones are inside it)."""
+        self._depth += 1
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self._depth -= 1
+            if self._depth == 0:
+                self.building_s += time.perf_counter() - start
 
     def evict(self, keep: set[TileKey]) -> None:
         """Drop cached tiles not in `keep` (their ancestors stay: children need them)."""
@@ -220,11 +238,12 @@ class TileSet:
         stored there."""
         side = self.lod.cells * 2**levels + 1
         disk = self.texture_disk(levels)
-        texture = disk.load(key, (side, side, 4), np.float16) if disk else None
-        if texture is None:
-            texture = self._compose_shading(key, levels).astype(np.float16)
-            if disk:
-                disk.save(key, texture)
+        with self._timed():
+            texture = disk.load(key, (side, side, 4), np.float16) if disk else None
+            if texture is None:
+                texture = self._compose_shading(key, levels).astype(np.float16)
+                if disk:
+                    disk.save(key, texture)
         return texture
 
     def _compose_shading(self, key: TileKey, levels: int) -> np.ndarray:

@@ -238,6 +238,7 @@ def render_trajectory(
                     f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 + added - reused, 1):.0f} triangles/frame"
                 )
     log(f"{n} frames and {added} adaptive ones in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
+    log(f"tiles and shading textures: {tiles.building_s:.1f} s building them or reading them from the tile cache")
     if tiles.disk is not None:
         log(f"tiles: {tiles.n_evaluated} built, {tiles.disk.n_read} read from the tile cache {tiles.disk.folder}")
         for textures in tiles.texture_disks.values():
