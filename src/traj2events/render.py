@@ -220,10 +220,12 @@ class _GLScene:
             self.slot_limit = max(1, min(layers, _SHADING_BYTES // (8 * shading_side**2)))  # RGBA16F texels
         else:
             self.slot_limit = 2**31 // (vertices_per_tile * 16)  # OpenGL's buffer offsets
-        # Per-vertex data: (position - tile origin, lit) and (normal, 0), one texel each.
+        # Per-vertex data: (position - tile origin, lit) and, shaded per vertex, (normal, 0),
+        # one texel each (shaded per pixel, the normals come from the shading texture).
         self.capacity = 0
-        self.vertex_buffers = list(gl.glGenBuffers(2))
-        self.vertex_textures = list(gl.glGenTextures(2))
+        n_arrays = 1 if self.textured else 2
+        self.vertex_buffers = [gl.glGenBuffers(1) for _ in range(n_arrays)]
+        self.vertex_textures = [gl.glGenTextures(1) for _ in range(n_arrays)]
         self._allocate(min(_INITIAL_SLOTS, self.slot_limit))
         self._framebuffer()
         self.image_bytes = width * height * 2 * 4  # (radiance, depth) float32
@@ -231,7 +233,8 @@ class _GLScene:
         self.free_pixel_buffers: list[int] = []
         gl.glUseProgram(self.program)
         self.uniform("vertex_position_lit", 0)
-        self.uniform("vertex_normal", 1)
+        if not self.textured:
+            self.uniform("vertex_normal", 1)
         self.uniform("vertices_per_tile", vertices_per_tile)
         if self.textured:
             self.uniform("shading", 2)
@@ -294,8 +297,11 @@ class _GLScene:
             gl.glDeleteTextures([self.shading_texture])
         self.shading_texture = new
 
-    def upload(self, slot: int, position_lit: np.ndarray, normal: np.ndarray, shading: np.ndarray | None) -> None:
-        """Fills `slot`: its vertices, and its layer of the shading texture when shaded per pixel."""
+    def upload(
+        self, slot: int, position_lit: np.ndarray, normal: np.ndarray | None, shading: np.ndarray | None
+    ) -> None:
+        """Fills `slot`: its vertices (with their normals when shaded per vertex), and its
+        layer of the shading texture when shaded per pixel."""
         gl = self.gl
         if slot >= self.slot_limit:
             raise RuntimeError(
@@ -393,7 +399,8 @@ class _GLScene:
         gl.glDeleteFramebuffers(1, [self.framebuffer])
         gl.glDeleteRenderbuffers(2, [self.colour, self.depth])
         gl.glDeleteTextures(self.vertex_textures)
-        gl.glDeleteBuffers(4, [*self.vertex_buffers, self.index_buffer, self.instance_buffer])
+        buffers = [*self.vertex_buffers, self.index_buffer, self.instance_buffer]
+        gl.glDeleteBuffers(len(buffers), buffers)
         if self.textured:
             gl.glDeleteTextures([self.shading_texture])
             gl.glDeleteBuffers(1, [self.uv_buffer])
@@ -498,9 +505,12 @@ class TerrainRenderer:
             slot = self._free.pop() if self._free else len(self._slots)
             position_lit = np.empty((len(t.vertices), 4), np.float32)
             position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
-            normal = np.zeros((len(t.vertices), 4), np.float32)
-            normal[:, :3] = t.normals
-            shading = self.tiles.shading_texture(key, self.shading_levels) if self.shading_levels else None
+            normal = shading = None
+            if self.shading_levels:
+                shading = self.tiles.shading_texture(key, self.shading_levels)
+            else:
+                normal = np.zeros((len(t.vertices), 4), np.float32)
+                normal[:, :3] = t.normals
             self._gl.upload(slot, position_lit, normal, shading)
             self._slots[key] = slot
         return self._slots[key]
