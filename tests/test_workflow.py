@@ -292,7 +292,7 @@ def edited_source(built, tmp_path):
 
 
 def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
-    assert edited_source("cli.py", 'help="frames held in memory at once', 'help="frames in memory at once') == {}
+    assert edited_source("cli.py", 'help="frames read at a time', 'help="frames read together') == {}
     assert (
         edited_source("emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;') == {}
     )
