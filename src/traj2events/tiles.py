@@ -188,13 +188,13 @@ class TileSet:
         spacing = self.tile_spacing_m(level)
         return -self.half_extent_m + i * self.lod.cells * spacing, -self.half_extent_m + j * self.lod.cells * spacing
 
-    def _extended_axes(self, level: int, origin: tuple[float, float], cells: int):
+    def _extended_axes(self, level: int, origin: tuple[float, float], cells: int, margin: int | None = None):
         """(x, y, lo_x, lo_y): the axes of `cells` x `cells` cells at `level`'s spacing from
-        `origin`, extended one cell around (for normals) and `margin` more toward the Sun
-        (for the shadow march; none at level 0, the whole terrain), and the index of
-        `origin` on each."""
+        `origin`, extended one cell around (for normals) and `margin` cells (default
+        `lod.margin`; none at level 0, the whole terrain) more toward the Sun (for the
+        shadow march), and the index of `origin` on each."""
         spacing = self.tile_spacing_m(level)
-        m = self.lod.margin if level > 0 else 0
+        m = (self.lod.margin if level > 0 else 0) if margin is None else margin
         lo_x, hi_x = (1, 1 + m) if self.sun_dir[0] > 0 else (1 + m, 1)
         lo_y, hi_y = (1, 1 + m) if self.sun_dir[1] > 0 else (1 + m, 1)
         x = origin[0] + spacing * np.arange(-lo_x, cells + 1 + hi_x)
@@ -345,15 +345,9 @@ def long_sweep_lit(tiles: TileSet, key: TileKey, levels: int, widths: int = 4) -
     level, i, j = key
     levels = min(levels, tiles.max_level() - level)
     n = tiles.lod.cells * 2**levels
-    spacing = tiles.tile_spacing_m(level + levels)
-    x0, y0 = tiles._origin(key)
-    ext = widths * n
-    lo_x, hi_x = (0, ext) if tiles.sun_dir[0] > 0 else (ext, 0)
-    lo_y, hi_y = (0, ext) if tiles.sun_dir[1] > 0 else (ext, 0)
-    x = x0 + spacing * np.arange(-lo_x, n + 1 + hi_x)
-    y = y0 + spacing * np.arange(-lo_y, n + 1 + hi_y)
+    x, y, lo_x, lo_y = tiles._extended_axes(level + levels, tiles._origin(key), n, margin=widths * n)
     xx, yy = np.meshgrid(x, y, indexing="ij")
-    h = tiles.terrain.height_m(xx, yy, spacing)
+    h = tiles.terrain.height_m(xx, yy, tiles.tile_spacing_m(level + levels))
     ancestors = [tiles.tile((level - up, i >> up, j >> up)).shadow for up in range(level + 1)]
 
     def beyond(px, py):  # the finest ancestor's obstruction where its grid holds the point
