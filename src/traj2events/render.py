@@ -311,6 +311,7 @@ class _GLScene:
         if slot >= self.capacity:
             self._allocate(min(max(2 * self.capacity, slot + 1), self.slot_limit))
         offset = slot * self.vertices_per_tile * 16
+        # Shaded per pixel there is one vertex buffer: zip stops before `normal` (None).
         for buffer, data in zip(self.vertex_buffers, (position_lit, normal)):
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, buffer)
             gl.glBufferSubData(gl.GL_ARRAY_BUFFER, offset, data.nbytes, data)
