@@ -37,6 +37,13 @@ against the reference, and per-event timing error: events of the same pixel and 
 matched in order, median and 90th percentile |dt|. Also the worst interval's measured
 log change (largest over pixels of |L1 - L0|) and what was predicted for it.
 Poses at every time come from the re-integrated dynamics (upsample.ReintegratedStates).
+
+--supersample S: every frame (reference, fixed and adaptive alike) is drawn at S times the
+size, with the tiles and textures chosen for the frame's own size (the same scene), and
+averaged over each pixel's S x S block, as a pixel's area integrates the light:
+the renderer point-samples, and sub-pixel relief and shadows near the horizon flip whole
+pixels between lit and dark from one 0.5 ms step to the next (docs/benchmarks.md). Those
+events no frame timing can place; averaging separates them from what timing can fix.
 """
 
 from __future__ import annotations
@@ -54,13 +61,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
 
+from traj2events.camera import Camera  # noqa: E402
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
 from traj2events.log_response import radiance_to_dn  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
+from traj2events.render import Frame, TerrainRenderer  # noqa: E402
 from traj2events.stages.render import RenderSettings, render_between  # noqa: E402
 from traj2events.upsample import ReintegratedStates  # noqa: E402
 
@@ -82,6 +90,38 @@ WHOLE = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "
 FLIGHT = ("adaptive, log 2", "adaptive, log 1", "adaptive, log 0.5 (ESIM)", "adaptive, log 0.2")
 # Clips (two per trajectory): the bounds measured since session 9.
 CLIPS = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "adaptive, log 0.05", "adaptive, 1 px")
+
+
+class TilesSeenBy:
+    """A TileSet whose level of detail is chosen for `camera`, whichever camera draws it."""
+
+    def __init__(self, tiles, camera: Camera):
+        self._tiles, self._camera = tiles, camera
+
+    def select(self, pose, camera: Camera) -> list:
+        return self._tiles.select(pose, self._camera)
+
+    def __getattr__(self, name: str):
+        return getattr(self._tiles, name)
+
+
+class Supersampled:
+    """A renderer at `factor` times the camera's size whose frames are block-averaged down:
+    radiance as the mean over each pixel's block (area integration), depth as the inverse
+    of the mean inverse depth (what the motion field scales with; sky counts as 0)."""
+
+    def __init__(self, renderer: TerrainRenderer, factor: int):
+        self.renderer, self.factor = renderer, factor
+
+    def render(self, pose) -> Frame:
+        frame = self.renderer.render(pose)
+        s = self.factor
+        h, w = frame.radiance.shape[0] // s, frame.radiance.shape[1] // s
+        radiance = frame.radiance.reshape(h, s, w, s).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
+        depth = frame.depth_m.reshape(h, s, w, s).astype(np.float64)
+        inverse = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0).mean(axis=(1, 3))
+        depth_m = np.divide(1.0, inverse, out=np.zeros_like(inverse), where=inverse > 0).astype(np.float32)
+        return Frame(radiance, depth_m, frame.n_tiles, frame.n_triangles)
 
 
 class Stream:
@@ -245,6 +285,7 @@ def main() -> None:
     parser.add_argument("--whole", action="store_true", help="whole trajectories through the render stage")
     parser.add_argument("--flight", type=int, metavar="N", help="N windows spread over each whole flight")
     parser.add_argument("--window", type=float, default=0.2, help="--flight: window length, s")
+    parser.add_argument("--supersample", type=int, default=1, metavar="S", help="frames averaged from S x S samples")
     parser.add_argument("--adaptive", nargs="+", choices=list(ADAPTIVE), help="the adaptive variants to run")
     args = parser.parse_args()
     if args.whole:
@@ -254,7 +295,8 @@ def main() -> None:
         parser.error(f"--reference-fps must be a multiple of {FIXED_FPS}")
     print(
         f"# frame timing: {args.size}^2, clean preset, reference {args.reference_fps} fps, adaptive from "
-        f"{args.fps} fps; {platform.node()} ({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}"
+        f"{args.fps} fps, {args.supersample}x{args.supersample} samples per pixel; {platform.node()} "
+        f"({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}"
     )
     print(
         "| clip | timing | frames | render s | emulate s | events | vs reference | median abs dt, us "
@@ -269,6 +311,9 @@ def main() -> None:
         config = resolve_config({"camera": {"width": args.size, "height": args.size, "fps": args.fps}})
         settings = RenderSettings.from_config(config, scenario)
         camera, tiles, sun, reflectance = settings.build()
+        drawn = Camera(
+            args.size * args.supersample, args.size * args.supersample, camera.fov_deg, camera.mount_height_m
+        )
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
         if args.flight:
@@ -276,7 +321,8 @@ def main() -> None:
         else:
             clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
         flight: dict[str, list[dict]] = {}
-        with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
+        with TerrainRenderer(TilesSeenBy(tiles, camera), drawn, sun, reflectance) as drawing:
+            renderer = drawing if args.supersample == 1 else Supersampled(drawing, args.supersample)
             for clip, (t0, t1) in clips.items():
                 rows = run_clip(
                     renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps,
