@@ -293,6 +293,8 @@ def main() -> None:
     if args.whole:
         whole_trajectories(args.trajectories, args.size, args.fps)
         return
+    if args.supersample < 1:
+        parser.error(f"--supersample: expected >= 1, got {args.supersample}")
     if any(args.reference_fps % rate for rate in FIXED_FPS):
         parser.error(f"--reference-fps must be a multiple of {FIXED_FPS}")
     print(
@@ -422,7 +424,8 @@ def best_rate_per_window(pooled: dict[str, list[dict]], budget: int, closing: in
 
     # The distinct values of each sorted array first: at 1024^2 all of them together hold
     # ~10^8 events, and a concatenated copy and its sort ran out of memory.
-    candidates = np.unique(np.concatenate([e[np.r_[True, e[1:] != e[:-1]]] for row in errors for e in row]))
+    distinct = [e[np.r_[True, e[1:] != e[:-1]]] for row in errors for e in row if len(e)]
+    candidates = np.unique(np.concatenate(distinct)) if distinct else np.zeros(1)
     lo, hi = 0, len(candidates) - 1
     while lo < hi:  # the smallest candidate median the budget can reach
         mid = (lo + hi) // 2
