@@ -146,7 +146,10 @@ class Stream:
         self.predicted_next = predicted_change
 
     def all_events(self) -> np.ndarray:
-        return np.concatenate(self.events)
+        """Every event fed so far, joined once (the stream then holds only the joined array)."""
+        if len(self.events) != 1:
+            self.events = [np.concatenate(self.events)]
+        return self.events[0]
 
 
 def matched_timing_errors_us(events: np.ndarray, reference: np.ndarray, width: int) -> np.ndarray:
@@ -190,10 +193,11 @@ def run_clip(
         render_s.append(seconds)
         dn, log_l = radiance_to_dn(radiance, white), emulator_log(radiance, white)
         reference.feed(dn, log_l, t, 0.0)
-        for rate, stream in fixed.items():
-            if i % (ref_fps // rate) == 0:
-                max_rate, _ = frame_motion(radiance, depth, camera, state, white)
-                stream.feed(dn, log_l, t, max_rate / rate)
+        takers = [(rate, stream) for rate, stream in fixed.items() if i % (ref_fps // rate) == 0]
+        if takers:  # the frame's predicted motion once, for every rate that takes it
+            max_rate, _ = frame_motion(radiance, depth, camera, state, white)
+        for rate, stream in takers:
+            stream.feed(dn, log_l, t, max_rate / rate)
         if (i + 1) % 200 == 0:
             print(f"#   reference {i + 1}/{n_ref + 1} frames", file=sys.stderr, flush=True)
     per_frame_s = float(np.mean(render_s))
