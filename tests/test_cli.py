@@ -52,6 +52,22 @@ def test_events_chunk_must_be_positive(tmp_path, capsys):
     assert "chunk" in capsys.readouterr().err and not (tmp_path / "e.h5").exists()
 
 
+def test_the_entry_point_exits_with_mains_status_and_freezes_what_is_left(monkeypatch):
+    import gc
+
+    from traj2events import cli
+
+    monkeypatch.setattr(cli, "main", lambda: 2)
+    frozen_before = gc.get_freeze_count()
+    try:
+        with pytest.raises(SystemExit) as exit_info:
+            cli.run()
+        assert exit_info.value.code == 2
+        assert gc.get_freeze_count() > frozen_before  # the shutdown's collections skip them
+    finally:
+        gc.unfreeze()
+
+
 def test_picture_needs_a_kind():
     with pytest.raises(SystemExit):
         build_parser().parse_args(["picture"])
