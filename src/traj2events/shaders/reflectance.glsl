@@ -4,6 +4,7 @@ uniform vec3 sun_dir;        // unit, toward the Sun (world)
 uniform float irradiance;    // W/m^2 at the Moon
 uniform int model;           // 0 Hapke, 1 Lunar-Lambert
 uniform float w;             // Hapke single-scattering albedo
+uniform float hapke_r0;      // r0 of w (render.hapke_r0_float32): the same at every pixel
 uniform float b;
 uniform float c;
 uniform float b0;
@@ -14,10 +15,8 @@ const float PI = 3.14159265358979;
 
 float chandrasekhar_h(float x, float w_)
 {
-    float gamma = sqrt(1.0 - w_);
-    float r0 = (1.0 - gamma) / (1.0 + gamma);
     float log_term = x > 0.0 ? log((1.0 + x) / x) : 0.0;
-    return 1.0 / (1.0 - w_ * x * (r0 + 0.5 * (1.0 - 2.0 * r0 * x) * log_term));
+    return 1.0 / (1.0 - w_ * x * (hapke_r0 + 0.5 * (1.0 - 2.0 * hapke_r0 * x) * log_term));
 }
 
 // One Henyey-Greenstein lobe in phase angle: peaks at g = 0 (backscatter) for b > 0.
