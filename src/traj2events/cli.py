@@ -469,9 +469,9 @@ def main(argv: list[str] | None = None) -> int:
 def run() -> None:
     """The process's entry point (the `traj2events` script, `python -m traj2events`): main,
     then exit with its status. Every object left is frozen out of the garbage collector
-    first: the interpreter's shutdown otherwise walks numba's and LLVM's objects again and
-    again, 0.3-0.4 s of a ~3 s events job (bench/events_command.py). Outputs are closed
-    by then; reference counts still free what they can."""
+    first: with numba's kernels loaded, the interpreter's shutdown otherwise takes 0.3-0.4 s
+    (of a ~3 s events job on a 1 s clip; docs/benchmarks.md). Outputs are closed by then;
+    reference counts still free what they can."""
     status = main()
     gc.freeze()
     sys.exit(status)
