@@ -444,6 +444,29 @@ def test_event_keys_sort_like_numpy_where_buckets_are_nearly_in_order():
     assert _sorted_keys(pix[:0], t_s[:0], on[:0], _NO_LABELS, n_pixels).size == 0
 
 
+def test_a_bucket_sorted_up_to_its_tail_is_merged_and_a_long_tail_sorted_whole():
+    """Per microsecond, pixels in order then an unsorted tail: tails of 1 to MAX_TAIL keys
+    that go before the whole head, after it and between (the merge), and one of MAX_TAIL + 1
+    (the whole-bucket sort), each against np.sort."""
+    from traj2events.emulator import _NO_LABELS, MAX_TAIL, _sorted_keys
+
+    rng = np.random.default_rng(8)
+    n_pixels = 64 * 64
+    pix, t_us = [], []
+    for us, (head, tail) in enumerate([(40, 1), (40, 7), (10, MAX_TAIL), (200, MAX_TAIL + 1), (30, 5), (5, 0)]):
+        head_pix = np.sort(rng.choice(np.arange(1000, 3000), head, replace=False))
+        tail_pix = rng.choice(np.r_[0:1000, 3000:n_pixels], tail)  # before and after the head
+        if tail > 2:
+            tail_pix[:2] = head_pix[[0, -1]] + 1  # and between its keys
+        pix += [head_pix, tail_pix]
+        t_us += [np.full(head + tail, us)]
+    pix, t_s = np.concatenate(pix), np.concatenate(t_us) * 1e-6
+    on = rng.random(pix.size) < 0.5
+    keys = _sorted_keys(pix, t_s, on, _NO_LABELS, n_pixels)
+    expected = np.sort(np.rint(t_s * 1e6).astype(np.int64) * (2 * n_pixels) + pix * 2 + on)
+    np.testing.assert_array_equal(keys, expected)
+
+
 def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     """The kernel reuses the gain along a run of pixels with the same two inputs: every
     pixel still gets the first-order step of its own pair, as numpy computes it, where a

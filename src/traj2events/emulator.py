@@ -390,28 +390,42 @@ def _reset_reference(pix, base, filtered, leak_drift):
 N_LABELS = 4  # label values 0..3, the key's lowest digit when labels are kept
 
 
-MAX_DESCENTS = 16  # a bucket out of order at more places than this is sorted whole, not by insertion
+MAX_TAIL = 64  # a bucket whose unsorted tail is longer than this is sorted whole
 
 
 @njit(cache=True, nogil=True)
-def _sort_bucket(key, first, end):
-    """key[first:end] sorted in place: by insertion where it is out of order at few places
-    (linear then), else by numba's quicksort."""
-    descents = 0
-    for k in range(first + 1, end):
-        descents += key[k] < key[k - 1]
-    if descents == 0:
+def _sort_bucket(key, first, end, tail):
+    """key[first:end] sorted in place. The signal's events come in pixel order and the noise's
+    after them, so a bucket is sorted up to its first descent; the rest (a few noise and
+    hot-pixel events) is sorted by insertion in `tail` (room for MAX_TAIL keys) and merged
+    into the sorted head from the back, moving each key once. A longer tail: numba's
+    quicksort over the whole bucket."""
+    head_end = first + 1
+    while head_end < end and key[head_end] >= key[head_end - 1]:
+        head_end += 1
+    m = end - head_end
+    if m == 0:
         return
-    if descents > MAX_DESCENTS:
+    if m > MAX_TAIL:
         key[first:end].sort()
         return
-    for k in range(first + 1, end):
-        value = key[k]
+    for k in range(m):
+        value = key[head_end + k]
         j = k - 1
-        while j >= first and key[j] > value:
-            key[j + 1] = key[j]
+        while j >= 0 and tail[j] > value:
+            tail[j + 1] = tail[j]
             j -= 1
-        key[j + 1] = value
+        tail[j + 1] = value
+    i, j = head_end - 1, m - 1  # the head's and the tail's largest not yet placed
+    for out in range(end - 1, first - 1, -1):
+        if j < 0:
+            break  # the rest of the head is in place
+        if i >= first and key[i] > tail[j]:
+            key[out] = key[i]
+            i -= 1
+        else:
+            key[out] = tail[j]
+            j -= 1
 
 
 @njit(cache=True, nogil=True)
@@ -449,8 +463,9 @@ def _sorted_keys(pix, t_s, on, label, n_pixels):
             event = event * N_LABELS + label[k]
         key[fill[b]] = event
         fill[b] += 1
+    tail = np.empty(MAX_TAIL, np.int64)
     for b in range(start.size - 1):
-        _sort_bucket(key, start[b], start[b + 1])
+        _sort_bucket(key, start[b], start[b + 1], tail)
     return key
 
 
