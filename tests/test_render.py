@@ -389,6 +389,14 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
         assert frame.n_tiles == alone.n_tiles > 0
 
 
+@pytest.mark.parametrize("w, r0", [(0.36, 1.0 / 9.0), (0.75, 1.0 / 3.0), (0.0, 0.0), (1.0, 1.0)])
+def test_hapke_r0_for_the_shaders_is_the_published_formula(w, r0):
+    """r0 = (1 - g) / (1 + g), g = sqrt(1 - w): g = 0.8 and 0.5 by hand, and the limits."""
+    from traj2events.render import hapke_r0_float32
+
+    assert hapke_r0_float32(w) == pytest.approx(r0, rel=1e-6, abs=1e-7)
+
+
 def test_shaders_take_the_reflectance_law_from_one_file():
     from traj2events.render import expand_includes, shader_source
 

@@ -13,10 +13,11 @@ uniform float albedo;        // Lunar-Lambert
 
 const float PI = 3.14159265358979;
 
-float chandrasekhar_h(float x, float w_)
+// Hapke's H function of the albedo w (its r0 from the uniform hapke_r0).
+float chandrasekhar_h(float x)
 {
     float log_term = x > 0.0 ? log((1.0 + x) / x) : 0.0;
-    return 1.0 / (1.0 - w_ * x * (hapke_r0 + 0.5 * (1.0 - 2.0 * hapke_r0 * x) * log_term));
+    return 1.0 / (1.0 - w * x * (hapke_r0 + 0.5 * (1.0 - 2.0 * hapke_r0 * x) * log_term));
 }
 
 // One Henyey-Greenstein lobe in phase angle: peaks at g = 0 (backscatter) for b > 0.
@@ -50,7 +51,7 @@ float reflectance_factor_of_phase(vec3 n, vec3 to_camera, float phase)
     float rf = 0.0;
     if (mu0 > 0.0 && mu > 0.0) {
         if (model == 0) {
-            float multiple = chandrasekhar_h(mu0, w) * chandrasekhar_h(mu, w) - 1.0;
+            float multiple = chandrasekhar_h(mu0) * chandrasekhar_h(mu) - 1.0;
             rf = 0.25 * w * mu0 / (mu0 + mu) * (phase + multiple);
         } else {
             rf = albedo * (2.0 * phase * mu0 / (mu0 + mu) + (1.0 - phase) * mu0);
