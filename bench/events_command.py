@@ -1,12 +1,13 @@
 """Benchmark: the whole `traj2events events` command against v2e's whole command.
 
   python bench/events_command.py results/descent/0000/trajectory.h5 [--v2e PATH] [--size 1024]
-      [--fps 100] [--repeats 2] [--python PYTHON]
+      [--fps 100] [--repeats 2] [--python PYTHON] [--seconds 1 [3 ...]]
 
-Input: a 1 s clip from the middle of the trajectory, rendered by the render stage at
---size and --fps: frames.h5 (linear radiance, the workflow's events input) and video.mkv
-(8-bit lossless, the paper's input). Commands, each run whole (start-up, decoding,
-emulation, writing), on one core (OMP/MKL/NUMBA/torch threads 1), alternated A B C A B C:
+Input: a clip of --seconds (default 1 s) from the middle of the trajectory, rendered by
+the render stage at --size and --fps: frames.h5 (linear radiance, the workflow's events
+input) and video.mkv (8-bit lossless, the paper's input). Commands, each run whole
+(start-up, decoding, emulation, writing), on one core (OMP/MKL/NUMBA/torch threads 1),
+alternated A B C A B C:
   A  traj2events events frames.h5 --preset paper --no-labels (the workflow's input: the
      photocurrent of events.sensor)
   A' the same on the display scale (--input-scale display: fewer events, the input of
@@ -17,7 +18,12 @@ emulation, writing), on one core (OMP/MKL/NUMBA/torch threads 1), alternated A B
      whose imports resolve under --python (a CPU torch is enough; v2e imports
      torchvision only for SuperSloMo, so a stub package can stand in for it). Without
      --v2e, C is skipped and said so.
-Prints each run's seconds and events, and the ratios of the medians (v2e / ours).
+Every command runs once untimed on the shortest clip first. Prints each run's seconds and
+events, and the ratios of the medians (v2e / ours). With two or more --seconds (clips of
+those lengths from the same start; every command on every clip in each alternation), also
+each command's seconds per frame (the slope of a straight line through its medians against
+the frames) and its fixed part (the intercept: start-up and finishing), and v2e / ours on
+the slopes: what the whole command's ratio tends to on a long trajectory.
 """
 
 from __future__ import annotations
@@ -37,6 +43,8 @@ os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import h5py  # noqa: E402
+import hdf5plugin  # noqa: E402, F401
+import numpy as np  # noqa: E402
 from workflow_cost import clip_trajectory  # noqa: E402  (bench/, beside this script)
 
 from traj2events.config import resolve_config  # noqa: E402
@@ -48,11 +56,12 @@ PAPER = ["--pos_thres", "0.25", "--neg_thres", "0.25", "--sigma_thres", "0.03", 
          "--leak_rate_hz", "0.1", "--shot_noise_rate_hz", "5", "--refractory_period", "0"]  # fmt: skip
 
 
-def clip_inputs(trajectory: Path, size: int, fps: float, folder: Path) -> tuple[Path, Path]:
-    """frames.h5 and video.mkv of 1 s from the middle of the trajectory."""
+def clip_inputs(trajectory: Path, size: int, fps: float, folder: Path, seconds: float = 1.0) -> tuple[Path, Path]:
+    """frames.h5 and video.mkv of `seconds` from the middle of the trajectory, in `folder`."""
     tr = read_trajectory(trajectory)
+    folder.mkdir(parents=True, exist_ok=True)
     clip = folder / "clip.h5"
-    clip_trajectory(trajectory, float(tr.t_nodes[-1]) / 2, 1.0, fps, clip)
+    clip_trajectory(trajectory, float(tr.t_nodes[-1]) / 2, seconds, fps, clip)
     config = resolve_config({"camera": {"width": size, "height": size, "fps": fps}})
     settings = RenderSettings.from_config(config, str(tr.attrs["scenario"]))
     frames, video = folder / "frames.h5", folder / "video.mkv"
@@ -70,10 +79,35 @@ def run(command: list[str], env: dict) -> float:
 
 
 def count_events(path: Path) -> int:
-    import hdf5plugin  # noqa: F401
-
     with h5py.File(path) as f:
         return len(f["events/t"]) if "events/t" in f else len(f["events"])
+
+
+def commands_for(frames: Path, video: Path, folder: Path, args) -> dict[str, list[str]]:
+    """The commands (A, A', B and, with --v2e, C) on one clip's inputs, writing into `folder`."""
+    ours = [str(Path(sys.executable).parent / "traj2events"), "events"]
+    paper = ["--preset", "paper", "--no-labels"]
+    commands = {
+        "A ours, frames.h5": [*ours, str(frames), "-o", str(folder / "a.h5"), *paper],
+        "A' ours, frames.h5, display scale": [
+            *ours, str(frames), "-o", str(folder / "a2.h5"), *paper, "--input-scale", "display"
+        ],
+        "B ours, video.mkv": [*ours, str(video), "-o", str(folder / "b.h5"), *paper],
+    }  # fmt: skip
+    if args.v2e:
+        commands["C v2e, video.mkv"] = [
+            args.python, str(args.v2e / "v2e.py"), "-i", str(video), "-o", str(folder / "v2e"), "--overwrite",
+            "--unique_output_folder", "false", "--disable_slomo", "--auto_timestamp_resolution", "false",
+            "--output_width", str(args.size), "--output_height", str(args.size), *PAPER,
+            "--dvs_exposure", "duration", "0.01", "--no_preview", "--skip_video_output", "--dvs_h5", "events.h5",
+            "--dvs_aedat2", "None", "--dvs_text", "None",
+        ]  # fmt: skip
+    return commands
+
+
+def output_of(name: str, command: list[str]) -> Path:
+    out = Path(command[command.index("-o") + 1])
+    return out / "events.h5" if name.startswith("C") else out
 
 
 def main() -> None:
@@ -84,51 +118,54 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=1024)
     parser.add_argument("--fps", type=float, default=100.0)
     parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--seconds", type=float, nargs="+", default=[1.0], help="clip lengths, s (default 1)")
     args = parser.parse_args()
     env = {**os.environ, **ONE_CORE}
-    ours = [str(Path(sys.executable).parent / "traj2events"), "events"]
+    lengths = sorted(set(args.seconds))
     with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
-        frames, video = clip_inputs(args.trajectory, args.size, args.fps, folder)
-        paper = ["--preset", "paper", "--no-labels"]
-        commands = {
-            "A ours, frames.h5": [*ours, str(frames), "-o", str(folder / "a.h5"), *paper],
-            "A' ours, frames.h5, display scale": [
-                *ours, str(frames), "-o", str(folder / "a2.h5"), *paper, "--input-scale", "display"
-            ],
-            "B ours, video.mkv": [*ours, str(video), "-o", str(folder / "b.h5"), *paper],
-        }  # fmt: skip
-        outputs = {name: Path(command[command.index("-o") + 1]) for name, command in commands.items()}
-        if args.v2e:
-            out = folder / "v2e"
-            commands["C v2e, video.mkv"] = [
-                args.python, str(args.v2e / "v2e.py"), "-i", str(video), "-o", str(out), "--overwrite",
-                "--unique_output_folder", "false", "--disable_slomo", "--auto_timestamp_resolution", "false",
-                "--output_width", str(args.size), "--output_height", str(args.size), *PAPER,
-                "--dvs_exposure", "duration", "0.01", "--no_preview", "--skip_video_output", "--dvs_h5", "events.h5",
-                "--dvs_aedat2", "None", "--dvs_text", "None",
-            ]  # fmt: skip
-            outputs["C v2e, video.mkv"] = out / "events.h5"
-        seconds: dict[str, list[float]] = {name: [] for name in commands}
-        for _ in range(args.repeats):
-            for name, command in commands.items():
-                seconds[name].append(run(command, env))
-        events = {name: count_events(path) for name, path in outputs.items()}
-        shutil.rmtree(folder / "v2e", ignore_errors=True)
+        clips = {}  # seconds -> (frames in the clip, its commands)
+        for seconds in lengths:
+            folder = Path(tmp) / f"{seconds:g}s"
+            frames, video = clip_inputs(args.trajectory, args.size, args.fps, folder, seconds)
+            with h5py.File(frames) as f:
+                n_frames = len(f["t"])
+            clips[seconds] = (n_frames, commands_for(frames, video, folder, args))
+        seconds_run = {(s, name): [] for s, (_, cmds) in clips.items() for name in cmds}
+        events = {}
+        for command in clips[lengths[0]][1].values():  # untimed: caches, compiled kernels, page cache
+            run(command, env)
+        for _ in range(args.repeats):  # alternated: every command on every clip, then again
+            for s, (_, cmds) in clips.items():
+                for name, command in cmds.items():
+                    seconds_run[(s, name)].append(run(command, env))
+                    events[(s, name)] = count_events(output_of(name, command))
+                    shutil.rmtree(Path(tmp) / f"{s:g}s" / "v2e", ignore_errors=True)
+    names = list(clips[lengths[0]][1])
     print(
-        f"# events command, {args.size}^2, {args.fps:g} fps, 1 s of {args.trajectory}; {platform.node()} "
-        f"({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}"
+        f"# events command, {args.size}^2, {args.fps:g} fps, clips of {', '.join(f'{s:g}' for s in lengths)} s "
+        f"from the middle of {args.trajectory}; {platform.node()} ({os.cpu_count()} cores, 1 used), "
+        f"{time.strftime('%Y-%m-%d')}"
     )
-    print("| command | runs, s | events |")
-    print("|---|---|---|")
-    for name, runs in seconds.items():
-        print(f"| {name} | {' / '.join(f'{s:.2f}' for s in runs)} | {events[name]} |")
-    if "C v2e, video.mkv" not in seconds:
+    for s in lengths:
+        print(f"\n{s:g} s ({clips[s][0]} frames)\n\n| command | runs, s | events |\n|---|---|---|")
+        for name in names:
+            print(f"| {name} | {' / '.join(f'{x:.2f}' for x in seconds_run[(s, name)])} | {events[(s, name)]} |")
+    if not args.v2e:
         print("\nv2e: not run (no --v2e checkout given)")
         return
-    v2e = statistics.median(seconds["C v2e, video.mkv"])
-    for name in (n for n in seconds if n.startswith(("A", "B"))):
-        print(f"\nv2e / {name}: {v2e / statistics.median(seconds[name]):.1f}x")
+    median = {key: statistics.median(runs) for key, runs in seconds_run.items()}
+    v2e = "C v2e, video.mkv"
+    for s in lengths:
+        for name in names[:-1]:
+            print(f"\n{s:g} s: v2e / {name}: {median[(s, v2e)] / median[(s, name)]:.1f}x")
+    if len(lengths) > 1:
+        frames = np.array([clips[s][0] for s in lengths], float)
+        fits = {name: np.polyfit(frames, [median[(s, name)] for s in lengths], 1) for name in names}
+        print("\n| command | s per frame (slope) | fixed s (intercept) |\n|---|---|---|")
+        for name, (slope, intercept) in fits.items():
+            print(f"| {name} | {slope:.4f} | {intercept:.2f} |")
+        for name in names[:-1]:
+            print(f"\nper frame, v2e / {name}: {fits[v2e][0] / fits[name][0]:.1f}x")
 
 
 if __name__ == "__main__":
