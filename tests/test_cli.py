@@ -171,11 +171,32 @@ def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):
             video.write(rng.integers(0, 255, (24, 32), dtype=np.uint8))
     data = (tmp_path / "v.mkv").read_bytes()
     (tmp_path / "cut.mkv").write_bytes(data[: len(data) // 2])
-    assert main(["events", str(tmp_path / "cut.mkv"), "-o", str(tmp_path / "e.h5"), "--chunk", "8"]) == 2
-    err = capsys.readouterr().err
-    assert "cut.mkv" in err and "truncated" in err and not (tmp_path / "e.h5").exists()
-    assert not list(tmp_path.glob(".e.h5*"))
+    for ahead in ("--read-ahead", "--no-read-ahead"):  # the reader thread's error reaches the command
+        assert main(["events", str(tmp_path / "cut.mkv"), "-o", str(tmp_path / "e.h5"), "--chunk", "8", ahead]) == 2
+        err = capsys.readouterr().err
+        assert "cut.mkv" in err and "truncated" in err and not (tmp_path / "e.h5").exists()
+        assert not list(tmp_path.glob(".e.h5*"))
     assert main(["events", str(tmp_path / "v.mkv"), "-o", str(tmp_path / "e.h5")]) == 0  # the whole one is fine
+
+
+@pytest.mark.parametrize(
+    "cpus, option, expected",
+    [({0}, None, False), ({0, 1}, None, True), ({0, 1}, "--no-read-ahead", False), ({0}, "--read-ahead", True)],
+)
+def test_events_read_ahead_by_default_only_with_a_second_cpu(tmp_path, monkeypatch, cpus, option, expected):
+    import traj2events.cli as cli
+
+    asked = {}
+
+    def frame_source(*args):
+        asked["ahead"] = args[-1]
+        raise ValueError("stop here")
+
+    monkeypatch.setattr(cli.os, "sched_getaffinity", lambda pid: cpus)
+    monkeypatch.setattr("traj2events.stages.events.frame_source", frame_source)
+    options = [option] if option else []
+    assert main(["events", str(tmp_path / "in.mkv"), "-o", str(tmp_path / "e.h5"), *options]) == 2
+    assert asked["ahead"] is expected
 
 
 @pytest.fixture()

@@ -64,3 +64,22 @@ def test_frames_round_trip_with_reused_buffers(tmp_path):
         for k, (radiance, depth) in enumerate(frames):  # frame 0 was not overwritten by frame 1's rounding
             np.testing.assert_array_equal(f.radiance(k), rounded_reference(radiance))
             np.testing.assert_array_equal(f.depth_m(k), rounded_reference(depth))
+
+
+@pytest.mark.parametrize("buffers", [1, 2, 3])
+def test_radiance_chunks_take_turns_in_a_ring_of_buffers(tmp_path, buffers):
+    rng = np.random.default_rng(8)
+    radiance = rng.random((7, 6, 5), np.float32) * 40
+    with FramesWriter(tmp_path / "frames.h5", 6, 5, {"width": 5, "height": 6}) as out:
+        for k in range(7):
+            out.append(0.01 * k, k, radiance[k], radiance[k])
+    with FramesFile(tmp_path / "frames.h5") as f:
+        chunks = list(f.radiance_chunks(2, buffers))
+        assert [len(t) for _, t in chunks] == [2, 2, 2, 1]
+        np.testing.assert_allclose(np.concatenate([t for _, t in chunks]), 0.01 * np.arange(7))
+        # Chunk n shares its array with chunk n + buffers (which overwrote it), no other.
+        for n, (a, _) in enumerate(chunks):
+            for m, (b, _) in enumerate(chunks):
+                assert np.shares_memory(a, b) == (n % buffers == m % buffers)
+        for n in range(len(chunks) - buffers, len(chunks)):  # the last `buffers` chunks are still intact
+            np.testing.assert_array_equal(chunks[n][0], rounded_reference(radiance[2 * n : 2 * n + 2]))

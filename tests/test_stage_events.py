@@ -125,3 +125,21 @@ def test_frames_h5_through_the_sensor_is_the_display_path_at_the_sensor_s_scale(
     assert main(["events", str(tmp_path / "frames.h5"), "-o", str(tmp_path / "c.h5"), "--preset", "clean",
                  "--no-labels", "--sensor", f'{{"f_number": {sensor.f_number}}}']) == 0  # fmt: skip
     assert read_events(tmp_path / "c.h5")[0].tobytes() == s.tobytes()
+
+
+def test_reading_ahead_gives_the_same_bytes(tmp_path):
+    frames = ramp_frames(n=40)
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in frames:
+            video.write(f)
+    with h5py.File(tmp_path / "frames.h5", "w") as f:
+        f["t"] = np.arange(len(frames)) / 50.0
+        f["radiance"] = frames.astype(np.float32) / 255.0 * 40.0
+        f.attrs["display_white_w_m2_sr"] = 40.0
+    for name in ("in.mkv", "frames.h5"):
+        for ahead in (False, True):
+            source = frame_source(tmp_path / name, chunk=3, white=40.0 if name == "frames.h5" else None, ahead=ahead)
+            emulate(source, emulator_params("paper"), 3, tmp_path / f"{name}.{ahead}.h5", "paper", name)
+        plain, _ = read_events(tmp_path / f"{name}.False.h5")
+        ahead_events, _ = read_events(tmp_path / f"{name}.True.h5")
+        assert len(plain) > 100 and plain.tobytes() == ahead_events.tobytes()

@@ -141,7 +141,8 @@ def cmd_events(args) -> int:
         raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
     sensor = _sensor(args.sensor) if args.input_scale == "sensor" else None
     chunk = CHUNK_FRAMES if args.chunk is None else args.chunk
-    source = frame_source(args.input, chunk, args.fps, args.white, sensor)
+    ahead = len(os.sched_getaffinity(0)) > 1 if args.read_ahead is None else args.read_ahead
+    source = frame_source(args.input, chunk, args.fps, args.white, sensor, ahead)
     from .progress import log
 
     log(
@@ -401,6 +402,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--chunk",
         type=int,
         help="frames read at a time (default: stages.events.CHUNK_FRAMES, 16; the events do not change)",
+    )
+    p.add_argument(
+        "--read-ahead",
+        action=argparse.BooleanOptionalAction,
+        help="read the next chunk of frames.h5 or the video in a second thread while emulating this one: "
+        "faster where a second core is free, one more chunk in memory; the events do not change "
+        "(default: on when this process may use more than one CPU)",
     )
     p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
     p.add_argument(

@@ -21,6 +21,7 @@ rule events:
         seed=event_seed,
         exports=export_flags,
         code=code("events"),
+    # One core per job (no threads: declared): a reader thread would take a neighbour's core.
     shell:
         "traj2events events {input.frames} --output {output.events} --seed {params.seed} {params.options} "
-        "--trajectory {input.trajectory} {params.exports} 2> {log}"
+        "--trajectory {input.trajectory} {params.exports} --no-read-ahead 2> {log}"

@@ -159,14 +159,17 @@ class FramesFile:
         """The depth of pixel (row i, column j) in every frame (n,)."""
         return self._file["depth_m"][:, i, j]
 
-    def radiance_chunks(self, chunk: int) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+    def radiance_chunks(self, chunk: int, buffers: int = 1) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames.
-        The chunks share one array, each valid until the next is read (copy one to keep
-        it): a new array per chunk cost more in page faults than HDF5's decompression."""
+        The chunks take turns in a ring of `buffers` arrays, each valid until `buffers` more
+        are read (copy one to keep it): a new array per chunk cost more in page faults than
+        HDF5's decompression. Two let a reader thread fill one while the other is used
+        (`read_ahead.read_ahead`)."""
         radiance = self._file["radiance"]
-        buffer = np.empty((min(chunk, self.shape[0]), *self.shape[1:]), radiance.dtype)
-        for start in range(0, self.shape[0], chunk):
+        ring = [np.empty((min(chunk, self.shape[0]), *self.shape[1:]), radiance.dtype) for _ in range(buffers)]
+        for n, start in enumerate(range(0, self.shape[0], chunk)):
             k = min(chunk, self.shape[0] - start)
+            buffer = ring[n % buffers]
             radiance.read_direct(buffer, np.s_[start : start + k], np.s_[:k])
             yield buffer[:k], self.t[start : start + k]
 

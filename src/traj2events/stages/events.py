@@ -14,7 +14,7 @@ import os
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Iterator
+from typing import Generator
 
 import numpy as np
 
@@ -26,11 +26,19 @@ from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
 from ..log_response import display_dn_per_radiance
 from ..progress import log
+from ..read_ahead import read_ahead
 from ..sensor import SensorParams, dn_per_radiance
 from ..state import BODY_RATES
 from ..video import iter_video, video_info
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
+
+# Frames read at a time. Each interval's events are emulated and written as it comes, so
+# a chunk only batches the reading; a 1024^2 float32 chunk of 16 is 64 MB, and 64 (before
+# session 18) cost ~0.2 GB more memory and ~0.4 s of page faults per job for no speed.
+CHUNK_FRAMES = 16
+# Chunks in memory at once: the one being emulated and the next, read meanwhile.
+READ_AHEAD_BUFFERS = 2
 
 
 @dataclass
@@ -40,7 +48,7 @@ class FrameSource:
     width: int
     height: int
     kind: str
-    chunks: Iterator[tuple[np.ndarray, np.ndarray]]
+    chunks: Generator[tuple[np.ndarray, np.ndarray], None, None]
     scene: dict = field(default_factory=dict)  # what frames.h5 says of the camera and the scene
     input_scale: float = 1.0  # the chunks' values times this are the emulator's DN
 
@@ -73,9 +81,12 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
     return FrameSource(width, height, "images (8-bit)", images())
 
 
-def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorParams | None = None) -> FrameSource:
+def frames_source(
+    path: Path, white: float | None, chunk: int, sensor: SensorParams | None = None, ahead: bool = False
+) -> FrameSource:
     """frames.h5's radiance as photocurrent through `sensor`, or (no sensor) on the display
-    scale 255 L / white (`white` or the file's display white)."""
+    scale 255 L / white (`white` or the file's display white); with `ahead`, the next chunk
+    read by a thread meanwhile."""
     frames = FramesFile(path)
     _, height, width = frames.shape
     scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
@@ -93,12 +104,13 @@ def frames_source(path: Path, white: float | None, chunk: int, sensor: SensorPar
 
     def radiance():  # float32 as stored: the emulator scales it per pixel (no float64 copy)
         with frames:
-            yield from frames.radiance_chunks(chunk)
+            yield from frames.radiance_chunks(chunk, buffers=READ_AHEAD_BUFFERS if ahead else 1)
 
-    return FrameSource(width, height, kind, radiance(), scene, scale)
+    chunks = read_ahead(radiance(), READ_AHEAD_BUFFERS) if ahead else radiance()
+    return FrameSource(width, height, kind, chunks, scene, scale)
 
 
-def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
+def video_source(path: Path, fps: float | None, chunk: int, ahead: bool = False) -> FrameSource:
     info = video_info(path)
     width, height, video_fps, _ = info
     fps = fps or video_fps
@@ -111,13 +123,8 @@ def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
             yield frames, (k + np.arange(len(frames))) / fps
             k += len(frames)
 
-    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video())
-
-
-# Frames read at a time. Each interval's events are emulated and written as it comes, so
-# a chunk only batches the reading; a 1024^2 float32 chunk of 16 is 64 MB, and 64 (before
-# session 18) cost ~0.2 GB more memory and ~0.4 s of page faults per job for no speed.
-CHUNK_FRAMES = 16
+    chunks = read_ahead(video(), READ_AHEAD_BUFFERS) if ahead else video()
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", chunks)
 
 
 def frame_source(
@@ -126,9 +133,11 @@ def frame_source(
     fps: float | None = None,
     white: float | None = None,
     sensor: SensorParams | None = None,
+    ahead: bool = False,
 ) -> FrameSource:
     """The frames of frames.h5 (through `sensor`, or on the display scale without one), a
-    video or a folder of images (by what `path` is)."""
+    video or a folder of images (by what `path` is). `ahead`: frames.h5 and videos read a
+    chunk ahead by a thread (a second core's worth: worth it only where one is free)."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"events INPUT: {path} does not exist")
@@ -137,8 +146,8 @@ def frame_source(
     if path.is_dir():
         return image_folder_source(path, fps, chunk)
     if path.suffix.lower() in (".h5", ".hdf5"):
-        return frames_source(path, white, chunk, sensor)
-    return video_source(path, fps, chunk)
+        return frames_source(path, white, chunk, sensor, ahead)
+    return video_source(path, fps, chunk, ahead)
 
 
 def emulator_params(preset: str, **overrides) -> EmulatorParams:
@@ -188,6 +197,7 @@ def emulate(
             if n_frames % progress_every < len(frames):
                 log(f"  {n_frames} frames, {n_events} events, {n_frames / (time.perf_counter() - start):.0f} frames/s")
     except BaseException as exc:
+        source.chunks.close()  # stops a reader thread now, not when the source is dropped
         writer.close(0, (type(exc), exc, exc.__traceback__))
         raise
     writer.close(int(round(t_last * 1e6)))
