@@ -1,12 +1,13 @@
 """Benchmark: the whole `traj2events events` command against v2e's whole command.
 
   python bench/events_command.py results/descent/0000/trajectory.h5 [--v2e PATH] [--size 1024]
-      [--fps 100] [--repeats 2] [--python PYTHON] [--seconds 1 [3 ...]]
+      [--fps 100] [--repeats 2] [--python PYTHON] [--seconds 1 [3 ...]] [--cpus 1]
 
 Input: a clip of --seconds (default 1 s) from the middle of the trajectory, rendered by
 the render stage at --size and --fps: frames.h5 (linear radiance, the workflow's events
 input) and video.mkv (8-bit lossless, the paper's input). Commands, each run whole
-(start-up, decoding, emulation, writing), on one core (OMP/MKL/NUMBA/torch threads 1),
+(start-up, decoding, emulation, writing), on --cpus CPUs (default 1; pinned with taskset,
+OMP/MKL/NUMBA/torch threads as many; ours reads ahead in a thread with two or more),
 alternated A B C A B C:
   A  traj2events events frames.h5 --preset paper --no-labels (the workflow's input: the
      photocurrent of events.sensor)
@@ -51,7 +52,7 @@ from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.stages.render import RenderSettings, render_trajectory  # noqa: E402
 
-ONE_CORE = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1", "LP_NUM_THREADS": "1"}
+THREADS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "LP_NUM_THREADS")
 V2E = "C v2e, video.mkv"  # the command that is v2e's
 PAPER = ["--pos_thres", "0.25", "--neg_thres", "0.25", "--sigma_thres", "0.03", "--cutoff_hz", "3",
          "--leak_rate_hz", "0.1", "--shot_noise_rate_hz", "5", "--refractory_period", "0"]  # fmt: skip
@@ -71,9 +72,11 @@ def clip_inputs(trajectory: Path, size: int, fps: float, folder: Path, seconds: 
     return frames, video, n_frames
 
 
-def run(command: list[str], env: dict) -> float:
+def run(command: list[str], env: dict, cpus: list[int]) -> float:
     start = time.perf_counter()
-    done = subprocess.run(command, env=env, capture_output=True, text=True)
+    done = subprocess.run(
+        ["taskset", "-c", ",".join(map(str, cpus)), *command], env=env, capture_output=True, text=True
+    )
     seconds = time.perf_counter() - start
     if done.returncode:
         raise RuntimeError(f"{' '.join(command)} failed:\n{done.stderr[-3000:]}")
@@ -121,8 +124,13 @@ def main() -> None:
     parser.add_argument("--fps", type=float, default=100.0)
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--seconds", type=float, nargs="+", default=[1.0], help="clip lengths, s (default 1)")
+    parser.add_argument("--cpus", type=int, default=1, help="CPUs each command may use (default 1)")
     args = parser.parse_args()
-    env = {**os.environ, **ONE_CORE}
+    allowed = sorted(os.sched_getaffinity(0))
+    if not 1 <= args.cpus <= len(allowed):
+        parser.error(f"--cpus: expected 1..{len(allowed)} (the CPUs this process may use), got {args.cpus}")
+    cpus = allowed[-args.cpus :]
+    env = {**os.environ, **dict.fromkeys(THREADS, str(args.cpus))}
     lengths = sorted(set(args.seconds))
     with tempfile.TemporaryDirectory() as tmp:
         clips = {}  # seconds -> (frames in the clip, its commands)
@@ -133,11 +141,11 @@ def main() -> None:
         seconds_run = {(s, name): [] for s, (_, cmds) in clips.items() for name in cmds}
         events = {}
         for command in clips[lengths[0]][1].values():  # untimed: caches, compiled kernels, page cache
-            run(command, env)
+            run(command, env, cpus)
         for _ in range(args.repeats):  # alternated: every command on every clip, then again
             for s, (_, cmds) in clips.items():
                 for name, command in cmds.items():
-                    seconds_run[(s, name)].append(run(command, env))
+                    seconds_run[(s, name)].append(run(command, env, cpus))
                     output = output_of(name, command)
                     events[(s, name)] = count_events(output)
                     if name == V2E:  # its folder of outputs, not needed again
@@ -146,7 +154,7 @@ def main() -> None:
     ours = [name for name in names if name != V2E]
     print(
         f"# events command, {args.size}^2, {args.fps:g} fps, clips of {', '.join(f'{s:g}' for s in lengths)} s "
-        f"from the middle of {args.trajectory}; {platform.node()} ({os.cpu_count()} cores, 1 used), "
+        f"from the middle of {args.trajectory}; {platform.node()} ({os.cpu_count()} cores, {args.cpus} used), "
         f"{time.strftime('%Y-%m-%d')}"
     )
     for s in lengths:
