@@ -94,7 +94,8 @@ def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_
                          "-o", str(folder / "motion_field.h5"), "--flo-dir", str(folder / "flow")],
         "events": [*cli, "events", str(frames), "-o", str(folder / "events.h5"), "--seed", "1",
                    "--preset", events["preset"], "--input-scale", events["input"],
-                   "--sensor", json.dumps(events["sensor"]), "--labels" if events["labels"] else "--no-labels"],
+                   "--sensor", json.dumps(events["sensor"]), "--labels" if events["labels"] else "--no-labels",
+                   "--no-read-ahead"],  # as the workflow's rule
     }  # fmt: skip
 
 
