@@ -7,7 +7,7 @@ Input: a clip of --seconds (default 1 s) from the middle of the trajectory, rend
 the render stage at --size and --fps: frames.h5 (linear radiance, the workflow's events
 input) and video.mkv (8-bit lossless, the paper's input). Commands, each run whole
 (start-up, decoding, emulation, writing), on --cpus CPUs (default 1; pinned with taskset,
-OMP/MKL/NUMBA/torch threads as many; ours reads ahead in a thread with two or more),
+OMP/MKL/NUMBA/torch threads as many; ours takes as many by default: `--threads`),
 alternated A B C A B C:
   A  traj2events events frames.h5 --preset paper --no-labels (the workflow's input: the
      photocurrent of events.sensor)

@@ -95,7 +95,7 @@ def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_
         "events": [*cli, "events", str(frames), "-o", str(folder / "events.h5"), "--seed", "1",
                    "--preset", events["preset"], "--input-scale", events["input"],
                    "--sensor", json.dumps(events["sensor"]), "--labels" if events["labels"] else "--no-labels",
-                   "--no-read-ahead"],  # as the workflow's rule
+                   "--threads", "1"],  # as the workflow's rule
     }  # fmt: skip
 
 

@@ -157,7 +157,13 @@ def test_bad_settings_and_options_are_named(tmp_path, capsys):
     assert main(["motion-field", str(good), "-o", str(tmp_path / "m.h5"), "--flo-dir", str(tmp_path / "f"),
                  "--moon-radius-m", "-1"]) == 2  # fmt: skip
     assert "moon_radius_m" in capsys.readouterr().err
-    for option, value in (("--window-ms", "0"), ("--white", "-3"), ("--fps", "0"), ("--seed", "-1")):
+    for option, value in (
+        ("--window-ms", "0"),
+        ("--white", "-3"),
+        ("--fps", "0"),
+        ("--seed", "-1"),
+        ("--threads", "0"),
+    ):
         assert main(["events", str(good), "-o", str(tmp_path / "e.h5"), option, value]) == 2
         assert option in capsys.readouterr().err and not (tmp_path / "e.h5").exists()
 
@@ -171,8 +177,9 @@ def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):
             video.write(rng.integers(0, 255, (24, 32), dtype=np.uint8))
     data = (tmp_path / "v.mkv").read_bytes()
     (tmp_path / "cut.mkv").write_bytes(data[: len(data) // 2])
-    for ahead in ("--read-ahead", "--no-read-ahead"):  # the reader thread's error reaches the command
-        assert main(["events", str(tmp_path / "cut.mkv"), "-o", str(tmp_path / "e.h5"), "--chunk", "8", ahead]) == 2
+    for threads in ("2", "1"):  # from 2, a reader thread's error reaches the command
+        assert main(["events", str(tmp_path / "cut.mkv"), "-o", str(tmp_path / "e.h5"), "--chunk", "8",
+                     "--threads", threads]) == 2  # fmt: skip
         err = capsys.readouterr().err
         assert "cut.mkv" in err and "truncated" in err and not (tmp_path / "e.h5").exists()
         assert not list(tmp_path.glob(".e.h5*"))
@@ -180,23 +187,22 @@ def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):
 
 
 @pytest.mark.parametrize(
-    "cpus, option, expected",
-    [({0}, None, False), ({0, 1}, None, True), ({0, 1}, "--no-read-ahead", False), ({0}, "--read-ahead", True)],
+    "cpus, option, threads",
+    [({0}, [], 1), ({0, 1}, [], 2), ({0, 1}, ["--threads", "1"], 1), ({0}, ["--threads", "3"], 3)],
 )
-def test_events_read_ahead_by_default_only_with_a_second_cpu(tmp_path, monkeypatch, cpus, option, expected):
+def test_events_threads_by_default_the_cpus_it_may_use(tmp_path, monkeypatch, cpus, option, threads):
     import traj2events.cli as cli
 
     asked = {}
 
-    def frame_source(*args):
-        asked["ahead"] = args[-1]
+    def frame_source(*args, ahead):
+        asked["ahead"] = ahead
         raise ValueError("stop here")
 
     monkeypatch.setattr(cli.os, "sched_getaffinity", lambda pid: cpus)
     monkeypatch.setattr("traj2events.stages.events.frame_source", frame_source)
-    options = [option] if option else []
-    assert main(["events", str(tmp_path / "in.mkv"), "-o", str(tmp_path / "e.h5"), *options]) == 2
-    assert asked["ahead"] is expected
+    assert main(["events", str(tmp_path / "in.mkv"), "-o", str(tmp_path / "e.h5"), *option]) == 2
+    assert asked["ahead"] is (threads > 1)  # reading ahead from two threads on
 
 
 @pytest.fixture()

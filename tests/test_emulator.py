@@ -485,8 +485,42 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     theta = np.full(n, 100.0, np.float32)  # no crossings: only the low-pass is looked at
     work = [np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
     _advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), cutoff_hz, dt, scale,
-             *work, _NO_TABLE, _NO_TABLE, _NO_TABLE, np.zeros(n, np.int64))  # fmt: skip
+             *work, _NO_TABLE, _NO_TABLE, _NO_TABLE, np.zeros(n, np.int64), 0)  # fmt: skip
     dn0, dn1 = i0.astype(np.float64) * scale, i1.astype(np.float64) * scale
     target = np.where(dn1 <= 20.0, dn1 * (np.log(20.0) / 20.0), np.log(np.maximum(dn1, 20.0)))
     gain = -np.expm1(-(2.0 * np.pi * dt) * (cutoff_hz * (0.5 * (dn0 + dn1) + 20.0) / 275.0))
     np.testing.assert_array_equal(filtered, f0 + gain * (target - f0))
+
+
+def test_pixel_ranges_cover_the_frame_in_order_each_big_enough():
+    from traj2events.emulator import PIXELS_PER_THREAD, pixel_ranges
+
+    assert pixel_ranges(1000, 4) == [(0, 1000)]  # a small frame: one range
+    assert pixel_ranges(3 * PIXELS_PER_THREAD + 5, 8) == [
+        (0, PIXELS_PER_THREAD + 1),
+        (PIXELS_PER_THREAD + 1, 2 * PIXELS_PER_THREAD + 3),
+        (2 * PIXELS_PER_THREAD + 3, 3 * PIXELS_PER_THREAD + 5),
+    ]
+    assert pixel_ranges(1 << 20, 2) == [(0, 1 << 19), (1 << 19, 1 << 20)]
+    with pytest.raises(ValueError, match="threads"):
+        EventEmulator(16, 12, threads=0)
+
+
+@pytest.mark.parametrize("input_kind", ["8-bit", "float32 radiance"])
+def test_threads_give_the_same_events_and_labels(input_kind):
+    # 384 x 512: three ranges of 65536 pixels; a moving texture, so every range has crossings.
+    rng = np.random.default_rng(12)
+    texture = rng.uniform(0, 255, (384, 640))
+    frames = np.stack([texture[:, 4 * k : 4 * k + 512] for k in range(6)])
+    if input_kind == "8-bit":
+        frames, scale = frames.round().astype(np.uint8), 1.0
+    else:
+        frames, scale = (frames / 7.0).astype(np.float32), 7.0
+    times = np.arange(6) / FPS
+    outputs = []
+    for threads in (1, 2, 3):
+        emu = EventEmulator(512, 384, PRESETS["paper"], seed=3, labels=True, input_scale=scale, threads=threads)
+        events, labels = emu.process_with_labels(frames, times)
+        outputs.append((events.tobytes(), labels.tobytes()))
+    assert len(outputs[0][0]) > 13 * 100_000  # > 100 k events
+    assert outputs[1] == outputs[0] and outputs[2] == outputs[0]

@@ -125,6 +125,8 @@ def cmd_events(args) -> int:
         _positive(option, value)
     if args.seed < 0:
         raise ValueError(f"--seed: expected a value >= 0, got {args.seed}")
+    if args.threads is not None and args.threads < 1:
+        raise ValueError(f"--threads: expected a value >= 1, got {args.threads}")
 
     params = emulator_params(
         args.preset,
@@ -141,8 +143,8 @@ def cmd_events(args) -> int:
         raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
     sensor = _sensor(args.sensor) if args.input_scale == "sensor" else None
     chunk = CHUNK_FRAMES if args.chunk is None else args.chunk
-    ahead = len(os.sched_getaffinity(0)) > 1 if args.read_ahead is None else args.read_ahead
-    source = frame_source(args.input, chunk, args.fps, args.white, sensor, ahead)
+    threads = len(os.sched_getaffinity(0)) if args.threads is None else args.threads
+    source = frame_source(args.input, chunk, args.fps, args.white, sensor, ahead=threads > 1)
     from .progress import log
 
     log(
@@ -158,6 +160,7 @@ def cmd_events(args) -> int:
         str(args.input),
         progress_every=chunk * 10,
         labels=args.labels,
+        threads=threads,
     )
     if args.frames_png:
         from .stages.pictures import events_picture
@@ -404,11 +407,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="frames read at a time (default: stages.events.CHUNK_FRAMES, 16; the events do not change)",
     )
     p.add_argument(
-        "--read-ahead",
-        action=argparse.BooleanOptionalAction,
-        help="read the next chunk of frames.h5 or the video in a second thread while emulating this one: "
-        "faster where a second core is free, one more chunk in memory; the events do not change "
-        "(default: on when this process may use more than one CPU)",
+        "--threads",
+        type=int,
+        help="CPUs to use: with 2 or more, the next chunk of frames.h5 or of the video is read in a thread "
+        "while this one is emulated (one more chunk in memory), and each frame's pixels are split over "
+        "that many threads (at least 65536 pixels each); the events do not change (default: the CPUs this "
+        "process may use)",
     )
     p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
     p.add_argument(

@@ -126,17 +126,20 @@ def _advance(
     gain_lut,
     leak_drift,
     n_leak,
+    first_pixel,
 ):
     """Low-pass and log per pixel, the leak's drift of base, and the number of threshold
     crossings (count > 0: ON, < 0: OFF). With a non-empty `leak_drift` (labels asked
     for): each pixel's unspent leak drift, advanced and spent as the module docstring
     says, and per active pixel the number of its ON crossings labelled leak (`n_leak`).
-    Updates filtered and base in place; lists the pixels with crossings in `active`, with
-    their count, x0 and x1 in the same slots (only those: less memory traffic than full
-    frames); returns how many. For 8-bit input the log and the gain come from tables
-    (`log_lut[I]`, `gain_lut[I0 + I1]`: every value they can take), else (empty tables)
-    they are computed per pixel, the gain reused while a run of pixels has the same two
-    inputs (shadows and sky are runs of zeros: half a low-Sun frame)."""
+    Updates filtered and base in place; lists the pixels with crossings in `active` (as
+    `first_pixel` + their index: the arrays can be a range of a frame's pixels, which
+    threads can run side by side), with their count, x0 and x1 in the same slots (only
+    those: less memory traffic than full frames); returns how many. For 8-bit input the
+    log and the gain come from tables (`log_lut[I]`, `gain_lut[I0 + I1]`: every value they
+    can take), else (empty tables) they are computed per pixel, the gain reused while a run
+    of pixels has the same two inputs (shadows and sky are runs of zeros: half a low-Sun
+    frame)."""
     knee_slope = np.log(KNEE_DN) / KNEE_DN
     two_pi_dt = 2.0 * np.pi * dt
     tables = log_lut.size > 0
@@ -183,7 +186,7 @@ def _advance(
             leak_drift[i] = d
         if c == 0:
             continue
-        active[n_active] = i
+        active[n_active] = first_pixel + i
         n_leak[n_active] = leak_only
         count[n_active] = c
         x0[n_active] = a
@@ -517,6 +520,19 @@ def _assemble(
 
 _LOG_LUT_8BIT = log_intensity_8bit(np.arange(256.0))
 _NO_TABLE = np.empty(0)
+# Pixels a thread takes at least: below that, handing a range to a thread costs more than
+# it saves (a 1024^2 frame's pass is ~10-20 ms on one core).
+PIXELS_PER_THREAD = 1 << 16
+
+
+def pixel_ranges(n_pixels: int, threads: int) -> list[tuple[int, int]]:
+    """(start, stop) of up to `threads` consecutive ranges covering n_pixels, each of at
+    least PIXELS_PER_THREAD (one range for a smaller frame), as equal as they can be."""
+    k = max(1, min(threads, n_pixels // PIXELS_PER_THREAD))
+    edges = [n_pixels * j // k for j in range(k + 1)]
+    return list(zip(edges[:-1], edges[1:]))
+
+
 _NO_LABELS = np.empty(0, np.uint8)
 _NO_EVENTS = (np.empty(0, np.int64), np.empty(0), np.empty(0, np.bool_))  # (pixel, t s, ON)
 
@@ -532,13 +548,18 @@ class EventEmulator:
         seed: int = 0,
         labels: bool = False,
         input_scale: float = 1.0,
+        threads: int = 1,
     ) -> None:
         """`labels`: also label each event with its cause (`process_with_labels`).
         `input_scale`: the frames times this are the model's DN (e.g. radiance times
         `sensor.dn_per_radiance`), applied per pixel in float64, so float32 frames need
-        no float64 copy; 8-bit frames with a scale of 1 use tables."""
+        no float64 copy; 8-bit frames with a scale of 1 use tables. `threads`: the per-pixel
+        pass split over up to this many threads (rows of at least PIXELS_PER_THREAD pixels
+        each); the same events however many."""
         if not (input_scale > 0 and np.isfinite(input_scale)):
             raise ValueError(f"EventEmulator: input_scale: expected a finite value > 0, got {input_scale}")
+        if not (isinstance(threads, int) and threads >= 1):
+            raise ValueError(f"EventEmulator: threads: expected an integer >= 1, got {threads!r}")
         self.width, self.height, self.params, self.seed, self.labels = width, height, params, seed, labels
         self.input_scale = float(input_scale)
         n = width * height
@@ -580,6 +601,8 @@ class EventEmulator:
         self._active = np.zeros(n, np.int64)
         self._n_leak = np.zeros(n, np.int64)
         self._leak_drift = _NO_TABLE  # unspent leak drift per pixel (labels only)
+        self._ranges = pixel_ranges(n, threads)
+        self._pool = None  # threads for all ranges but the first, made at the first frame
         self._t: float | None = None
         self._interval = 0  # index of the next frame interval (keys the random draws)
 
@@ -659,6 +682,39 @@ class EventEmulator:
         if self.labels:  # that offset is leak drift, pending from the start
             self._leak_drift = phase_drift.astype(np.float64)
 
+    def _advance_ranges(self, intensity0, intensity1, *scalars_and_tables) -> int:
+        """`_advance` over every pixel, a range per thread (the first in this one); the
+        active pixels of each range moved up behind the previous range's, so the slots
+        list them in pixel order as one pass would. Returns how many."""
+        per_pixel = (self._filtered, self._base, self.theta_on, self.theta_off, self._leak_step)
+        slots = (self._count, self._x0, self._x1, self._active)
+        cutoff_hz, dt, scale, log_lut, gain_lut = scalars_and_tables
+        labels = self._leak_drift.size > 0
+
+        def advance(start: int, stop: int) -> int:
+            r = slice(start, stop)
+            return _advance(
+                intensity0[r], intensity1[r], *(a[r] for a in per_pixel), cutoff_hz, dt, scale,
+                *(a[r] for a in slots), log_lut, gain_lut, self._leak_drift[r] if labels else self._leak_drift,
+                self._n_leak[r], start,
+            )  # fmt: skip
+
+        if len(self._ranges) == 1:
+            return advance(*self._ranges[0])
+        if self._pool is None:
+            from concurrent.futures import ThreadPoolExecutor
+
+            self._pool = ThreadPoolExecutor(len(self._ranges) - 1, thread_name_prefix="emulator")
+        later = [self._pool.submit(advance, start, stop) for start, stop in self._ranges[1:]]
+        n_active = advance(*self._ranges[0])
+        for (start, _), future in zip(self._ranges[1:], later):
+            n = future.result()
+            if start != n_active:
+                for a in (*slots, self._n_leak):
+                    a[n_active : n_active + n] = a[start : start + n]  # numpy copies overlaps safely
+            n_active += n
+        return n_active
+
     def _interval_events(self, intensity: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray | None]:
         p = self.params
         t0, dt = self._t, t1 - self._t
@@ -671,25 +727,8 @@ class EventEmulator:
             gain_lut = lowpass_gain(0.5 * np.arange(511.0), p.cutoff_hz, dt)  # by I0 + I1
         else:
             log_lut = gain_lut = _NO_TABLE
-        n_active = _advance(
-            self._intensity,
-            intensity,
-            self._filtered,
-            self._base,
-            self.theta_on,
-            self.theta_off,
-            self._leak_step,
-            float(p.cutoff_hz),
-            dt,
-            self.input_scale,
-            self._count,
-            self._x0,
-            self._x1,
-            self._active,
-            log_lut,
-            gain_lut,
-            self._leak_drift,
-            self._n_leak,
+        n_active = self._advance_ranges(
+            self._intensity, intensity, float(p.cutoff_hz), dt, self.input_scale, log_lut, gain_lut
         )
         n_events = int(np.abs(self._count[:n_active]).sum())
         pix = np.empty(n_events, np.int64)

@@ -13,6 +13,8 @@ rule events:
         "results/logs/{scenario}/{id}/events.log",
     conda:
         ENV
+    # One core per job: many jobs side by side use the cores better than threads within one.
+    threads: 1
     resources:
         mem_mb=resources_of("events", "mem_mb"),
         runtime=resources_of("events", "runtime"),
@@ -21,7 +23,6 @@ rule events:
         seed=event_seed,
         exports=export_flags,
         code=code("events"),
-    # One core per job (no threads: declared): a reader thread would take a neighbour's core.
     shell:
         "traj2events events {input.frames} --output {output.events} --seed {params.seed} {params.options} "
-        "--trajectory {input.trajectory} {params.exports} --no-read-ahead 2> {log}"
+        "--trajectory {input.trajectory} {params.exports} --threads {threads} 2> {log}"

@@ -51,6 +51,7 @@ class FrameSource:
     chunks: Generator[tuple[np.ndarray, np.ndarray], None, None]
     scene: dict = field(default_factory=dict)  # what frames.h5 says of the camera and the scene
     input_scale: float = 1.0  # the chunks' values times this are the emulator's DN
+    decoder_cpus: int = 0  # CPUs a child process takes decoding the input (ffmpeg's, for a video)
 
 
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
@@ -124,7 +125,7 @@ def video_source(path: Path, fps: float | None, chunk: int, ahead: bool = False)
             k += len(frames)
 
     chunks = read_ahead(video(), READ_AHEAD_BUFFERS) if ahead else video()
-    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", chunks)
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", chunks, decoder_cpus=1)
 
 
 def frame_source(
@@ -168,12 +169,20 @@ def emulate(
     input_name: str,
     progress_every: int = 640,
     labels: bool = False,
+    threads: int = 1,
 ) -> tuple[int, int, float]:
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
-    `input_name` are recorded in its attributes; with `labels`, each event's cause too).
-    Returns (frames, events, time of the last frame in s)."""
+    `input_name` are recorded in its attributes; with `labels`, each event's cause too;
+    `threads`: CPUs to use, the emulator's per-pixel pass split over those the source's
+    decoder leaves). Returns (frames, events, time of the last frame in s)."""
     emulator = EventEmulator(
-        source.width, source.height, params, seed=seed, labels=labels, input_scale=source.input_scale
+        source.width,
+        source.height,
+        params,
+        seed=seed,
+        labels=labels,
+        input_scale=source.input_scale,
+        threads=max(1, threads - source.decoder_cpus),
     )
     attrs = {
         "preset": preset,
