@@ -1,6 +1,6 @@
-"""Benchmark: event emulator speed, paper preset, one thread.
+"""Benchmark: event emulator speed, paper preset, one thread (or --threads N).
 
-  python bench/emulator.py [--frames 100]
+  python bench/emulator.py [--frames 100] [--threads 1]
 
 Input: an 8-bit texture (smoothed noise) translating at 2 px per frame at 100 fps, so
 edges everywhere produce events (~0.04 events per pixel per frame, about half of them
@@ -64,12 +64,12 @@ def load_kernels(frames: np.ndarray) -> None:
     EventEmulator(frames.shape[2], frames.shape[1], PRESETS["paper"], seed=0).process(frames[:2], [0.0, 0.01])
 
 
-def emulate_timed(frames: np.ndarray, labels: bool = False) -> tuple[list, float]:
+def emulate_timed(frames: np.ndarray, labels: bool = False, threads: int = 1) -> tuple[list, float]:
     """Paper preset at 100 fps, streamed in chunks of 10 frames: (event chunks, seconds);
-    with `labels`, each chunk is (events, labels)."""
+    with `labels`, each chunk is (events, labels); `threads`: the emulator's."""
     n_frames, height, width = frames.shape
     times = np.arange(n_frames) / 100.0
-    emu = EventEmulator(width, height, PRESETS["paper"], seed=1, labels=labels)
+    emu = EventEmulator(width, height, PRESETS["paper"], seed=1, labels=labels, threads=threads)
     process = emu.process_with_labels if labels else emu.process
     start = time.perf_counter()
     chunks = [process(frames[k : k + 10], times[k : k + 10]) for k in range(0, n_frames, 10)]
@@ -143,13 +143,14 @@ def main() -> None:
     parser.add_argument("--profile", action="store_true", help="time per kernel instead (1024 x 1024)")
     parser.add_argument("--labels", action="store_true", help="the cost of per-event labels instead")
     parser.add_argument("--repeats", type=int, default=4, help="A B pairs for --labels (default 4)")
+    parser.add_argument("--threads", type=int, default=1, help="the emulator's threads (default 1)")
     args = parser.parse_args()
     if args.profile:
         return profile(args.frames)
     if args.labels:
         return labels_cost(args.frames, args.repeats)
     print(
-        f"# emulator, paper preset, 1 thread, on {platform.node()} ({os.cpu_count()} cores), "
+        f"# emulator, paper preset, {args.threads} thread(s), on {platform.node()} ({os.cpu_count()} cores), "
         f"{time.strftime('%Y-%m-%d')}"
     )
     print("| size | input | frames | frames/s | events | events/s | events per pixel per frame | bytes/event on disk |")
@@ -165,7 +166,7 @@ def main() -> None:
         if flicker:
             frames = flickering(frames, period_frames=10, dim=0.15)
         load_kernels(frames)
-        chunks, elapsed = emulate_timed(frames)
+        chunks, elapsed = emulate_timed(frames, threads=args.threads)
         n_events = sum(len(c) for c in chunks)
         writer = EventsWriter(out / "events.h5", width, height, {})
         for c in chunks:
