@@ -34,14 +34,23 @@ def test_items_in_order_and_none_refilled_while_held(buffers):
     assert seen == list(range(20))
 
 
+def wait_for(log, n, timeout_s=10.0):
+    """Waits until the source has produced n items (a loaded machine may be slow), then a
+    little longer: time enough to produce one more if it were allowed to."""
+    deadline = time.monotonic() + timeout_s
+    while len(log) < n and time.monotonic() < deadline:
+        time.sleep(0.005)
+    time.sleep(0.05)
+
+
 def test_reads_at_most_buffers_minus_one_ahead():
     log = []
     chunks = read_ahead(ring_source(10, 3, log), 3)
     next(chunks)
-    time.sleep(0.05)  # time for the thread to run as far ahead as it may
+    wait_for(log, 3)
     assert log == [0, 1, 2]  # item 0 held, items 1 and 2 read into the ring's other arrays, no more
     next(chunks)
-    time.sleep(0.05)
+    wait_for(log, 4)
     assert log == [0, 1, 2, 3]
     chunks.close()
 
@@ -61,12 +70,13 @@ def test_the_source_s_error_comes_after_its_items():
 
 def test_stopping_early_stops_the_thread_and_closes_the_source():
     log = []
-    before = threading.active_count()
+    before = set(threading.enumerate())
     chunks = read_ahead(ring_source(1000, 2, log), 2)
     assert (next(chunks) == 0).all()
+    (reader,) = [t for t in threading.enumerate() if t not in before and t.name == "read_ahead"]
     chunks.close()
     assert log[-1] == "closed" and len(log) <= 4  # stopped within the ring, not at the source's end
-    assert threading.active_count() == before
+    assert not reader.is_alive()
 
 
 def test_fewer_than_two_buffers_is_refused():
