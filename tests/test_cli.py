@@ -191,18 +191,25 @@ def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):
     [({0}, [], 1), ({0, 1}, [], 2), ({0, 1}, ["--threads", "1"], 1), ({0}, ["--threads", "3"], 3)],
 )
 def test_events_threads_by_default_the_cpus_it_may_use(tmp_path, monkeypatch, cpus, option, threads):
+    from types import SimpleNamespace
+
     import traj2events.cli as cli
 
     asked = {}
 
     def frame_source(*args, ahead):
         asked["ahead"] = ahead
+        return SimpleNamespace(width=16, height=12, kind="a test source")
+
+    def emulate(source, *args, threads, **kwargs):
+        asked["threads"] = threads
         raise ValueError("stop here")
 
     monkeypatch.setattr(cli.os, "sched_getaffinity", lambda pid: cpus)
     monkeypatch.setattr("traj2events.stages.events.frame_source", frame_source)
+    monkeypatch.setattr("traj2events.stages.events.emulate", emulate)
     assert main(["events", str(tmp_path / "in.mkv"), "-o", str(tmp_path / "e.h5"), *option]) == 2
-    assert asked["ahead"] is (threads > 1)  # reading ahead from two threads on
+    assert asked == {"ahead": threads > 1, "threads": threads}  # reading ahead from two threads on
 
 
 @pytest.fixture()

@@ -143,3 +143,23 @@ def test_reading_ahead_gives_the_same_bytes(tmp_path):
         plain, _ = read_events(tmp_path / f"{name}.False.h5")
         ahead_events, _ = read_events(tmp_path / f"{name}.True.h5")
         assert len(plain) > 100 and plain.tobytes() == ahead_events.tobytes()
+
+
+def test_a_video_s_decoder_takes_one_of_the_threads(tmp_path, monkeypatch):
+    import traj2events.stages.events as stage
+
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in ramp_frames(n=3):
+            video.write(f)
+    made = []
+
+    class Recording(stage.EventEmulator):
+        def __init__(self, *args, threads, **kwargs):
+            made.append(threads)
+            super().__init__(*args, threads=threads, **kwargs)
+
+    monkeypatch.setattr(stage, "EventEmulator", Recording)
+    for threads in (1, 2, 3):
+        source = frame_source(tmp_path / "in.mkv", ahead=threads > 1)
+        emulate(source, emulator_params("clean"), 0, tmp_path / f"{threads}.h5", "clean", "in.mkv", threads=threads)
+    assert made == [1, 1, 2]
