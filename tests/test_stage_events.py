@@ -163,3 +163,13 @@ def test_a_video_s_decoder_takes_one_of_the_threads(tmp_path, monkeypatch):
         source = frame_source(tmp_path / "in.mkv", ahead=threads > 1)
         emulate(source, emulator_params("clean"), 0, tmp_path / f"{threads}.h5", "clean", "in.mkv", threads=threads)
     assert made == [1, 1, 2]
+
+
+def test_an_error_from_a_plain_iterator_source_is_the_one_raised(tmp_path):
+    from traj2events.stages.events import FrameSource
+
+    frames = np.full((3, 12, 16), np.nan, np.float32)  # refused by the emulator
+    source = FrameSource(16, 12, "test", iter([(frames, np.arange(3) / 50.0)]))  # no close(), unlike a generator
+    with pytest.raises(ValueError, match="NaN"):
+        emulate(source, emulator_params("clean"), 0, tmp_path / "e.h5", "clean", "test")
+    assert not (tmp_path / "e.h5").exists()

@@ -206,7 +206,9 @@ def emulate(
             if n_frames % progress_every < len(frames):
                 log(f"  {n_frames} frames, {n_events} events, {n_frames / (time.perf_counter() - start):.0f} frames/s")
     except BaseException as exc:
-        source.chunks.close()  # stops a reader thread now, not when the source is dropped
+        close = getattr(source.chunks, "close", None)  # a generator's: stops a reader thread now
+        if close is not None:
+            close()
         writer.close(0, (type(exc), exc, exc.__traceback__))
         raise
     writer.close(int(round(t_last * 1e6)))
