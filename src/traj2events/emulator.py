@@ -520,6 +520,9 @@ def _assemble(
 
 _LOG_LUT_8BIT = log_intensity_8bit(np.arange(256.0))
 _NO_TABLE = np.empty(0)
+_NO_LABELS = np.empty(0, np.uint8)
+_NO_EVENTS = (np.empty(0, np.int64), np.empty(0), np.empty(0, np.bool_))  # (pixel, t s, ON)
+
 # Pixels a thread takes at least: below that, handing a range to a thread costs more than
 # it saves (a 1024^2 frame's pass is ~10-20 ms on one core).
 PIXELS_PER_THREAD = 1 << 16
@@ -531,10 +534,6 @@ def pixel_ranges(n_pixels: int, threads: int) -> list[tuple[int, int]]:
     k = max(1, min(threads, n_pixels // PIXELS_PER_THREAD))
     edges = [n_pixels * j // k for j in range(k + 1)]
     return list(zip(edges[:-1], edges[1:]))
-
-
-_NO_LABELS = np.empty(0, np.uint8)
-_NO_EVENTS = (np.empty(0, np.int64), np.empty(0), np.empty(0, np.bool_))  # (pixel, t s, ON)
 
 
 class EventEmulator:
@@ -682,20 +681,18 @@ class EventEmulator:
         if self.labels:  # that offset is leak drift, pending from the start
             self._leak_drift = phase_drift.astype(np.float64)
 
-    def _advance_ranges(self, intensity0, intensity1, *scalars_and_tables) -> int:
+    def _advance_ranges(self, intensity0, intensity1, cutoff_hz, dt, log_lut, gain_lut) -> int:
         """`_advance` over every pixel, a range per thread (the first in this one); the
         active pixels of each range moved up behind the previous range's, so the slots
         list them in pixel order as one pass would. Returns how many."""
         per_pixel = (self._filtered, self._base, self.theta_on, self.theta_off, self._leak_step)
         slots = (self._count, self._x0, self._x1, self._active)
-        cutoff_hz, dt, scale, log_lut, gain_lut = scalars_and_tables
-        labels = self._leak_drift.size > 0
 
         def advance(start: int, stop: int) -> int:
             r = slice(start, stop)
             return _advance(
-                intensity0[r], intensity1[r], *(a[r] for a in per_pixel), cutoff_hz, dt, scale,
-                *(a[r] for a in slots), log_lut, gain_lut, self._leak_drift[r] if labels else self._leak_drift,
+                intensity0[r], intensity1[r], *(a[r] for a in per_pixel), cutoff_hz, dt, self.input_scale,
+                *(a[r] for a in slots), log_lut, gain_lut, self._leak_drift[r] if self.labels else self._leak_drift,
                 self._n_leak[r], start,
             )  # fmt: skip
 
@@ -727,9 +724,7 @@ class EventEmulator:
             gain_lut = lowpass_gain(0.5 * np.arange(511.0), p.cutoff_hz, dt)  # by I0 + I1
         else:
             log_lut = gain_lut = _NO_TABLE
-        n_active = self._advance_ranges(
-            self._intensity, intensity, float(p.cutoff_hz), dt, self.input_scale, log_lut, gain_lut
-        )
+        n_active = self._advance_ranges(self._intensity, intensity, float(p.cutoff_hz), dt, log_lut, gain_lut)
         n_events = int(np.abs(self._count[:n_active]).sum())
         pix = np.empty(n_events, np.int64)
         t = np.empty(n_events, np.float64)

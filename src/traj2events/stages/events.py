@@ -83,11 +83,11 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
 
 
 def frames_source(
-    path: Path, white: float | None, chunk: int, sensor: SensorParams | None = None, ahead: bool = False
+    path: Path, white: float | None, chunk: int, sensor: SensorParams | None = None, buffers: int = 1
 ) -> FrameSource:
     """frames.h5's radiance as photocurrent through `sensor`, or (no sensor) on the display
-    scale 255 L / white (`white` or the file's display white); with `ahead`, the next chunk
-    read by a thread meanwhile."""
+    scale 255 L / white (`white` or the file's display white), its chunks taking turns in a
+    ring of `buffers` arrays (`FramesFile.radiance_chunks`)."""
     frames = FramesFile(path)
     _, height, width = frames.shape
     scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
@@ -105,13 +105,12 @@ def frames_source(
 
     def radiance():  # float32 as stored: the emulator scales it per pixel (no float64 copy)
         with frames:
-            yield from frames.radiance_chunks(chunk, buffers=READ_AHEAD_BUFFERS if ahead else 1)
+            yield from frames.radiance_chunks(chunk, buffers)
 
-    chunks = read_ahead(radiance(), READ_AHEAD_BUFFERS) if ahead else radiance()
-    return FrameSource(width, height, kind, chunks, scene, scale)
+    return FrameSource(width, height, kind, radiance(), scene, scale)
 
 
-def video_source(path: Path, fps: float | None, chunk: int, ahead: bool = False) -> FrameSource:
+def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
     info = video_info(path)
     width, height, video_fps, _ = info
     fps = fps or video_fps
@@ -124,8 +123,7 @@ def video_source(path: Path, fps: float | None, chunk: int, ahead: bool = False)
             yield frames, (k + np.arange(len(frames))) / fps
             k += len(frames)
 
-    chunks = read_ahead(video(), READ_AHEAD_BUFFERS) if ahead else video()
-    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", chunks, decoder_cpus=1)
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), decoder_cpus=1)
 
 
 def frame_source(
@@ -147,8 +145,12 @@ def frame_source(
     if path.is_dir():
         return image_folder_source(path, fps, chunk)
     if path.suffix.lower() in (".h5", ".hdf5"):
-        return frames_source(path, white, chunk, sensor, ahead)
-    return video_source(path, fps, chunk, ahead)
+        source = frames_source(path, white, chunk, sensor, READ_AHEAD_BUFFERS if ahead else 1)
+    else:
+        source = video_source(path, fps, chunk)
+    if ahead:
+        source.chunks = read_ahead(source.chunks, READ_AHEAD_BUFFERS)
+    return source
 
 
 def emulator_params(preset: str, **overrides) -> EmulatorParams:
