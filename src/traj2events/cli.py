@@ -412,7 +412,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="CPUs to use: with 2 or more, the next chunk of frames.h5 or of the video is read in a thread "
         "while this one is emulated (one more chunk in memory), and each frame's pixels are split over "
         "that many threads (one fewer for a video, whose decoder takes a CPU; at least 65536 pixels each); "
-        "the events do not change (default: the CPUs this process may use)",
+        "the events do not change (default: the CPUs this process may use). A video's decoder, ffmpeg, "
+        "takes its own threads besides: up to one per CPU the process may use",
     )
     p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
     p.add_argument(
