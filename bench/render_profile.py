@@ -17,6 +17,15 @@ Also, where the extension exists (llvmpipe has it), OpenGL's pipeline statistics
 frame (vertices shaded, triangles in and out of clipping, fragment-shader invocations:
 llvmpipe counts the 16 lanes of every 4 x 4 block it shades), and the median frame with
 the rasteriser discarding everything: the vertex stage alone (shading, clipping).
+
+  taskset -c 1 python bench/render_profile.py --probes [--rounds 2] [--frames 20] [--size 1024]
+
+instead times the braking stretch (after 5 warm-up frames, --frames poses x 3 rounds,
+median ms per frame) with the committed shaders and with each probe of PROBES: the
+shaders with one part taken out (the law, the phase term, the texture read, every
+interpolated input), each run as its own process, all of them alternated --rounds times.
+The differences say what each part costs. A probe whose text the shaders no longer
+contain stops the run with its name.
 """
 
 from __future__ import annotations
@@ -26,6 +35,7 @@ import cProfile
 import os
 import pstats
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -34,7 +44,75 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
 
+from traj2events import render as render_module  # noqa: E402
 from traj2events.tiles import LodSettings  # noqa: E402
+
+# Probes of the textured shaders: (file, committed text, replacement) edits, each taking
+# one part out; together they split a frame's time (docs/benchmarks.md, session 22).
+_LAW = "    float rf = reflectance_factor_of_phase(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
+_BODY = _LAW.join(
+    [
+        "    vec4 texel = texture(shading, vec3(frag_uv, frag_layer));\n",
+        "\n    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);",
+    ]
+)
+_FRAG = "terrain_textured.frag"
+PROBES = {
+    "no law": [(_FRAG, _LAW, "    float rf = texel.x + frag_phase;")],
+    "no law, no phase term": [(_FRAG, _LAW, "    float rf = texel.x;")],
+    "no texture": [(_FRAG, _BODY, "    float radiance = frag_phase + frag_uv.x * frag_uv.y + frag_layer;")],
+    "constant radiance": [(_FRAG, _BODY, "    float radiance = 1.0;")],
+}
+
+
+def probed_shader_source(edits: list[tuple[str, str, str]]):
+    """render.shader_source with `edits` applied; an edit whose text is gone is an error."""
+    committed = render_module.shader_source
+
+    def source(name: str) -> str:
+        text = committed(name)
+        for file, old, new in edits:
+            if file == name:
+                if old not in text:
+                    raise ValueError(f"probe: shaders/{file} no longer contains {old.strip()[:60]!r}")
+                text = text.replace(old, new)
+        return text
+
+    return source
+
+
+def probe_ms(probe: str | None, size: int, frames: int) -> float:
+    """Median ms per frame over the braking stretch, with `probe`'s shaders (None: committed)."""
+    if probe is not None:
+        render_module.shader_source = probed_shader_source(PROBES[probe])
+    state, sun, extent = CASES["braking, 2 km, pitch 55 deg"]
+    budget, levels = LodSettings.pixels_per_cell, LodSettings.shading_levels
+    with stretch_renderer(state, sun, extent, size, frames, budget, "osmesa", None, levels) as (r, path, _):
+        for pose in path[:5]:
+            r.render(pose)
+        times = []
+        for _ in range(3):
+            for pose in path:
+                start = time.perf_counter()
+                r.render(pose)
+                times.append(time.perf_counter() - start)
+    return 1e3 * statistics.median(times)
+
+
+def run_probes(size: int, frames: int, rounds: int) -> None:
+    """Every probe and the committed shaders, each in its own process, alternated."""
+    names = ["committed", *PROBES]
+    ms = {name: [] for name in names}
+    for _ in range(rounds):
+        for name in names:
+            command = [sys.executable, __file__, "--probe", name, "--size", str(size), "--frames", str(frames)]
+            done = subprocess.run(command, capture_output=True, text=True, env={**os.environ, "LP_NUM_THREADS": "1"})
+            if done.returncode:
+                raise RuntimeError(f"probe {name!r} failed:\n{done.stderr[-2000:]}")
+            ms[name].append(float(done.stdout.split()[-1]))
+    print(f"braking stretch, {size}^2, {frames} poses x 3 rounds, median ms per frame ({rounds} alternations):")
+    for name in names:
+        print(f"  {name:24s} " + " / ".join(f"{v:.1f}" for v in ms[name]))
 
 
 def timed(log: list[float], function):
@@ -103,8 +181,17 @@ def main() -> None:
     parser.add_argument(
         "--shading-levels", type=int, default=LodSettings.shading_levels, help="render.lod.shading_levels"
     )
+    parser.add_argument("--probes", action="store_true", help="time the shader probes instead (OSMesa)")
+    parser.add_argument("--rounds", type=int, default=2, help="with --probes: alternations")
+    parser.add_argument("--probe", choices=["committed", *PROBES], help=argparse.SUPPRESS)  # one probe's process
     args = parser.parse_args()
     os.environ.setdefault("LP_NUM_THREADS", "1")
+    if args.probe:
+        print(f"{probe_ms(None if args.probe == 'committed' else args.probe, args.size, args.frames):.3f}")
+        return
+    if args.probes:
+        run_probes(args.size, args.frames, args.rounds)
+        return
     budget, levels = args.pixels_per_cell, args.shading_levels
     for name, (state, sun, extent) in CASES.items():
         stretch = stretch_renderer(state, sun, extent, args.size, args.frames, budget, args.backend, None, levels)
