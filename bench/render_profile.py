@@ -47,73 +47,6 @@ from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
 from traj2events import render as render_module  # noqa: E402
 from traj2events.tiles import LodSettings  # noqa: E402
 
-# Probes of the textured shaders: (file, committed text, replacement) edits, each taking
-# one part out; together they split a frame's time (docs/benchmarks.md, session 22).
-_LAW = "    float rf = reflectance_factor_of_phase(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
-_BODY = _LAW.join(
-    [
-        "    vec4 texel = texture(shading, vec3(frag_uv, frag_layer));\n",
-        "\n    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);",
-    ]
-)
-_FRAG = "terrain_textured.frag"
-PROBES = {
-    "no law": [(_FRAG, _LAW, "    float rf = texel.x + frag_phase;")],
-    "no law, no phase term": [(_FRAG, _LAW, "    float rf = texel.x;")],
-    "no texture": [(_FRAG, _BODY, "    float radiance = frag_phase + frag_uv.x * frag_uv.y + frag_layer;")],
-    "constant radiance": [(_FRAG, _BODY, "    float radiance = 1.0;")],
-}
-
-
-def probed_shader_source(edits: list[tuple[str, str, str]]):
-    """render.shader_source with `edits` applied; an edit whose text is gone is an error."""
-    committed = render_module.shader_source
-
-    def source(name: str) -> str:
-        text = committed(name)
-        for file, old, new in edits:
-            if file == name:
-                if old not in text:
-                    raise ValueError(f"probe: shaders/{file} no longer contains {old.strip()[:60]!r}")
-                text = text.replace(old, new)
-        return text
-
-    return source
-
-
-def probe_ms(probe: str | None, size: int, frames: int) -> float:
-    """Median ms per frame over the braking stretch, with `probe`'s shaders (None: committed)."""
-    if probe is not None:
-        render_module.shader_source = probed_shader_source(PROBES[probe])
-    state, sun, extent = CASES["braking, 2 km, pitch 55 deg"]
-    budget, levels = LodSettings.pixels_per_cell, LodSettings.shading_levels
-    with stretch_renderer(state, sun, extent, size, frames, budget, "osmesa", None, levels) as (r, path, _):
-        for pose in path[:5]:
-            r.render(pose)
-        times = []
-        for _ in range(3):
-            for pose in path:
-                start = time.perf_counter()
-                r.render(pose)
-                times.append(time.perf_counter() - start)
-    return 1e3 * statistics.median(times)
-
-
-def run_probes(size: int, frames: int, rounds: int) -> None:
-    """Every probe and the committed shaders, each in its own process, alternated."""
-    names = ["committed", *PROBES]
-    ms = {name: [] for name in names}
-    for _ in range(rounds):
-        for name in names:
-            command = [sys.executable, __file__, "--probe", name, "--size", str(size), "--frames", str(frames)]
-            done = subprocess.run(command, capture_output=True, text=True, env={**os.environ, "LP_NUM_THREADS": "1"})
-            if done.returncode:
-                raise RuntimeError(f"probe {name!r} failed:\n{done.stderr[-2000:]}")
-            ms[name].append(float(done.stdout.split()[-1]))
-    print(f"braking stretch, {size}^2, {frames} poses x 3 rounds, median ms per frame ({rounds} alternations):")
-    for name in names:
-        print(f"  {name:24s} " + " / ".join(f"{v:.1f}" for v in ms[name]))
-
 
 def timed(log: list[float], function):
     """`function`, appending each call's seconds to `log`."""
@@ -125,6 +58,73 @@ def timed(log: list[float], function):
         return out
 
     return wrapper
+
+
+# Probes of the textured fragment shader: (committed text, replacement), each taking one
+# part out; together they split a frame's time (docs/benchmarks.md, session 22).
+_LAW = "    float rf = reflectance_factor_of_phase(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
+_BODY = _LAW.join(
+    [
+        "    vec4 texel = texture(shading, vec3(frag_uv, frag_layer));\n",
+        "\n    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);",
+    ]
+)
+PROBED_SHADER = "terrain_textured.frag"
+PROBES = {
+    "no law": (_LAW, "    float rf = texel.x + frag_phase;"),
+    "no law, no phase term": (_LAW, "    float rf = texel.x;"),
+    "no texture": (_BODY, "    float radiance = frag_phase + frag_uv.x * frag_uv.y + frag_layer;"),
+    "constant radiance": (_BODY, "    float radiance = 1.0;"),
+}
+
+
+def probed_shader_source(old: str, new: str):
+    """render.shader_source with `old` replaced by `new` in PROBED_SHADER; an error if the
+    shader no longer contains `old`."""
+    committed = render_module.shader_source
+
+    def source(name: str) -> str:
+        text = committed(name)
+        if name != PROBED_SHADER:
+            return text
+        if old not in text:
+            raise ValueError(f"probe: shaders/{name} no longer contains {old.strip()[:60]!r}")
+        return text.replace(old, new)
+
+    return source
+
+
+def probe_ms(probe: str, size: int, frames: int) -> float:
+    """Median ms per frame over the braking stretch with `probe`'s shaders ("committed": as they are)."""
+    if probe != "committed":
+        render_module.shader_source = probed_shader_source(*PROBES[probe])
+    state, sun, extent = CASES["braking, 2 km, pitch 55 deg"]
+    budget, levels = LodSettings.pixels_per_cell, LodSettings.shading_levels
+    with stretch_renderer(state, sun, extent, size, frames, budget, "osmesa", None, levels) as (r, path, _):
+        for pose in path[:5]:
+            r.render(pose)
+        times = []
+        render = timed(times, r.render)
+        for _ in range(3):
+            for pose in path:
+                render(pose)
+    return 1e3 * statistics.median(times)
+
+
+def run_probes(size: int, frames: int, rounds: int) -> None:
+    """Every probe and the committed shaders, each in its own process, alternated."""
+    names = ["committed", *PROBES]
+    ms = {name: [] for name in names}
+    for _ in range(rounds):
+        for name in names:
+            command = [sys.executable, __file__, "--probe", name, "--size", str(size), "--frames", str(frames)]
+            done = subprocess.run(command, capture_output=True, text=True)
+            if done.returncode:
+                raise RuntimeError(f"probe {name!r} failed:\n{done.stderr[-2000:]}")
+            ms[name].append(float(done.stdout.split()[-1]))
+    print(f"braking stretch, {size}^2, {frames} poses x 3 rounds, median ms per frame ({rounds} alternations):")
+    for name in names:
+        print(f"  {name:24s} " + " / ".join(f"{v:.1f}" for v in ms[name]))
 
 
 STATISTICS = (
@@ -187,7 +187,7 @@ def main() -> None:
     args = parser.parse_args()
     os.environ.setdefault("LP_NUM_THREADS", "1")
     if args.probe:
-        print(f"{probe_ms(None if args.probe == 'committed' else args.probe, args.size, args.frames):.3f}")
+        print(f"{probe_ms(args.probe, args.size, args.frames):.3f}")
         return
     if args.probes:
         run_probes(args.size, args.frames, args.rounds)
