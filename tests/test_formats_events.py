@@ -39,7 +39,7 @@ def test_dsec_layout_and_ms_to_idx_invariant(tmp_path):
     write(tmp_path / "a.h5", events, chunks=7)
     with h5py.File(tmp_path / "a.h5") as f:
         assert set(f["events"]) == {"x", "y", "t", "p"} and f["t_offset"][()] == 0
-        assert f["events/x"].dtype == np.uint16 and f["events/t"].dtype == np.int64 and f["events/p"].dtype == np.uint8
+        assert f["events/x"].dtype == np.uint16 and f["events/t"].dtype == np.uint32 and f["events/p"].dtype == np.uint8
         t = f["events/t"][()]
         idx = f["ms_to_idx"][()]
         assert f.attrs["width"] == 40 and f.attrs["preset"] == "paper" and f.attrs["seed"] == 3
@@ -48,6 +48,25 @@ def test_dsec_layout_and_ms_to_idx_invariant(tmp_path):
     for m in range(0, len(idx), 7):
         i = idx[m]
         assert (i == len(t) or t[i] >= 1000 * m) and (i == 0 or t[i - 1] < 1000 * m)
+
+
+def test_times_are_dsec_uint32_after_t_offset_and_read_back_as_int64(tmp_path):
+    # DSEC's type: events up to 2^32 - 1 us after t_offset; read back exactly, with an offset
+    # far beyond uint32 (the reader widens before it adds).
+    events = random_events(n=3)
+    offset = 10**13
+    events["t"] = offset + np.array([0, 2**31, 2**32 - 1])
+    writer = EventsWriter(tmp_path / "far.h5", 40, 30, {}, t_offset_us=offset)
+    writer.append(events)
+    writer.close(int(events["t"][-1]) + 1)
+    back, _ = read_events(tmp_path / "far.h5")
+    assert back.tobytes() == events.tobytes()
+    assert read_events_window(tmp_path / "far.h5", offset + 2**31, offset + 2**32).tobytes() == events[1:].tobytes()
+    late = random_events(n=1)
+    late["t"] = 2**32
+    writer = EventsWriter(tmp_path / "late.h5", 40, 30, {})
+    with pytest.raises(ValueError, match=r"events/t holds 0\.\.4294967295 us after t_offset"):
+        writer.append(late)
 
 
 def test_chunking_does_not_change_the_file(tmp_path):

@@ -16,10 +16,13 @@ EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")]) 
 EVENT_LABELS = ("signal", "shot_noise", "leak", "hot_pixel")
 SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL = range(len(EVENT_LABELS))
 
+MAX_T_US = np.iinfo(np.uint32).max  # events/t's range after t_offset (~71.6 min)
+
 
 class EventsWriter:
     """events.h5 in the DSEC layout, appended chunk by chunk (events sorted by t):
-    `events/x`, `events/y` (uint16), `events/t` (int64, us, relative to `t_offset`),
+    `events/x`, `events/y` (uint16), `events/t` (uint32, us, relative to `t_offset`: DSEC's
+    type, so up to ~71.6 min after it),
     `events/p` (uint8, 1 = ON), `ms_to_idx` (uint64: index of the first event at or after
     each millisecond), `t_offset` (int64, us); with `labels`, also `events/label` (uint8,
     the index in EVENT_LABELS, attribute `label_names`). Event arrays are compressed with
@@ -43,7 +46,7 @@ class EventsWriter:
         group = self._file.create_group("events")
         self._sets = {
             name: group.create_dataset(name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), **compression)
-            for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")) + (("label", "u1"),) * labels
+            for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<u4"), ("p", "u1")) + (("label", "u1"),) * labels
         }
         if labels:
             set_attrs(self._sets["label"], {"label_names": ",".join(EVENT_LABELS)})
@@ -67,13 +70,19 @@ class EventsWriter:
         t = np.subtract(events["t"], self.t_offset_us, dtype=np.int64)  # one pass, contiguous
         if t[0] < self._last_t or (t[1:] < t[:-1]).any():  # no int64 temporary, as np.diff makes
             raise ValueError("events.h5: events must arrive sorted by t")
+        if t[0] < 0 or t[-1] > MAX_T_US:
+            raise ValueError(
+                f"events.h5: events/t holds 0..{MAX_T_US} us after t_offset ({self.t_offset_us} us; uint32, as DSEC), "
+                f"got events from {int(t[0])} to {int(t[-1])} us after it"
+            )
         # ms_to_idx[m] = first index with t >= 1000 m, for every m up to this chunk's last event.
         last_ms = int(t[-1] // 1000)
         if last_ms >= self._next_ms:
             ms = np.arange(self._next_ms, last_ms + 1, dtype=np.int64)
             self._ms_to_idx.append(self.n + np.searchsorted(t, ms * 1000, side="left"))
             self._next_ms = last_ms + 1
-        self._take({"x": events["x"], "y": events["y"], "t": t, "p": events["p"], "label": labels})
+        # uint32 (DSEC's type): half the bytes of int64 to shuffle and compress (2x faster to write).
+        self._take({"x": events["x"], "y": events["y"], "t": t.astype(np.uint32), "p": events["p"], "label": labels})
         self._last_t = int(t[-1])
 
     def _take(self, columns: dict) -> None:
@@ -123,7 +132,8 @@ def read_events(path: str | os.PathLike) -> tuple[np.ndarray, dict]:
         g = f["events"]
         out = np.empty(len(g["t"]), EVENT_DTYPE)
         out["x"], out["y"], out["p"] = g["x"][()], g["y"][()], g["p"][()]
-        out["t"] = g["t"][()] + int(f["t_offset"][()])
+        out["t"] = g["t"][()]  # uint32 widened to int64 by the assignment, then offset
+        out["t"] += int(f["t_offset"][()])
         return out, Attributes(path, f.attrs)
 
 
@@ -157,7 +167,8 @@ def _read_window(path, t_start_us: int, t_end_us: int, labels: bool) -> tuple[np
         g = f["events"]
         out = np.empty(hi - lo, EVENT_DTYPE)
         out["x"], out["y"], out["p"] = g["x"][lo:hi], g["y"][lo:hi], g["p"][lo:hi]
-        out["t"] = g["t"][lo:hi] + offset
+        out["t"] = g["t"][lo:hi]
+        out["t"] += offset
         label = g["label"][lo:hi] if labels else None
     inside = (out["t"] >= t_start_us) & (out["t"] < t_end_us)
     return out[inside], (label[inside] if labels else None)
