@@ -346,7 +346,7 @@ def build_parser() -> argparse.ArgumentParser:
         "sorted by name; needs --fps). Writes events.h5 in the DSEC layout.",
     )
     p.add_argument("input", help="frames.h5, a video file, or a folder of images")
-    p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc/zstd)")
+    p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc)")
     p.add_argument(
         "--preset",
         choices=("paper", "clean"),
