@@ -725,11 +725,18 @@ class EventEmulator:
         else:
             log_lut = gain_lut = _NO_TABLE
         n_active = self._advance_ranges(self._intensity, intensity, float(p.cutoff_hz), dt, log_lut, gain_lut)
-        n_events = int(np.abs(self._count[:n_active]).sum())
-        pix = np.empty(n_events, np.int64)
-        t = np.empty(n_events, np.float64)
-        on = np.empty(n_events, np.bool_)
-        label = np.empty(n_events, np.uint8)
+        n_signal = int(np.abs(self._count[:n_active]).sum())
+        self._interval += 1
+        # Noise and hot-pixel events are drawn first (the draws depend on the input alone), so
+        # that the signal's events go straight into arrays with room for them: no copy of the
+        # signal's (most of the events) to join them.
+        noise = self._shot_noise(intensity, t0, dt)
+        hot = self._hot_pixel_events(t0, dt)
+        n_room = n_signal + len(noise[0]) + len(hot[0])
+        pix = np.empty(n_room, np.int64)
+        t = np.empty(n_room, np.float64)
+        on = np.empty(n_room, np.bool_)
+        label = np.empty(n_room, np.uint8)
         k = _emit(
             self._active,
             n_active,
@@ -750,21 +757,17 @@ class EventEmulator:
             on,
             label,
         )
-        signal = (pix[:k], t[:k], on[:k])
+        noise = self._noise_after_signal(*noise)
         self._intensity, self._t = intensity, t1
-        self._interval += 1
-        parts = [signal, self._shot_noise(intensity, t0, dt), self._hot_pixel_events(t0, dt)]
-        labels = None
-        if self.labels:
-            labels = np.concatenate(
-                [
-                    label[:k],
-                    np.full(len(parts[1][0]), SHOT_NOISE, np.uint8),
-                    np.full(len(parts[2][0]), HOT_PIXEL, np.uint8),
-                ]
-            )
-        merged = (np.concatenate([q[j] for q in parts]) for j in range(3))
-        return _assemble(*merged, labels, self.width, self.width * self.height)
+        end = k
+        for part, cause in ((noise, SHOT_NOISE), (hot, HOT_PIXEL)):
+            n = len(part[0])
+            pix[end : end + n], t[end : end + n], on[end : end + n] = part
+            label[end : end + n] = cause
+            end += n
+        return _assemble(
+            pix[:end], t[:end], on[:end], label[:end] if self.labels else None, self.width, self.width * self.height
+        )
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
         """Mask of the events to emit: with T_ref > 0, an event closer than T_ref to its
@@ -790,8 +793,12 @@ class EventEmulator:
         t = np.empty(n, np.float64)
         on = np.empty(n, np.bool_)
         k = _noise_candidates(n, state, self._alias, intensity, self.input_scale, self._g_max, t0, dt, pix, t, on)
-        pix, t, on = pix[:k], t[:k], on[:k]
-        if p.refractory_s > 0:
+        return pix[:k], t[:k], on[:k]
+
+    def _noise_after_signal(self, pix: np.ndarray, t: np.ndarray, on: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The interval's shot noise once its signal events are emitted: the refractory
+        period against those, and each noise event's reset of its pixel."""
+        if self.params.refractory_s > 0:
             order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
             pix, t, on = pix[order], t[order], on[order]
             keep = self._refractory(pix, t)
