@@ -77,6 +77,23 @@ def test_same_seed_same_bytes_and_clear_errors(tmp_path):
     assert not (tmp_path / "x.h5").exists()
 
 
+def test_an_input_longer_than_events_h5_can_time_is_refused_before_emulating(tmp_path):
+    # events/t is uint32 us (DSEC's type): ~71.6 min. Frames to t = 5000 s: refused, nothing written.
+    with h5py.File(tmp_path / "long.h5", "w") as f:
+        f["t"] = np.array([0.0, 4294.0, 5000.0])
+        f["radiance"] = np.ones((3, 4, 4), np.float32)
+        f.attrs["display_white_w_m2_sr"] = 40.0
+    with pytest.raises(ValueError, match=r"long.h5 runs to t = 5000.0 s; events.h5 times events up to 4295.0 s"):
+        emulate_file(tmp_path / "long.h5", tmp_path / "e.h5")
+    assert not list(tmp_path.glob("e.h5*"))
+    folder = tmp_path / "images"
+    folder.mkdir()
+    for k in range(3):
+        Image.fromarray(np.full((4, 4), 100, np.uint8)).save(folder / f"{k}.png")
+    with pytest.raises(ValueError, match="runs to t = 5000.0 s"):
+        emulate_file(folder, tmp_path / "e.h5", fps=2 / 5000)
+
+
 def test_labels_through_the_command_same_events_and_reproducible(tmp_path):
     from traj2events.cli import main
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import __version__
 from ..emulator import PRESETS, EmulatorParams, EventEmulator
-from ..formats.events import EventsWriter, read_events
+from ..formats.events import MAX_T_US, EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
@@ -61,6 +61,16 @@ SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_c
                "moon_radius_m", "scenario", "id")  # fmt: skip
 
 
+def check_recording_length(path: Path, last_time_s: float | None) -> None:
+    """An input that runs past what events.h5 can time (events/t: uint32 us, DSEC's type)
+    is refused before any event is emulated."""
+    if last_time_s is not None and last_time_s * 1e6 > MAX_T_US:
+        raise ValueError(
+            f"events INPUT: {path} runs to t = {last_time_s:.1f} s; events.h5 times events up to "
+            f"{MAX_T_US / 1e6:.1f} s (events/t: uint32 us, as DSEC's)"
+        )
+
+
 def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
     from PIL import Image
 
@@ -71,6 +81,7 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
         raise ValueError("events: --fps is required for a folder of images")
     width, height = Image.open(files[0]).size
     times = np.arange(len(files)) / fps
+    check_recording_length(path, float(times[-1]))
 
     def images():
         for start in range(0, len(files), chunk):
@@ -90,6 +101,11 @@ def frames_source(
     ring of `buffers` arrays (`FramesFile.radiance_chunks`)."""
     frames = FramesFile(path)
     _, height, width = frames.shape
+    try:
+        check_recording_length(path, float(frames.t[-1]) if len(frames.t) else None)
+    except ValueError:
+        frames.close()
+        raise
     scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
     if sensor is not None:
         scale = dn_per_radiance(sensor)
@@ -112,10 +128,11 @@ def frames_source(
 
 def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
     info = video_info(path)
-    width, height, video_fps, _ = info
+    width, height, video_fps, count = info
     fps = fps or video_fps
     if not fps > 0:
         raise ValueError(f"events: {path} gives no frame rate; give --fps")
+    check_recording_length(path, (count - 1) / fps if count else None)
 
     def video():
         k = 0
