@@ -243,6 +243,13 @@ def test_stream_invariants_and_chunking_does_not_change_a_byte():
     assert len(intervals) == 39 and np.concatenate(intervals).tobytes() == whole.tobytes()
     for k, events in enumerate(intervals):
         assert ((events["t"] >= round(times[k] * 1e6)) & (events["t"] <= round(times[k + 1] * 1e6))).all()
+    # As columns: the same values, each a contiguous array of the structured field's type.
+    emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
+    columns = [c for c, _ in emu.intervals(frames, times, columns=True)]
+    for name in ("x", "y", "t", "p"):
+        joined = np.concatenate([c[name] for c in columns])
+        assert joined.dtype == whole.dtype[name] and joined.tobytes() == whole[name].tobytes()
+        assert all(c[name].flags.c_contiguous for c in columns)
 
 
 def test_bad_input_is_named():

@@ -78,6 +78,12 @@ def test_chunking_does_not_change_the_file(tmp_path):
     write(tmp_path / "uneven.h5", events, chunks=[1, 1023, 1024, 1500, 1452])
     assert (tmp_path / "one.h5").read_bytes() == (tmp_path / "many.h5").read_bytes()
     assert (tmp_path / "one.h5").read_bytes() == (tmp_path / "uneven.h5").read_bytes()
+    # The same events given as dicts of columns: the same file.
+    writer = EventsWriter(tmp_path / "columns.h5", 40, 30, {"preset": "paper", "seed": 3}, chunk=1024)
+    for part in np.array_split(events, 5):
+        writer.append({name: np.ascontiguousarray(part[name]) for name in ("x", "y", "t", "p")})
+    writer.close(2_600_000)
+    assert (tmp_path / "one.h5").read_bytes() == (tmp_path / "columns.h5").read_bytes()
     back, attrs = read_events(tmp_path / "one.h5")
     assert back.tobytes() == events.tobytes()
     window = read_events_window(tmp_path / "one.h5", 1_000_500, 1_010_500)

@@ -505,14 +505,24 @@ def _decode_keys(key, width, n_pixels, out_x, out_y, out_t, out_p, out_label):
 
 
 def _assemble(
-    pix: np.ndarray, t_s: np.ndarray, on: np.ndarray, label: np.ndarray | None, width: int, n_pixels: int
-) -> tuple[np.ndarray, np.ndarray | None]:
-    """Events (structured) in (t, y, x, p) order, and their labels if given: one key per
-    event, sorted (`_sorted_keys`; equal keys are identical events, so the order among them
-    does not matter; the label is the key's lowest digit, so the order of the events is the
-    same either way)."""
+    pix: np.ndarray,
+    t_s: np.ndarray,
+    on: np.ndarray,
+    label: np.ndarray | None,
+    width: int,
+    n_pixels: int,
+    columns: bool = False,
+) -> tuple[np.ndarray | dict[str, np.ndarray], np.ndarray | None]:
+    """Events in (t, y, x, p) order, and their labels if given: one key per event, sorted
+    (`_sorted_keys`; equal keys are identical events, so the order among them does not
+    matter; the label is the key's lowest digit, so the order of the events is the same
+    either way). The events structured, or with `columns` as a dict of contiguous x, y, t,
+    p arrays (what a column store such as events.h5 writes without splitting records)."""
     key = _sorted_keys(pix, t_s, on, _NO_LABELS if label is None else label, n_pixels)
-    out = np.empty(key.size, EVENT_DTYPE)
+    if columns:
+        out = {name: np.empty(key.size, EVENT_DTYPE[name]) for name in EVENT_DTYPE.names}
+    else:
+        out = np.empty(key.size, EVENT_DTYPE)
     out_label = _NO_LABELS if label is None else np.empty(key.size, np.uint8)
     _decode_keys(key, width, n_pixels, out["x"], out["y"], out["t"], out["p"], out_label)  # field views: no copies
     return out, (None if label is None else out_label)
@@ -618,10 +628,14 @@ class EventEmulator:
             raise ValueError("EventEmulator: labels need labels=True when the emulator is made")
         return self._joined(self.intervals(frames_dn, times_s))
 
-    def intervals(self, frames_dn: np.ndarray, times_s: np.ndarray) -> Iterator[tuple[np.ndarray, np.ndarray | None]]:
+    def intervals(
+        self, frames_dn: np.ndarray, times_s: np.ndarray, columns: bool = False
+    ) -> Iterator[tuple[np.ndarray | dict[str, np.ndarray], np.ndarray | None]]:
         """As `process` (with labels: `process_with_labels`), one frame interval's events
         (and labels, else None) at a time: the same events, with memory for one interval's
-        events instead of the chunk's (a writer can take each as it comes)."""
+        events instead of the chunk's (a writer can take each as it comes). `columns`: each
+        interval's events as a dict of contiguous x, y, t, p arrays instead of a structured
+        array (the same values; EventsWriter takes either, columns ~3 ns per event faster)."""
         frames = np.asarray(frames_dn)
         times = np.asarray(times_s, dtype=np.float64)
         if frames.ndim != 3 or frames.shape[1:] != (self.height, self.width) or len(times) != len(frames):
@@ -654,7 +668,7 @@ class EventEmulator:
                 continue
             if not t > self._t:
                 raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
-            yield self._interval_events(intensity, float(t))
+            yield self._interval_events(intensity, float(t), columns)
         if self._intensity is not None and self._intensity.base is not None:
             self._intensity = self._intensity.copy()  # kept for the next call: not a view of this chunk
 
@@ -712,7 +726,9 @@ class EventEmulator:
             n_active += n
         return n_active
 
-    def _interval_events(self, intensity: np.ndarray, t1: float) -> tuple[np.ndarray, np.ndarray | None]:
+    def _interval_events(
+        self, intensity: np.ndarray, t1: float, columns: bool = False
+    ) -> tuple[np.ndarray | dict[str, np.ndarray], np.ndarray | None]:
         p = self.params
         t0, dt = self._t, t1 - self._t
         # x = signal - base, linear in t within the interval: low-pass (exact, bandwidth from
@@ -765,8 +781,9 @@ class EventEmulator:
             pix[end : end + n], t[end : end + n], on[end : end + n] = part
             label[end : end + n] = cause
             end += n
+        n_pixels = self.width * self.height
         return _assemble(
-            pix[:end], t[:end], on[:end], label[:end] if self.labels else None, self.width, self.width * self.height
+            pix[:end], t[:end], on[:end], label[:end] if self.labels else None, self.width, n_pixels, columns
         )
 
     def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -73,13 +73,16 @@ class EventsWriter:
         self._next_ms = 0
         self._last_t = np.iinfo(np.int64).min
 
-    def append(self, events: np.ndarray, labels: np.ndarray | None = None) -> None:
-        """Events sorted by t (after the ones before), with their labels if the file has them."""
+    def append(self, events: np.ndarray | dict[str, np.ndarray], labels: np.ndarray | None = None) -> None:
+        """Events sorted by t (after the ones before), with their labels if the file has them:
+        a structured array (EVENT_DTYPE) or a dict of its x, y, t, p columns (contiguous
+        columns are written without a copy to split the records)."""
         if ("label" in self._sets) != (labels is not None):
             raise ValueError("events.h5: labels must be given exactly when the writer was made with labels=True")
-        if not len(events):
+        n = len(events["t"])
+        if not n:
             return
-        ensure_free_space(self._path, len(events) * events.dtype.itemsize)
+        ensure_free_space(self._path, n * EVENT_DTYPE.itemsize)
         t = np.subtract(events["t"], self.t_offset_us, dtype=np.int64)  # one pass, contiguous
         if t[0] < self._last_t or (t[1:] < t[:-1]).any():  # no int64 temporary, as np.diff makes
             raise ValueError("events.h5: events must arrive sorted by t")

@@ -217,9 +217,10 @@ def emulate(
     writer = EventsWriter(output, source.width, source.height, attrs, labels=labels)
     try:
         for frames, times in source.chunks:
-            for events, event_labels in emulator.intervals(frames, times):  # memory: one interval's events
+            # Memory: one interval's events; as columns, which events.h5 stores.
+            for events, event_labels in emulator.intervals(frames, times, columns=True):
                 writer.append(events, event_labels)
-                n_events += len(events)
+                n_events += len(events["t"])
             n_frames += len(frames)
             t_last = float(times[-1])
             if n_frames % progress_every < len(frames):
