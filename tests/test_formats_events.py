@@ -65,8 +65,10 @@ def test_times_are_dsec_uint32_after_t_offset_and_read_back_as_int64(tmp_path):
     late = random_events(n=1)
     late["t"] = 2**32
     writer = EventsWriter(tmp_path / "late.h5", 40, 30, {})
-    with pytest.raises(ValueError, match=r"events/t holds 0\.\.4294967295 us after t_offset"):
+    with pytest.raises(ValueError, match=r"events/t holds 0\.\.4294967295 us after t_offset") as error:
         writer.append(late)
+    writer.close(0, (error.type, error.value, error.tb))
+    assert not (tmp_path / "late.h5").exists()
 
 
 def test_chunking_does_not_change_the_file(tmp_path):

@@ -21,7 +21,8 @@ Per pixel, per frame interval [t_k, t_k+1]:
   8. hot pixels: a fraction of pixels firing ON at a fixed rate, whatever the input.
 
 Events are a numpy structured array (x, y, t, p) in tonic's convention: x column, y row
-(uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t. On request
+(uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t (or, from
+`intervals(columns=True)`, a dict of those four columns). On request
 (`labels=True`) each event also gets its cause (`formats.events.EVENT_LABELS`): signal,
 shot noise, leak or hot pixel. Leak is told from signal by leak quanta: per pixel, the
 leak drift not yet spent (from its random leak phase on) is kept, each whole theta_on of
@@ -524,7 +525,9 @@ def _assemble(
     else:
         out = np.empty(key.size, EVENT_DTYPE)
     out_label = _NO_LABELS if label is None else np.empty(key.size, np.uint8)
-    _decode_keys(key, width, n_pixels, out["x"], out["y"], out["t"], out["p"], out_label)  # field views: no copies
+    _decode_keys(
+        key, width, n_pixels, out["x"], out["y"], out["t"], out["p"], out_label
+    )  # fields or columns: no copies
     return out, (None if label is None else out_label)
 
 
