@@ -118,6 +118,25 @@ def _positive(option: str, value: float | None) -> None:
         raise ValueError(f"{option}: expected a value > 0, got {value}")
 
 
+def keep_freed_memory() -> None:
+    """Ask glibc's malloc to keep the memory a process frees for its next allocations. The
+    events command allocates and frees ~60 B per event every frame interval (~75 MB at
+    1024^2 on the sensor path); by default glibc hands most of it back to the kernel, which
+    must clear those pages again at the next interval: 5-6 % of the command
+    (docs/benchmarks.md, "Session 23: freed memory kept"). The results cannot change; the
+    process's memory stays at its peak instead of falling between intervals. A no-op where
+    the C library has no mallopt (macOS) or ignores it (musl)."""
+    import ctypes
+
+    try:
+        mallopt = ctypes.CDLL(None).mallopt
+    except (OSError, AttributeError):
+        return
+    m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's <malloc.h>
+    mallopt(m_mmap_threshold, 256 << 20)  # arrays below 256 MiB from the heap, not mmap
+    mallopt(m_trim_threshold, (1 << 31) - 1)  # and its free top kept (up to 2 GiB)
+
+
 def cmd_events(args) -> int:
     from .stages.events import CHUNK_FRAMES, emulate, emulator_params, export_events, frame_source
 
@@ -145,6 +164,7 @@ def cmd_events(args) -> int:
     chunk = CHUNK_FRAMES if args.chunk is None else args.chunk
     threads = len(os.sched_getaffinity(0)) if args.threads is None else args.threads
     source = frame_source(args.input, chunk, args.fps, args.white, sensor, ahead=threads > 1)
+    keep_freed_memory()
     from .progress import log
 
     log(

@@ -32,8 +32,11 @@ MEMORY_MB = {
     "motion_field": (300.0, 4e-4),  # 68 MB at 256^2 with terrain, 0.27 GB at 1024^2 sphere only: one field at a time
     # events: one interval's events at a time, 16 frames read at a time (session 18): 0.20 /
     # 0.22 / 0.29 / 0.49 GB at 128^2 / 256^2 / 512^2 / 1024^2, sensor path with labels (1 s
-    # descent clip; 0.20 / 0.24 / 0.34 / 0.74 GB reading 64 frames at a time)
-    "events": (230.0, 2.6e-4),
+    # descent clip; 0.20 / 0.24 / 0.34 / 0.74 GB reading 64 frames at a time). Session 23,
+    # freed memory kept for reuse (cli.keep_freed_memory): 0.22 / 0.29 / 0.55 GB at 256^2 /
+    # 512^2 / 1024^2 (the same clip), 0.59-0.65 GB on the 1 s braking clip at 1024^2 (1.24 M
+    # events per frame; 0.55-0.56 GB before)
+    "events": (230.0, 4.0e-4),
     "sample_trajectories": (500.0, 0.0),  # plus 500 MB per process
 }
 # Adaptive timing (render.timing) renders extra frames for the emulator where the scene
