@@ -68,6 +68,7 @@ def cmd_upsample(args) -> int:
 def cmd_render(args) -> int:
     from .stages.render import RenderSettings, render_trajectory
 
+    keep_freed_memory()
     render_trajectory(
         args.trajectory,
         _settings(RenderSettings, args.settings),
@@ -120,12 +121,13 @@ def _positive(option: str, value: float | None) -> None:
 
 def keep_freed_memory() -> None:
     """Ask glibc's malloc to keep the memory a process frees for its next allocations. The
-    events command allocates and frees ~60 B per event every frame interval (~75 MB at
-    1024^2 on the sensor path); by default glibc hands most of it back to the kernel, which
-    must clear those pages again at the next interval: 5-6 % of the command
-    (docs/benchmarks.md, "Session 23: freed memory kept"). The results cannot change; the
-    process's memory stays at its peak instead of falling between intervals. A no-op where
-    the C library has no mallopt (macOS) or ignores it (musl)."""
+    render and events commands allocate and free large arrays every frame (events: ~60 B per
+    event, ~75 MB per 1024^2 interval on the sensor path); by default glibc hands much of it
+    back to the kernel, which must clear those pages again at the next frame: 3-5 % of the
+    events command, ~7 % of the render command's (docs/benchmarks.md, "Session 23: freed
+    memory kept"). The results cannot change; the process's memory stays at its peak instead
+    of falling between frames. A no-op where the C library has no mallopt (macOS) or
+    ignores it (musl)."""
     import ctypes
 
     try:
