@@ -525,9 +525,8 @@ def _assemble(
     else:
         out = np.empty(key.size, EVENT_DTYPE)
     out_label = _NO_LABELS if label is None else np.empty(key.size, np.uint8)
-    _decode_keys(
-        key, width, n_pixels, out["x"], out["y"], out["t"], out["p"], out_label
-    )  # fields or columns: no copies
+    # Decoded straight into the fields or the columns: no copies.
+    _decode_keys(key, width, n_pixels, out["x"], out["y"], out["t"], out["p"], out_label)
     return out, (None if label is None else out_label)
 
 

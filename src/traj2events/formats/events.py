@@ -18,15 +18,16 @@ SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL = range(len(EVENT_LABELS))
 
 MAX_T_US = np.iinfo(np.uint32).max  # events/t's range after t_offset (~71.6 min)
 
-# Blosc (codec, level, bit shuffle) per column: the fastest to write of zstd-1 / LZ4 with bit
-# or byte shuffle that does not make the column larger (docs/benchmarks.md, session 23):
-# together 3.5 ns less per event than zstd-1 + bit shuffle everywhere (DSEC's), and smaller.
-COLUMN_CODECS = {
-    "x": ("lz4", 1, True),  # 1.6x faster, +0.2 % bytes
-    "y": ("zstd", 1, True),  # LZ4: 1.9x faster but +10 %
-    "t": ("zstd", 1, False),  # sorted times: byte shuffle 1.7x faster and half the bytes
-    "p": ("lz4", 1, True),  # 1.7x faster, +3 % of a small column
-    "label": ("zstd", 1, True),  # LZ4: 1.6x faster but twice the bytes
+# events.h5's columns: (type, Blosc (codec, level, bit shuffle)). Each codec is the fastest to
+# write of zstd-1 / LZ4 with bit or byte shuffle that does not make its column larger
+# (docs/benchmarks.md, session 23): together 3.5 ns less per event than zstd-1 + bit shuffle
+# everywhere (DSEC's), and smaller.
+COLUMNS = {
+    "x": ("<u2", ("lz4", 1, True)),  # 1.6x faster, +0.2 % bytes
+    "y": ("<u2", ("zstd", 1, True)),  # LZ4: 1.9x faster but +10 %
+    "t": ("<u4", ("zstd", 1, False)),  # sorted times: byte shuffle 1.7x faster and half the bytes
+    "p": ("u1", ("lz4", 1, True)),  # 1.7x faster, +3 % of a small column
+    "label": ("u1", ("zstd", 1, True)),  # only with labels; LZ4: 1.6x faster but twice the bytes
 }
 
 
@@ -37,7 +38,7 @@ class EventsWriter:
     `events/p` (uint8, 1 = ON), `ms_to_idx` (uint64: index of the first event at or after
     each millisecond), `t_offset` (int64, us); with `labels`, also `events/label` (uint8,
     the index in EVENT_LABELS, attribute `label_names`). Event arrays are compressed with
-    Blosc through hdf5plugin (as DSEC's), a codec per column (COLUMN_CODECS); attributes
+    Blosc through hdf5plugin (as DSEC's), a codec per column (COLUMNS); attributes
     hold the emulator's parameters."""
 
     def __init__(
@@ -57,9 +58,10 @@ class EventsWriter:
         group = self._file.create_group("events")
         self._sets = {
             name: group.create_dataset(
-                name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), **blosc(*COLUMN_CODECS[name])
+                name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), **blosc(*codec)
             )
-            for name, dtype in (("x", "<u2"), ("y", "<u2"), ("t", "<u4"), ("p", "u1")) + (("label", "u1"),) * labels
+            for name, (dtype, codec) in COLUMNS.items()
+            if labels or name != "label"
         }
         if labels:
             set_attrs(self._sets["label"], {"label_names": ",".join(EVENT_LABELS)})
