@@ -175,11 +175,22 @@ def test_a_video_s_decoder_takes_one_of_the_threads(tmp_path, monkeypatch):
             made.append(threads)
             super().__init__(*args, threads=threads, **kwargs)
 
+    import traj2events.video as video_module
+
+    decoders = []
+
+    def recording_command(path, threads=None):
+        decoders.append(threads)
+        return decode_command(path, threads)
+
+    decode_command = video_module.decode_command
     monkeypatch.setattr(stage, "EventEmulator", Recording)
+    monkeypatch.setattr(video_module, "decode_command", recording_command)
     for threads in (1, 2, 3):
         source = frame_source(tmp_path / "in.mkv", ahead=threads > 1)
         emulate(source, emulator_params("clean"), 0, tmp_path / f"{threads}.h5", "clean", "in.mkv", threads=threads)
     assert made == [1, 1, 2]
+    assert decoders == [1, 1, 1]  # ffmpeg's decoder: one thread, not one per CPU (its default)
 
 
 def test_an_error_from_a_plain_iterator_source_is_the_one_raised(tmp_path):

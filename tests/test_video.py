@@ -3,7 +3,15 @@
 import numpy as np
 import pytest
 
-from traj2events.video import VideoWriter, _display_steps, display_code, display_frame, read_video
+from traj2events.video import (
+    VideoWriter,
+    _display_steps,
+    decode_command,
+    display_code,
+    display_frame,
+    iter_video,
+    read_video,
+)
 
 
 def test_ffv1_round_trip_is_exact(tmp_path):
@@ -14,7 +22,15 @@ def test_ffv1_round_trip_is_exact(tmp_path):
             video.write(f)
     np.testing.assert_array_equal(read_video(tmp_path / "v.mkv"), frames)
     np.testing.assert_array_equal(read_video(tmp_path / "v.mkv", [0, 3, 6]), frames[[0, 3, 6]])
+    for threads in (None, 1):
+        np.testing.assert_array_equal(np.concatenate(list(iter_video(tmp_path / "v.mkv", 3, threads=threads))), frames)
     assert not list(tmp_path.glob(".*part"))
+
+
+def test_decode_command_sets_the_decoder_threads_before_its_input():
+    args = decode_command("in.mkv", 1)
+    assert args[args.index("-threads") + 1] == "1" and args.index("-threads") < args.index("-i")
+    assert "-threads" not in decode_command("in.mkv")  # ffmpeg's default
 
 
 def test_preview_decodes_close_to_the_frames(tmp_path):

@@ -233,20 +233,24 @@ def video_info(path: str | os.PathLike) -> tuple[int, int, float, int | None]:
     return int(stream["width"]), int(stream["height"]), fps, count
 
 
-def iter_video(path: str | os.PathLike, chunk: int = 64, info: tuple | None = None):
+def decode_command(path: str | os.PathLike, threads: int | None = None) -> list[str]:
+    """ffmpeg's arguments decoding a video to raw 8-bit grey on its standard output, with
+    `threads` decoder threads (None: ffmpeg's default, one per CPU it may use)."""
+    import ffmpeg
+
+    options = {} if threads is None else {"threads": threads}
+    stream = ffmpeg.input(str(path), **options).output("pipe:", format="rawvideo", pix_fmt="gray")
+    return stream.global_args("-loglevel", "error").compile()
+
+
+def iter_video(path: str | os.PathLike, chunk: int = 64, info: tuple | None = None, threads: int | None = None):
     """Decode a video to 8-bit grey, yielding (k, H, W) uint8 chunks: memory bounded by
     `chunk` frames, whatever the video's length. A video that decodes to fewer frames
     than its container announces (truncated, corrupt) raises ValueError at its end.
-    `info`: the video's `video_info`, when the caller has it (each probe is ~80 ms)."""
-    import ffmpeg
-
+    `info`: the video's `video_info`, when the caller has it (each probe is ~80 ms).
+    `threads`: the decoder's threads (`decode_command`)."""
     width, height, _, expected = info or video_info(path)
-    process = (
-        ffmpeg.input(str(path))
-        .output("pipe:", format="rawvideo", pix_fmt="gray")
-        .global_args("-loglevel", "error")
-        .run_async(pipe_stdout=True)
-    )
+    process = subprocess.Popen(decode_command(path, threads), stdout=subprocess.PIPE)
     size = width * height
     decoded = 0
     try:

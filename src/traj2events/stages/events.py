@@ -54,6 +54,11 @@ class FrameSource:
     decoder_cpus: int = 0  # CPUs a child process takes decoding the input (ffmpeg's, for a video)
 
 
+# ffmpeg's decoder threads for a video: one, beside the emulator's. ffmpeg's default, a
+# thread per CPU, oversubscribed two CPUs (3-9 % slower, docs/benchmarks.md, session 22)
+# and ignored --threads.
+VIDEO_DECODER_CPUS = 1
+
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
 SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_convention", "camera_mount_height_m",
                "camera_position", "fps", "timing", "stars", "sun_range_m",
@@ -136,11 +141,11 @@ def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
 
     def video():
         k = 0
-        for frames in iter_video(path, chunk, info):
+        for frames in iter_video(path, chunk, info, threads=VIDEO_DECODER_CPUS):
             yield frames, (k + np.arange(len(frames))) / fps
             k += len(frames)
 
-    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), decoder_cpus=1)
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), decoder_cpus=VIDEO_DECODER_CPUS)
 
 
 def frame_source(
