@@ -6,8 +6,9 @@
 For each trajectory, clips from mid-flight of each length in --seconds (poses from the
 re-integrated dynamics at the config's fps) go through the commands the workflow runs,
 each whole and on one core (OMP/LP threads 1): `traj2events render` (with its two ffmpeg
-encoders), `traj2events motion-field --frames` (every --field-every-th frame: a field costs the
-same at any cadence, and a clip then has enough of them to fit) and
+encoders; one when the config sets render.preview: false), `traj2events motion-field
+--frames` (every --field-every-th frame: a field costs the same at any cadence, and a clip
+then has enough of them to fit) and
 `traj2events events` (the config's preset, input and labels). Each command's CPU time,
 its children's included (the encoders), is fitted as a + b frames over the clip lengths:
 b is the cost per frame, a the cost per job (start-up, tile building). Every command runs
@@ -86,7 +87,8 @@ def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_
     frames = folder / "frames.h5"
     return {
         "render": [*cli, "render", str(clip), "--settings", settings, "--frames", str(frames),
-                   "--video", str(folder / "video.mkv"), "--preview", str(folder / "preview.mp4")],
+                   "--video", str(folder / "video.mkv"),
+                   *(["--preview", str(folder / "preview.mp4")] if config["render"]["preview"] else [])],
         "motion field": [*cli, "motion-field", str(clip), "--width", str(camera["width"]),
                          "--height", str(camera["height"]), "--fov-deg", str(camera["fov_deg"]),
                          "--mount-height-m", str(camera["mount_height_m"]),
@@ -100,7 +102,8 @@ def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_
 
 
 def output_bytes(folder: Path) -> dict[str, int]:
-    sizes = {name: (folder / name).stat().st_size for name in ("frames.h5", "video.mkv", "preview.mp4", "events.h5")}
+    names = ("frames.h5", "video.mkv", "preview.mp4", "events.h5")
+    sizes = {name: (folder / name).stat().st_size for name in names if (folder / name).exists()}  # preview: optional
     sizes["motion_field.h5"] = (folder / "motion_field.h5").stat().st_size
     sizes["flow/*.flo"] = sum(p.stat().st_size for p in (folder / "flow").iterdir())
     return sizes

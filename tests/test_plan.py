@@ -25,6 +25,16 @@ def test_kept_frames_count_and_temporary_ones_do_not():
     assert kept.frames_h5_live_bytes_max == temporary.frames_h5_live_bytes_max > 0
 
 
+def test_without_the_preview_neither_its_disk_nor_its_encoder_is_planned():
+    on = dataset_plan(resolve_config({**ONE, "camera": {"width": 1024, "height": 1024}}))
+    off = dataset_plan(resolve_config({**ONE, "camera": {"width": 1024, "height": 1024}, "render": {"preview": False}}))
+    assert "preview.mp4" in on.disk_bytes and "preview.mp4" not in off.disk_bytes
+    assert on.disk_bytes["video.mkv"] == off.disk_bytes["video.mkv"]
+    # The encoder's measured share of a 1024^2 frame's render CPU (bench/preview_cost.py).
+    assert 0.1 < 1 - off.core_hours["render"] / on.core_hours["render"] < 0.3
+    assert off.core_hours["events"] == on.core_hours["events"]
+
+
 def test_default_dataset_plan_is_near_what_it_measured():
     # Measured 2026-11-23 (docs/benchmarks.md): 18 671 frames, ~5 min of rendering on one core;
     # session 9 (sensor model, stars): 19 115 frames, 1.59 GB under results/.

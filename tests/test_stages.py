@@ -132,6 +132,17 @@ def test_render_writes_frames_and_a_lossless_video_of_them(built):
     assert np.abs(video.astype(int) - display_frame(radiance, white, gamma).astype(int)).max() <= 1
 
 
+def test_without_the_preview_the_other_files_are_the_same(built, config, tmp_path):
+    settings = RenderSettings.from_config(config, "descent")
+    render_trajectory(built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["frames.h5", "video.mkv"]  # no preview, no leftovers
+    assert (built / "p.mp4").stat().st_size > 0  # the fixture's render wrote one
+    assert (tmp_path / "video.mkv").read_bytes() == (built / "video.mkv").read_bytes()
+    with h5py.File(tmp_path / "frames.h5") as f, h5py.File(built / "frames.h5") as with_preview:
+        for name in ("radiance", "depth_m", "t"):
+            assert np.array_equal(f[name][()], with_preview[name][()])
+
+
 def test_motion_field_with_the_terrain_field(built, config):
     camera = Camera(SIZE, SIZE, config["camera"]["fov_deg"])
     motion_field(built / "trajectory.h5", camera, 1_737_400.0, 7, built / "mf.h5", built / "flow", built / "frames.h5")

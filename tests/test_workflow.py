@@ -347,6 +347,14 @@ def test_emulator_setting_reruns_events_only(built, tmp_path):
     assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
 
 
+def test_turning_the_preview_off_reruns_no_render(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("render", {}).update(preview=False))
+    assert jobs == {"dataset_index": 2}  # its inputs lose preview.mp4; no render, nothing after it
+    out = snakemake(tmp_path / "wf", "-n", "-p", "--forcerun", "render").stdout
+    assert "traj2events render" in out and "--preview" not in out and "preview.mp4" not in out
+
+
 def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(

@@ -328,7 +328,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
-    p.add_argument("--preview", required=True, help="preview.mp4: H.264 of the same, to look at")
+    p.add_argument(
+        "--preview",
+        help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless render.preview is false: "
+        "its encoder takes CPU beside the render); default: none",
+    )
     p.add_argument(
         "--backend",
         default=section("render")["backend"],

@@ -22,6 +22,9 @@ EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # meas
 # Seconds of one core: per frame (a fixed part and a per-pixel part), per motion field;
 # at 1024^2 from bench/workflow_cost.py (CPU time of the whole commands, encoders included).
 RENDER_S = (0.012, 1.4e-7)  # 1024^2: 0.16 s/frame with the two encoders, shaded per pixel (session 15)
+PREVIEW_S_PER_PX = (
+    2.5e-8  # of RENDER_S: the preview's H.264 encoder, 21-32 ms at 1024^2 (bench/preview_cost.py, session 24)
+)
 EVENTS_S = (0.0005, 1.1e-7)  # the whole events command (decoding, emulation, writing): 0.08-0.15 s at 1024^2
 FIELD_S_PER_PX = 1.0e-7  # motion field with the terrain-true field: 0.08-0.12 s at 1024^2 (sessions 11-12)
 # Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
@@ -111,6 +114,12 @@ def rendered_per_frame(config: dict) -> float:
     return min(1.0 + a * (camera["width"] / 128.0) ** q * bound**-p, timing["max_fps"] / camera["fps"])
 
 
+def render_s_per_frame(config: dict, pixels: int) -> float:
+    """One core's seconds per rendered frame, encoders included (the preview's only with render.preview)."""
+    preview = 0.0 if config["render"]["preview"] else PREVIEW_S_PER_PX * pixels
+    return RENDER_S[0] + RENDER_S[1] * pixels - preview
+
+
 def dataset_plan(config: dict) -> Plan:
     """The planned size of the (validated) config's dataset."""
     camera, every = config["camera"], config["motion_field"]["every_n_frames"]
@@ -123,17 +132,18 @@ def dataset_plan(config: dict) -> Plan:
     rendered = rendered_per_frame(config)  # frames.h5 and the emulator get the adaptive frames too
     disk = {
         "video.mkv": BYTES_PER_PX["video.mkv"] * px_frames,
-        "preview.mp4": BYTES_PER_PX["preview.mp4"] * px_frames,
         "events.h5": BYTES_PER_PX["events.h5"] * px_frames,
         "motion_field.h5": BYTES_PER_PX["motion_field.h5"] * px_fields,
         "flow/*.flo": BYTES_PER_PX["flow/*.flo"] * px_fields,
     }
+    if config["render"]["preview"]:
+        disk["preview.mp4"] = BYTES_PER_PX["preview.mp4"] * px_frames
     for name in config["events"]["exports"]:
         disk[f"events {name}"] = EXPORT_BYTES_PER_EVENTS_BYTE[name] * disk["events.h5"]
     if config["render"]["keep_frames"]:
         disk["frames.h5"] = BYTES_PER_PX["frames.h5"] * px_frames * rendered
     hours = {
-        "render": rendered * frames * (RENDER_S[0] + RENDER_S[1] * pixels) / 3600,
+        "render": rendered * frames * render_s_per_frame(config, pixels) / 3600,
         "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels) / 3600,
         "motion field": px_fields * FIELD_S_PER_PX / 3600,
     }
@@ -164,7 +174,7 @@ def job_resources(config: dict, stage: str, scenario: str | None, threads: int =
     fields = _fields(frames, config["motion_field"]["every_n_frames"])
     rendered = rendered_per_frame(config)
     seconds = {
-        "render": rendered * frames * (RENDER_S[0] + RENDER_S[1] * pixels),
+        "render": rendered * frames * render_s_per_frame(config, pixels),
         "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels),
         "motion_field": pixels * fields * FIELD_S_PER_PX,
     }.get(stage, 60.0)

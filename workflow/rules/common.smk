@@ -82,6 +82,21 @@ def frames_output(path):
     return path if config["render"]["keep_frames"] else temp(path)
 
 
+def render_outputs(folder):
+    """The render job's files: frames.h5, video.mkv and, with render.preview, preview.mp4."""
+    outputs = {"frames": frames_output(folder + "frames.h5"), "video": folder + "video.mkv"}
+    if config["render"]["preview"]:
+        outputs["preview"] = folder + "preview.mp4"
+    return outputs
+
+
+def preview_option(wildcards, output):
+    """The render command's --preview option (render.preview), or nothing. A function of
+    `output`: Snakemake does not record such a parameter, so turning the preview off in a
+    built dataset reruns no render job (tests/test_workflow.py)."""
+    return f"--preview {output.preview}" if config["render"]["preview"] else ""
+
+
 def camera_options(wildcards):
     """The camera and sphere of the config as command-line options."""
     c = config["camera"]
@@ -128,7 +143,7 @@ def trajectory_ids(scenario):
 PER_TRAJECTORY = [
     "trajectory.h5",
     "video.mkv",
-    "preview.mp4",
+    *(["preview.mp4"] if config["render"]["preview"] else []),
     "frames.png",
     "motion_field.h5",
     "motion_field.png",

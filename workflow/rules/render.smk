@@ -1,5 +1,5 @@
 # Stages 4-5: render the lunar surface from every pose (linear radiance + depth), and the
-# videos (lossless FFV1, H.264 preview) made from the same frames.
+# videos (lossless FFV1; an H.264 preview unless render.preview is false) made from the same frames.
 
 
 rule render:
@@ -7,9 +7,7 @@ rule render:
         trajectory="results/{scenario}/{id}/trajectory.h5",
         dem=elevation_grid,
     output:
-        frames=frames_output("results/{scenario}/{id}/frames.h5"),
-        video="results/{scenario}/{id}/video.mkv",
-        preview="results/{scenario}/{id}/preview.mp4",
+        **render_outputs("results/{scenario}/{id}/"),
     log:
         "results/logs/{scenario}/{id}/render.log",
     conda:
@@ -23,7 +21,8 @@ rule render:
         code=code("render"),
         backend=config["render"]["backend"],
         tile_cache=tile_cache_option,
+        preview=preview_option,
     shell:
         # llvmpipe would start a thread per core in every job; one job = one core.
         "LP_NUM_THREADS={threads} traj2events render {input.trajectory} --settings '{params.settings}' "
-        "--frames {output.frames} --video {output.video} --preview {output.preview} --backend {params.backend} {params.tile_cache} 2> {log}"
+        "--frames {output.frames} --video {output.video} {params.preview} --backend {params.backend} {params.tile_cache} 2> {log}"

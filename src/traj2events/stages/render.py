@@ -6,6 +6,7 @@ emulator only; the videos keep the fixed rate."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import time
@@ -169,11 +170,12 @@ def render_trajectory(
     settings: RenderSettings,
     frames: str | os.PathLike,
     video: str | os.PathLike,
-    preview: str | os.PathLike,
+    preview: str | os.PathLike | None,
     backend: str = "auto",
     tile_cache: str | None = None,
 ) -> None:
-    """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv, preview.mp4.
+    """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv and, unless
+    `preview` is None, preview.mp4 (render.preview; its H.264 encoder costs CPU: docs/benchmarks.md).
     `backend`: the OpenGL backend (render.resolve_backend); `tile_cache`: a folder where
     tile heights are shared with other jobs (formats/tile_cache.py). Neither changes the scene."""
     s = settings
@@ -206,7 +208,7 @@ def render_trajectory(
         TerrainRenderer(tiles, camera, sun, reflectance, stars=s.star_field(), backend=backend) as renderer,
         FramesWriter(frames, s.height, s.width, attrs) as out,
         VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
-        VideoWriter(preview, s.width, s.height, fps, "h264") as shown_preview,
+        VideoWriter(preview, s.width, s.height, fps, "h264") if preview else contextlib.nullcontext() as shown_preview,
     ):
         log(f"  OpenGL: {renderer.backend} ({renderer.gl_renderer})")
         # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
@@ -222,7 +224,8 @@ def render_trajectory(
             out.append(tr.t[k], k, frame.radiance, frame.depth_m)
             shown = display_frame(frame.radiance, s.display_white_w_m2_sr, s.display_gamma)
             lossless.write(shown)
-            shown_preview.write(shown)
+            if shown_preview is not None:
+                shown_preview.write(shown)
             if states is not None and k + 1 < n:
                 between = render_between(
                     renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing, s.emulator_white_w_m2_sr
