@@ -22,9 +22,7 @@ EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # meas
 # Seconds of one core: per frame (a fixed part and a per-pixel part), per motion field;
 # at 1024^2 from bench/workflow_cost.py (CPU time of the whole commands, encoders included).
 RENDER_S = (0.012, 1.4e-7)  # 1024^2: 0.16 s/frame with the two encoders, shaded per pixel (session 15)
-PREVIEW_S_PER_PX = (
-    2.5e-8  # of RENDER_S: the preview's H.264 encoder, 21-32 ms at 1024^2 (bench/preview_cost.py, session 24)
-)
+PREVIEW_S_PER_PX = 2.5e-8  # of RENDER_S: the preview's encoder, 21-32 ms at 1024^2 (bench/preview_cost.py)
 EVENTS_S = (0.0005, 1.1e-7)  # the whole events command (decoding, emulation, writing): 0.08-0.15 s at 1024^2
 FIELD_S_PER_PX = 1.0e-7  # motion field with the terrain-true field: 0.08-0.12 s at 1024^2 (sessions 11-12)
 # Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
