@@ -84,9 +84,9 @@ def frames_output(path):
 
 def render_outputs(folder):
     """The render job's files: frames.h5, video.mkv and, with render.preview, preview.mp4."""
-    outputs = {"frames": frames_output(folder + "frames.h5"), "video": folder + "video.mkv"}
+    outputs = {"frames": frames_output(f"{folder}/frames.h5"), "video": f"{folder}/video.mkv"}
     if config["render"]["preview"]:
-        outputs["preview"] = folder + "preview.mp4"
+        outputs["preview"] = f"{folder}/preview.mp4"
     return outputs
 
 

@@ -7,7 +7,7 @@ rule render:
         trajectory="results/{scenario}/{id}/trajectory.h5",
         dem=elevation_grid,
     output:
-        **render_outputs("results/{scenario}/{id}/"),
+        **render_outputs("results/{scenario}/{id}"),
     log:
         "results/logs/{scenario}/{id}/render.log",
     conda:
