@@ -40,9 +40,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import numpy as np  # noqa: E402
 from scipy.ndimage import gaussian_filter  # noqa: E402
 
-import traj2events.emulator as emulator  # noqa: E402
-from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
+import traj2events.sensor.emulator as emulator  # noqa: E402
 from traj2events.formats.events import EVENT_LABELS, EventsWriter  # noqa: E402
+from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
 
 
 def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.ndarray:
@@ -116,11 +116,11 @@ def profile(n_frames: int) -> None:
         return wrapper
 
     columns = {
-        "_advance": "frame pass",
-        "_emit": "event times",
-        "_noise_candidates": "noise",
-        "_reset_reference": "reference resets",
-        "_assemble": "ordering",
+        "advance": "frame pass",
+        "emit": "event times",
+        "noise_candidates": "noise",
+        "reset_reference": "reference resets",
+        "assemble": "ordering",
     }
     for name in columns:
         setattr(emulator, name, timed(name, getattr(emulator, name)))

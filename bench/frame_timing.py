@@ -29,7 +29,7 @@ timing) from the linear radiance of:
   - a dense reference rendered at --reference-fps;
   - fixed 50, 80, 100, 125, 200, 250, 400, 500 and 1000 fps (every n-th frame of the
     reference: the same renders);
-  - adaptive timing (traj2events.frame_timing) with several bounds, the fixed --fps frames
+  - adaptive timing (traj2events.geometry.frame_timing) with several bounds, the fixed --fps frames
     included, rendered at the times it picks.
 Per variant: frames, render seconds (fixed: frames x the reference's mean seconds per
 frame; adaptive: measured, with the motion-field prediction), emulation seconds, events
@@ -61,16 +61,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
 
-from traj2events.camera import Camera  # noqa: E402
 from traj2events.config import resolve_config  # noqa: E402
-from traj2events.dynamics import Dynamics  # noqa: E402
-from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
-from traj2events.log_response import radiance_to_dn  # noqa: E402
-from traj2events.render import Frame, TerrainRenderer  # noqa: E402
+from traj2events.geometry.camera import Camera  # noqa: E402
+from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
+from traj2events.renderer.draw import Frame, TerrainRenderer  # noqa: E402
+from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.render import RenderSettings, render_between  # noqa: E402
-from traj2events.upsample import ReintegratedStates  # noqa: E402
+from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
+from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
 
 FIXED_FPS = (50, 80, 100, 125, 200, 250, 400, 500, 1000)
 ADAPTIVE = {

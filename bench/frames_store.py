@@ -35,13 +35,13 @@ import h5py  # noqa: E402
 import hdf5plugin  # noqa: E402
 import numpy as np  # noqa: E402
 
-from traj2events.camera import Camera  # noqa: E402
 from traj2events.formats.frames import round_mantissa  # noqa: E402
-from traj2events.log_response import log_intensity_8bit, radiance_to_dn  # noqa: E402
-from traj2events.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.tiles import LodSettings, TileSet  # noqa: E402
+from traj2events.geometry.camera import Camera  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
+from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
+from traj2events.sensor.laws import log_intensity_8bit, radiance_to_dn  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from render import CASES, R_MOON, poses  # noqa: E402

@@ -28,11 +28,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import numpy as np  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
-from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.log_response import radiance_to_dn  # noqa: E402
-from traj2events.motion_field import depth_flow  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
+from traj2events.geometry.motion_field import depth_flow  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.camera_poses import camera_poses  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 

@@ -27,9 +27,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
-from traj2events.camera import Camera, camera_pose  # noqa: E402
 from traj2events.formats.hdf5 import blosc  # noqa: E402
-from traj2events.motion_field import (  # noqa: E402
+from traj2events.geometry.camera import Camera, camera_pose  # noqa: E402
+from traj2events.geometry.motion_field import (  # noqa: E402
     inverse_depth_sphere,
     inverse_depth_sphere_textbook,
     local_vertical,

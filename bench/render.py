@@ -32,13 +32,13 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
 
-from traj2events.camera import Camera, camera_pose  # noqa: E402
 from traj2events.formats.frames import FramesWriter  # noqa: E402
-from traj2events.illumination import Sun  # noqa: E402
-from traj2events.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.tiles import LodSettings, TileSet  # noqa: E402
+from traj2events.geometry.camera import Camera, camera_pose  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.scene.illumination import Sun  # noqa: E402
+from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
+from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
 from traj2events.video import VideoWriter, display_frame  # noqa: E402
 
 R_MOON = 1737400.0

@@ -44,8 +44,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
 
-from traj2events import render as render_module  # noqa: E402
-from traj2events.tiles import LodSettings  # noqa: E402
+from traj2events.renderer import draw as render_module  # noqa: E402
+from traj2events.scene.tiles import LodSettings  # noqa: E402
 
 
 def timed(log: list[float], function):

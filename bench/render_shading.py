@@ -53,15 +53,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import numpy as np  # noqa: E402
 from render import CASES, R_MOON, frame_errors, poses  # noqa: E402  (bench/render.py)
 
-import traj2events.render as render_module  # noqa: E402
-from traj2events.camera import Camera  # noqa: E402
+import traj2events.renderer.draw as render_module  # noqa: E402
 from traj2events.config import load_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
+from traj2events.geometry.camera import Camera  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
+from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.tiles import LodSettings, TileSet  # noqa: E402
 
 
 @dataclasses.dataclass

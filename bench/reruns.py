@@ -35,8 +35,8 @@ SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 
 CODE_EDITS = {
     "help text": ("cli.py", 'help="frames held in memory at once', 'help="frames in memory at once'),
-    "comment": ("emulator.py", "KNEE_DN = 20.0  # lin-log knee", "KNEE_DN = 20.0  # the lin-log knee"),
-    "emulator code": ("emulator.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0"),
+    "comment": ("sensor/laws.py", "KNEE_DN = 20.0  # lin-log knee", "KNEE_DN = 20.0  # the lin-log knee"),
+    "emulator code": ("sensor/laws.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0"),
     "figure style": ("figures.py", "fig.suptitle(title)", "fig.suptitle(title, fontsize=11)"),
 }
 CONFIG_EDITS = {

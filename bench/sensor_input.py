@@ -9,7 +9,7 @@ radiance then goes to the emulator (paper preset: the paper's Table 2 thresholds
 noise; seed 1; labels on) three ways:
   - video: the 8-bit display frames (255 (L / white)^(1/2.2)), the paper's own path;
   - display: linear radiance on the display scale, 255 L / white (the HDR path until now);
-  - sensor: linear radiance as photocurrent through events.sensor (traj2events.sensor).
+  - sensor: linear radiance as photocurrent through events.sensor (traj2events.sensor.photocurrent).
 Per path: emulation seconds, events per pixel per second, the share labelled signal, and
 the share of all events on moving-edge pixels (|grad ln L . flow| over 0.05 per frame,
 flow from the rendered depth), against the edge pixels' share of the image (what random
@@ -31,16 +31,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import numpy as np  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
-from traj2events.dynamics import Dynamics  # noqa: E402
-from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.events import SIGNAL  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.log_response import radiance_to_dn  # noqa: E402
-from traj2events.motion_field import depth_flow  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.sensor import SensorParams, sensor_dn  # noqa: E402
+from traj2events.geometry.motion_field import depth_flow  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
+from traj2events.sensor.photocurrent import SensorParams, sensor_dn  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.upsample import ReintegratedStates  # noqa: E402
+from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
+from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
 from traj2events.video import display_frame  # noqa: E402
 
 EDGE = 0.05  # |grad ln L . flow dt| per frame counted as a moving edge

@@ -30,8 +30,8 @@ import numpy as np  # noqa: E402
 
 from traj2events.config import load_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
+from traj2events.scene.tiles import long_sweep_lit  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.tiles import long_sweep_lit  # noqa: E402
 
 
 def main() -> None:

@@ -26,12 +26,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 import numpy as np  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
-from traj2events.emulator import PRESETS, EventEmulator  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.render import TerrainRenderer  # noqa: E402
-from traj2events.sensor import SensorParams, sensor_dn  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.scene.stars import star_radiance  # noqa: E402
+from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.photocurrent import SensorParams, sensor_dn  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.stars import star_radiance  # noqa: E402
 
 
 def skiest_second(trajectory, settings: RenderSettings, fps: float) -> np.ndarray:

@@ -42,19 +42,19 @@ sys.path.insert(0, str(ROOT / "src"))
 
 import numpy as np  # noqa: E402
 
-from traj2events.batch import solve_samples  # noqa: E402
 from traj2events.config import load_config, load_yaml, merge_config, resolve_config  # noqa: E402
-from traj2events.dynamics import Dynamics  # noqa: E402
-from traj2events.motion_stats import motion_summary  # noqa: E402
-from traj2events.ocp import LandingProblem  # noqa: E402
-from traj2events.scenarios import (  # noqa: E402
+from traj2events.stages.base_solution import solve_base  # noqa: E402
+from traj2events.trajectory.batch import solve_samples  # noqa: E402
+from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
+from traj2events.trajectory.motion_stats import motion_summary  # noqa: E402
+from traj2events.trajectory.ocp import LandingProblem  # noqa: E402
+from traj2events.trajectory.scenarios import (  # noqa: E402
     ScenarioSettings,  # noqa: E402
     base_conditions,
     sample_conditions,
 )
-from traj2events.stages.base_solution import solve_base  # noqa: E402
-from traj2events.state import MASS  # noqa: E402
-from traj2events.upsample import ShootingCheck, final_state_error  # noqa: E402
+from traj2events.trajectory.state import MASS  # noqa: E402
+from traj2events.trajectory.upsample import ShootingCheck, final_state_error  # noqa: E402
 
 
 def machine() -> str:

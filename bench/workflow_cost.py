@@ -42,12 +42,12 @@ sys.path.insert(0, str(ROOT / "src"))
 import numpy as np  # noqa: E402
 
 from traj2events.config import load_config  # noqa: E402
-from traj2events.dynamics import Dynamics  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory, write_trajectory  # noqa: E402
 from traj2events.plan import dataset_plan  # noqa: E402
-from traj2events.render import resolve_backend  # noqa: E402
+from traj2events.renderer.context import resolve_backend  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
+from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
+from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
 
 ONE_CORE = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1", "LP_NUM_THREADS": "1"}
 STAGES = ("render", "motion field", "events")

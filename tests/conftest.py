@@ -5,8 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from traj2events.dynamics import Dynamics, Vehicle
-from traj2events.ocp import BoundaryConditions, LandingProblem, OcpSettings
+from traj2events.trajectory.dynamics import Dynamics, Vehicle
+from traj2events.trajectory.ocp import BoundaryConditions, LandingProblem, OcpSettings
 
 ROOT = Path(__file__).resolve().parents[1]
 

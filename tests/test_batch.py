@@ -6,8 +6,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from traj2events import batch
 from traj2events.stages.sample_trajectories import NOT_IN_DATASET, dataset_ids
+from traj2events.trajectory import batch
 
 
 def fake_result(index: int, failing: set[int]):

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from traj2events.camera import Camera, camera_motion, camera_pose, opengl_camera_to_world
+from traj2events.geometry.camera import Camera, camera_motion, camera_pose, opengl_camera_to_world
 
 
 def test_focal_length_and_pixel_centres():

@@ -11,7 +11,7 @@ import yaml
 from conftest import ROOT
 from traj2events.config import SCHEMA_PATH, ConfigError, load_config, load_yaml, resolve_config, validate_config
 from traj2events.defaults import default_config, merge_config
-from traj2events.scenarios import ScenarioSettings
+from traj2events.trajectory.scenarios import ScenarioSettings
 
 
 @pytest.fixture(scope="module")
@@ -195,11 +195,11 @@ def test_reserved_scenario_names_are_refused(name):
 def test_dataclass_defaults_come_from_the_defaults_file():
     from dataclasses import fields
 
-    from traj2events.ocp import OcpSettings
-    from traj2events.reflectance import ReflectanceParams
-    from traj2events.terrain import TerrainParams
-    from traj2events.tiles import LodSettings
-    from traj2events.vehicle import Vehicle
+    from traj2events.scene.reflectance import ReflectanceParams
+    from traj2events.scene.terrain import TerrainParams
+    from traj2events.scene.tiles import LodSettings
+    from traj2events.trajectory.ocp import OcpSettings
+    from traj2events.trajectory.vehicle import Vehicle
 
     d = default_config()
     for cls, values in (

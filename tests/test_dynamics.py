@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from traj2events.dynamics import Dynamics, Vehicle, rotation_matrix, split_control_dynamics
+from traj2events.trajectory.dynamics import Dynamics, Vehicle, rotation_matrix, split_control_dynamics
 
 
 def rest_state(mass=8000.0, angles=(0.0, 0.0, 0.0), rates=(0.0, 0.0, 0.0)):

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from traj2events.emulator import PRESETS, EmulatorParams, EventEmulator, lowpass_gain
-from traj2events.log_response import log_intensity_8bit
+from traj2events.sensor.emulator import PRESETS, EmulatorParams, EventEmulator
+from traj2events.sensor.laws import log_intensity_8bit, lowpass_gain
 
 CLEAN = PRESETS["clean"]
 FPS = 100.0
@@ -134,14 +134,14 @@ def test_shot_noise_rate_balance_and_exponential_intervals():
 def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
     # The packed alias table and the branch-free thinning kernel, directly: with I = 0 every
     # candidate is kept (g = g_max), so the counts follow the weights alone.
-    from traj2events.emulator import _alias_table, _noise_candidates
+    from traj2events.sensor.noise import alias_table, noise_candidates
 
     weights = np.array(weights)
     n = 400_000
     pix, t, on = np.empty(n, np.int64), np.empty(n), np.empty(n, np.bool_)
     g_max = 1.0 - 0.75 * 20.0 / 275.0
-    k = _noise_candidates(
-        n, np.uint64(12345), _alias_table(weights), np.zeros(len(weights), np.uint8), 1.0, g_max, 2.0, 0.01, pix, t, on
+    k = noise_candidates(
+        n, np.uint64(12345), alias_table(weights), np.zeros(len(weights), np.uint8), 1.0, g_max, 2.0, 0.01, pix, t, on
     )
     assert k == n
     expected = n * weights / weights.sum()
@@ -152,7 +152,7 @@ def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
     assert on.mean() == pytest.approx(0.5, abs=5 * 0.5 / np.sqrt(n))
     # Bright pixels keep only g(I) / g_max of their candidates.
     bright = np.full(len(weights), 255, np.uint8)
-    kept = _noise_candidates(n, np.uint64(7), _alias_table(weights), bright, 1.0, g_max, 0.0, 0.01, pix, t, on)
+    kept = noise_candidates(n, np.uint64(7), alias_table(weights), bright, 1.0, g_max, 0.0, 0.01, pix, t, on)
     g = 1 - 0.75 * (255 + 20) / 275
     assert kept == pytest.approx(n * g / g_max, abs=5 * np.sqrt(n * 0.25))
 
@@ -204,7 +204,7 @@ def test_deferred_refractory_moves_events_to_the_end_of_the_period():
 def test_linear_radiance_input_keeps_the_model_in_dn():
     # 255 L / white: a radiance ramp in log space gives the same events as the same
     # ramp in DN, and values above white (HDR) are fine.
-    from traj2events.log_response import radiance_to_dn
+    from traj2events.sensor.laws import radiance_to_dn
 
     t = np.arange(51) / FPS
     radiance = 40.0 * np.exp(2.0 * t) * 1.5  # up to 1.5 x 40 x e (beyond white = 40)
@@ -408,12 +408,12 @@ def test_input_scale_on_float32_frames_is_the_float64_product_byte_for_byte():
 @pytest.mark.parametrize("labels", [False, True])
 @pytest.mark.parametrize("times", ["to hours", "dense", "crowded"])
 def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels, times):
-    """_assemble's key (t us, y, x, p[, label]) decodes to the very events it encodes, in
+    """assemble's key (t us, y, x, p[, label]) decodes to the very events it encodes, in
     (t, y, x, p) order: every corner pixel, both polarities, on image widths that are not
     powers of two; t from 0 (the first key inside t = 0's range) to hours (buckets of 2^s
     us), over fewer microseconds than events (a bucket per us, sorted by insertion), or
     crowded into a few microseconds (buckets too disordered for insertion)."""
-    from traj2events.emulator import _assemble
+    from traj2events.sensor.ordering import assemble
 
     rng = np.random.default_rng(width + height)
     n_pixels = width * height
@@ -423,7 +423,7 @@ def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels, ti
     pix = np.concatenate([[n_pixels - 1, 1, 0, n_pixels - 1], rng.integers(0, n_pixels, n - 4)])
     on = rng.random(n) < 0.5
     label = rng.integers(0, 4, n).astype(np.uint8) if labels else None
-    events, out_label = _assemble(pix, t_us * 1e-6, on, label, width, n_pixels)
+    events, out_label = assemble(pix, t_us * 1e-6, on, label, width, n_pixels)
     order = np.lexsort(((label if labels else np.zeros(n)), on, pix % width, pix // width, t_us))
     np.testing.assert_array_equal(events["t"], t_us[order])
     np.testing.assert_array_equal(events["y"], (pix // width)[order])
@@ -436,7 +436,7 @@ def test_event_keys_sort_and_decode_back_to_the_events(width, height, labels, ti
 def test_event_keys_sort_like_numpy_where_buckets_are_nearly_in_order():
     """The signal's events come in pixel order, the noise's after them: the insertion path
     (few descents per bucket) and an empty input give np.sort's keys."""
-    from traj2events.emulator import _NO_LABELS, _sorted_keys
+    from traj2events.sensor.ordering import NO_LABELS, sorted_keys
 
     rng = np.random.default_rng(3)
     n_pixels = 1024 * 1024
@@ -445,17 +445,17 @@ def test_event_keys_sort_like_numpy_where_buckets_are_nearly_in_order():
     pix = np.concatenate([signal, noise])
     t_s = rng.integers(0, 10_000, pix.size) * 1e-6
     on = rng.random(pix.size) < 0.5
-    keys = _sorted_keys(pix, t_s, on, _NO_LABELS, n_pixels)
+    keys = sorted_keys(pix, t_s, on, NO_LABELS, n_pixels)
     expected = np.sort(np.rint(t_s * 1e6).astype(np.int64) * (2 * n_pixels) + pix * 2 + on)
     np.testing.assert_array_equal(keys, expected)
-    assert _sorted_keys(pix[:0], t_s[:0], on[:0], _NO_LABELS, n_pixels).size == 0
+    assert sorted_keys(pix[:0], t_s[:0], on[:0], NO_LABELS, n_pixels).size == 0
 
 
 def test_a_bucket_sorted_up_to_its_tail_is_merged_and_a_long_tail_sorted_whole():
     """Per microsecond, pixels in order then an unsorted tail: tails of 1 to MAX_TAIL keys
     that go before the whole head, after it and between (the merge), and one of MAX_TAIL + 1
     (the whole-bucket sort), each against np.sort."""
-    from traj2events.emulator import _NO_LABELS, MAX_TAIL, _sorted_keys
+    from traj2events.sensor.ordering import MAX_TAIL, NO_LABELS, sorted_keys
 
     rng = np.random.default_rng(8)
     n_pixels = 64 * 64
@@ -469,7 +469,7 @@ def test_a_bucket_sorted_up_to_its_tail_is_merged_and_a_long_tail_sorted_whole()
         t_us += [np.full(head + tail, us)]
     pix, t_s = np.concatenate(pix), np.concatenate(t_us) * 1e-6
     on = rng.random(pix.size) < 0.5
-    keys = _sorted_keys(pix, t_s, on, _NO_LABELS, n_pixels)
+    keys = sorted_keys(pix, t_s, on, NO_LABELS, n_pixels)
     expected = np.sort(np.rint(t_s * 1e6).astype(np.int64) * (2 * n_pixels) + pix * 2 + on)
     np.testing.assert_array_equal(keys, expected)
 
@@ -478,7 +478,9 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     """The kernel reuses the gain along a run of pixels with the same two inputs: every
     pixel still gets the first-order step of its own pair, as numpy computes it, where a
     run breaks in either frame alone, on -0.0 and with a scale."""
-    from traj2events.emulator import _NO_TABLE, _advance
+    from traj2events.sensor.pixel import advance
+
+    _NO_TABLE = np.empty(0)
 
     rng = np.random.default_rng(5)
     i0 = np.repeat(rng.choice([0.0, 0.5, 2.0], 60), rng.integers(1, 6, 60)).astype(np.float32)
@@ -491,7 +493,7 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     f0 = filtered.copy()
     theta = np.full(n, 100.0, np.float32)  # no crossings: only the low-pass is looked at
     work = [np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
-    _advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), cutoff_hz, dt, scale,
+    advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), cutoff_hz, dt, scale,
              *work, _NO_TABLE, _NO_TABLE, _NO_TABLE, np.zeros(n, np.int64), 0)  # fmt: skip
     dn0, dn1 = i0.astype(np.float64) * scale, i1.astype(np.float64) * scale
     target = np.where(dn1 <= 20.0, dn1 * (np.log(20.0) / 20.0), np.log(np.maximum(dn1, 20.0)))
@@ -500,7 +502,7 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
 
 
 def test_pixel_ranges_cover_the_frame_in_order_each_big_enough():
-    from traj2events.emulator import PIXELS_PER_THREAD, pixel_ranges
+    from traj2events.sensor.parallel import PIXELS_PER_THREAD, pixel_ranges
 
     assert pixel_ranges(1000, 4) == [(0, 1000)]  # a small frame: one range
     assert pixel_ranges(3 * PIXELS_PER_THREAD + 5, 8) == [

@@ -82,6 +82,7 @@ def render_venv(tmp_path_factory):
     return py, env
 
 
+@pytest.mark.slow  # builds a virtual environment (~50 s)
 def test_the_render_environment_runs_the_package_from_the_checkout(render_venv):
     """After the post-deploy script, the package runs from src/ as `python -m traj2events`
     (the rules' way under --sdm conda) and pyrender draws with OSMesa, which PyOpenGL 3.1.0
@@ -108,6 +109,7 @@ def test_the_render_environment_runs_the_package_from_the_checkout(render_venv):
     assert version.returncode == 0 and version.stdout.startswith("traj2events "), version.stderr
 
 
+@pytest.mark.slow  # pip installs the package (~30 s)
 def test_pip_install_alone_gives_a_working_command_outside_the_repository(render_venv, tmp_path):
     """`pip install` of the repository (not editable, no setup.sh): check-config finds the
     schema and defaults as package data, and a stage without OpenGL runs, from a folder

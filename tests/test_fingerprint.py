@@ -18,16 +18,37 @@ def short(names):
 
 def test_closures_follow_the_imports():
     render = short(import_closure("traj2events.stages.render"))
-    assert {"render", "tiles", "terrain", "illumination", "reflectance", "camera", "state", "video"} <= render
-    assert not {"ocp", "emulator", "figures", "cli"} & render  # the solver and the emulator are not in it
-    # Adaptive frame timing: poses from the dynamics, the motion field, the pixel's log response.
-    assert {"frame_timing", "dynamics", "upsample", "motion_field", "log_response"} <= render
+    assert {
+        "renderer.draw",
+        "renderer.context",
+        "scene.tiles",
+        "scene.terrain",
+        "scene.illumination",
+        "scene.reflectance",
+        "geometry.camera",
+        "trajectory.state",
+        "video",
+    } <= render
+    # the solver and the emulator are not in it
+    assert not {"trajectory.ocp", "sensor.emulator", "figures", "cli"} & render
+    # Adaptive frame timing: poses from the dynamics, the motion field, the pixel's laws.
+    assert {
+        "geometry.frame_timing",
+        "trajectory.dynamics",
+        "trajectory.upsample",
+        "geometry.motion_field",
+        "sensor.laws",
+    } <= render
     events = short(import_closure("traj2events.stages.events"))
-    assert "emulator" in events and not {"render", "figures", "ocp"} & events
+    assert {"sensor.emulator", "sensor.pixel", "sensor.laws", "sensor.noise"} <= events
+    assert not {"renderer.draw", "figures", "trajectory.ocp"} & events
     pictures = short(import_closure("traj2events.stages.pictures"))
-    assert {"figures", "motion_field"} <= pictures  # the motion-field picture shows the field
+    # the motion-field picture shows the field; a function-level import counts (motion_pass)
+    assert {"figures", "geometry.motion_field", "geometry.motion_pass"} <= pictures
     # A module imported only inside a function counts too (base solve -> scenarios -> ocp).
-    assert {"ocp", "dynamics", "scenarios"} <= short(import_closure("traj2events.stages.base_solution"))
+    assert {"trajectory.ocp", "trajectory.dynamics", "trajectory.scenarios"} <= short(
+        import_closure("traj2events.stages.base_solution")
+    )
 
 
 @pytest.mark.parametrize("stage", STAGES)
@@ -38,8 +59,8 @@ def test_no_stage_depends_on_the_command_line_or_config_loading(stage):
 def test_render_fingerprint_includes_the_shaders():
     import ast
 
-    tree = ast.parse(fingerprint.module_path("traj2events.render").read_text())
-    assert {p.name for p in fingerprint.data_files(tree)} == {
+    path = fingerprint.module_path("traj2events.renderer.draw")
+    assert {p.name for p in fingerprint.data_files(ast.parse(path.read_text()), path.parent)} == {
         "terrain.vert",
         "terrain.frag",
         "terrain_textured.vert",
@@ -69,9 +90,9 @@ def all_fingerprints():
 
 def test_comments_docstrings_and_formatting_change_nothing(package_copy):
     before = all_fingerprints()
-    package_copy("log_response.py", "KNEE_DN = 20.0  #", "KNEE_DN = 20.0  # (edited) ")
-    package_copy("emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;')
-    package_copy("render.py", "\nimport os\n", "\n\nimport os  # formatting\n\n")
+    package_copy("sensor/laws.py", "KNEE_DN = 20.0  #", "KNEE_DN = 20.0  # (edited) ")
+    package_copy("sensor/emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;')
+    package_copy("renderer/context.py", "\nimport os\n", "\n\nimport os  # formatting\n\n")
     package_copy(
         "cli.py", "def cmd_events(args) -> int:", "def cmd_events(args) -> int:  # a real edit, but in the CLI"
     )
@@ -80,12 +101,12 @@ def test_comments_docstrings_and_formatting_change_nothing(package_copy):
 
 def test_a_code_change_changes_the_stages_that_import_it(package_copy):
     before = all_fingerprints()
-    package_copy("emulator.py", "-np.expm1(-2.0 * np.pi * f_c", "-np.expm1(-6.3 * f_c")
+    package_copy("sensor/pixel.py", "two_pi_dt = 2.0 * np.pi * dt", "two_pi_dt = 6.3 * dt")
     after = all_fingerprints()
     assert {s for s in STAGES if after[s] != before[s]} == {"events"}
-    # The log response is the emulator's and adaptive timing's: both stages rerun.
-    package_copy("log_response.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0")
+    # The laws are the emulator's and adaptive timing's: both stages rerun.
+    package_copy("sensor/laws.py", "KNEE_DN = 20.0", "KNEE_DN = 21.0")
     again = all_fingerprints()
     assert {s for s in STAGES if again[s] != after[s]} == {"events", "render"}
-    package_copy("shaders/terrain.frag", "void main", "// a shader comment is text, and counts\nvoid main")
+    package_copy("renderer/shaders/terrain.frag", "void main", "// a shader comment is text, and counts\nvoid main")
     assert code_fingerprint("traj2events.stages.render") != before["render"]

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from conftest import landing_bc
-from traj2events.dynamics import Dynamics
 from traj2events.formats.atomic import atomic_directory, atomic_output
 from traj2events.formats.flow import read_flo, write_flo
 from traj2events.formats.trajectory import read_trajectory, solution_attrs, vehicle_attrs, write_trajectory
-from traj2events.upsample import reintegrate, upsample
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.upsample import reintegrate, upsample
 
 
 def test_atomic_output_leaves_nothing_behind_on_failure(tmp_path):

@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from traj2events.camera import Camera
-from traj2events.frame_timing import (
+from traj2events.geometry.camera import Camera
+from traj2events.geometry.frame_timing import (
     FrameTiming,
     emulator_log,
     frame_motion,
@@ -15,7 +15,7 @@ from traj2events.frame_timing import (
     next_interval_s,
     next_render_time,
 )
-from traj2events.log_response import KNEE_DN, radiance_to_dn
+from traj2events.sensor.laws import KNEE_DN, radiance_to_dn
 
 
 def test_log_change_rate_is_the_rate_of_a_translating_image():

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from traj2events.illumination import Sun, local_sun_tan_elevation, shadow_field, sun_direction
-from traj2events.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.scene.illumination import Sun, local_sun_tan_elevation, shadow_field, sun_direction
+from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
 
 FLAT = 1e15  # radius of a Moon so large its surface is a plane
 
@@ -26,7 +26,7 @@ def test_crater_shadow_has_the_analytic_length(azimuth, elevation):
     field = shadow_field(x, x, h, sun_direction(azimuth, elevation), FLAT)
     c, s = np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))
     t = np.arange(-radius, radius, 0.02)  # along the line through the centre, toward the Sun
-    from traj2events.terrain import bilinear
+    from traj2events.scene.terrain import bilinear
 
     lit = bilinear(field.lit, (x[0], x[0]), x[1] - x[0], t * c, t * s, fill=1.0)
     measured = radius - t[lit < 0.5].min()

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from traj2events.camera import Camera, camera_motion, camera_pose
-from traj2events.motion_field import (
+from traj2events.geometry.camera import Camera, camera_motion, camera_pose
+from traj2events.geometry.motion_field import (
     MOON_RADIUS_M,
     OUT_OF_VIEW,
     SKY,
@@ -260,7 +260,7 @@ def test_one_metre_altitude_is_exact():
 def test_depth_map_field_equals_the_analytic_field_for_the_same_surface():
     # A rendered depth map of the plane must give the plane's field: the path the
     # renderer's depth will take to the terrain-true motion field.
-    from traj2events.motion_field import depth_flow
+    from traj2events.geometry.motion_field import depth_flow
 
     state = random_state(np.random.default_rng(5), altitude=300.0)
     pose = camera_pose(state)
@@ -273,7 +273,7 @@ def test_depth_map_field_equals_the_analytic_field_for_the_same_surface():
     np.testing.assert_allclose(flow[..., 1], v, rtol=1e-12, atol=1e-12)
     np.testing.assert_array_equal(terrain, h > 0)
     # The stage's compiled pass: the same field, its sky where the depth map has none.
-    from traj2events.motion_field import depth_motion
+    from traj2events.geometry.motion_field import depth_motion
 
     compiled, _, status = depth_motion(CAM, state, rigid_motion(state, 0.01), depth, dtype=np.float64)
     np.testing.assert_allclose(compiled[..., 0], u, rtol=1e-12, atol=1e-12)
@@ -285,7 +285,7 @@ def test_depth_map_field_equals_the_analytic_field_for_the_same_surface():
 def test_one_pass_kernel_gives_the_numpy_field_and_the_displacement_bit_for_bit(seed):
     """sphere_motion and depth_motion: the float64 numpy field and displacement, rounded
     once to the stored float32 (the stage used to compute the flow in float32 arithmetic)."""
-    from traj2events.motion_field import depth_displacement, depth_flow, depth_motion
+    from traj2events.geometry.motion_field import depth_displacement, depth_flow, depth_motion
 
     rng = np.random.default_rng(20 + seed)
     cam = Camera(96, 64, 50.0)
@@ -329,7 +329,7 @@ def plate_scene_depth(camera, camera_x_m, altitude_m=100.0, plate=(-10.0, 10.0),
 
 
 def test_terrain_displacement_marks_what_a_known_occluder_hides():
-    from traj2events.motion_field import OCCLUDED, depth_displacement
+    from traj2events.geometry.motion_field import OCCLUDED, depth_displacement
 
     camera = Camera(128, 48, 60.0)
     state_k, state_next = np.zeros(13), np.zeros(13)
@@ -357,7 +357,7 @@ def test_first_corner_prefilter_never_skips_a_point_the_full_occlusion_test_flag
     """The branch-free row test run before `_behind_nearer` must be a necessary condition
     for it (else occluded points would go unflagged), for points in and out of view,
     near the borders, behind nearer and farther surfaces, and with NaN coordinates."""
-    from traj2events.motion_field import _behind_nearer, _first_corner_nearer_row
+    from traj2events.geometry.motion_pass import _behind_nearer, _first_corner_nearer_row
 
     rng = np.random.default_rng(5)
     height, width, rel_tol = 12, 16, 0.01
@@ -382,7 +382,7 @@ def test_first_corner_prefilter_never_skips_a_point_the_full_occlusion_test_flag
 
 
 def test_sphere_displacement_marks_sky_out_of_view_and_beyond_the_limb():
-    from traj2events.motion_field import OCCLUDED, SKY, local_vertical
+    from traj2events.geometry.motion_field import OCCLUDED, SKY, local_vertical
 
     radius = 1_737_400.0
     state_k = np.zeros(13)
@@ -417,7 +417,7 @@ def test_sphere_displacement_marks_sky_out_of_view_and_beyond_the_limb():
 
 
 def test_field_difference_by_hand():
-    from traj2events.motion_field import field_difference
+    from traj2events.geometry.motion_field import field_difference
 
     a = np.zeros((4, 5, 2), np.float32)
     b = a.copy()

@@ -4,8 +4,8 @@
 import numpy as np
 import pytest
 
-from traj2events.motion_stats import excursion_deg, motion_summary, pitch_rise_deg, travel_per_drop
-from traj2events.state import PITCH, ROLL, YAW
+from traj2events.trajectory.motion_stats import excursion_deg, motion_summary, pitch_rise_deg, travel_per_drop
+from traj2events.trajectory.state import PITCH, ROLL, YAW
 
 
 def test_pitch_rise_is_the_largest_climb_above_the_running_minimum():
@@ -40,10 +40,10 @@ def test_the_default_vehicle_brakes_without_riding_the_tilt_limit(tmp_path):
     """With the agile vehicle (config/vehicle-agile.yaml) braking samples pitch up to the
     80 deg tilt limit in 11 of 12 and roll and yaw swing ~9 deg; the default's attitude
     authority (132 N m) keeps them below it, with roll and yaw swings of tens of degrees."""
-    from traj2events.batch import solve_samples
     from traj2events.config import resolve_config
-    from traj2events.scenarios import ScenarioSettings
     from traj2events.stages.base_solution import solve_base
+    from traj2events.trajectory.batch import solve_samples
+    from traj2events.trajectory.scenarios import ScenarioSettings
 
     config = resolve_config(
         {"ocp": {"n_nodes": 30, "refine_n_nodes": 60}, "scenarios": {"braking": {"n_trajectories": 4}}}
@@ -61,13 +61,13 @@ def test_braking_pitch_keeps_decreasing_only_where_the_scenario_asks():
     """Mass-optimal braking pitches up by ~20 deg while it coasts; with
     scenarios.braking.pitch_decreasing (the default) the pitch never rises, at the nodes
     and along the re-integrated flight between them, for a few kg of fuel."""
-    from traj2events.batch import solve_samples
     from traj2events.config import resolve_config
-    from traj2events.dynamics import Dynamics
-    from traj2events.scenarios import ScenarioSettings
     from traj2events.stages.base_solution import solve_base
-    from traj2events.state import MASS
-    from traj2events.upsample import ReintegratedStates
+    from traj2events.trajectory.batch import solve_samples
+    from traj2events.trajectory.dynamics import Dynamics
+    from traj2events.trajectory.scenarios import ScenarioSettings
+    from traj2events.trajectory.state import MASS
+    from traj2events.trajectory.upsample import ReintegratedStates
 
     fuel, rise = {}, {}
     for decreasing in (False, True):

@@ -5,9 +5,9 @@ import pytest
 
 from conftest import ROOT, landing_bc
 from traj2events.config import load_config
-from traj2events.dynamics import Dynamics, Vehicle
-from traj2events.ocp import FINAL_FIXED, LandingProblem, OcpSettings, node_fractions
-from traj2events.upsample import final_state_error, interpolate_controls
+from traj2events.trajectory.dynamics import Dynamics, Vehicle
+from traj2events.trajectory.ocp import FINAL_FIXED, LandingProblem, OcpSettings, node_fractions
+from traj2events.trajectory.upsample import final_state_error, interpolate_controls
 
 
 def max_tilt_deg(sol):

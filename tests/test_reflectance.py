@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from traj2events.reflectance import (
+from traj2events.scene.reflectance import (
     ReflectanceParams,
     chandrasekhar_h,
     hapke_radiance_factor,
@@ -47,7 +47,7 @@ def test_dark_where_the_sun_or_camera_is_below_the_surface():
 
 
 def test_hapke_phase_function_has_the_published_values():
-    from traj2events.reflectance import hapke_phase
+    from traj2events.scene.reflectance import hapke_phase
 
     # Worked by hand from P(g) = (1+c)/2 (1-b^2)/(1-2b cos g+b^2)^1.5 + (1-c)/2 (1-b^2)/(1+2b cos g+b^2)^1.5,
     # b = c = 0.5: at g = 0, 0.75 * 0.75/0.125 + 0.25 * 0.75/3.375 = 41/9; at g = 180 deg, 5/3;
@@ -61,7 +61,7 @@ def test_hapke_phase_function_has_the_published_values():
 
 @pytest.mark.parametrize("b, c", [(0.26, 0.4), (0.5, -0.3), (0.0, 0.0)])
 def test_hapke_phase_function_is_normalised(b, c):
-    from traj2events.reflectance import hapke_phase
+    from traj2events.scene.reflectance import hapke_phase
 
     # (1/4 pi) integral of P over the sphere = (1/2) integral of P(g) sin g dg over [0, pi] = 1.
     g = np.linspace(0.0, np.pi, 200_001)

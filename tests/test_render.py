@@ -8,13 +8,20 @@ import sys
 import numpy as np
 import pytest
 
-from traj2events import render as render_module
-from traj2events.camera import Camera, CameraPose, camera_pose
-from traj2events.illumination import Sun
-from traj2events.reflectance import ReflectanceParams, angles, radiance_factor
-from traj2events.render import TerrainRenderer, _check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
-from traj2events.terrain import GridTerrain, ProceduralTerrain, TerrainParams, fresh_crater_profile, surface_points
-from traj2events.tiles import LodSettings, TileSet
+from traj2events.geometry.camera import Camera, CameraPose, camera_pose
+from traj2events.renderer import draw as render_module
+from traj2events.renderer.context import check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.illumination import Sun
+from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.scene.terrain import (
+    GridTerrain,
+    ProceduralTerrain,
+    TerrainParams,
+    fresh_crater_profile,
+    surface_points,
+)
+from traj2events.scene.tiles import LodSettings, TileSet
 
 R_MOON = 1737400.0
 SUN = Sun(1.496e11, 105.0, 7.0)
@@ -64,10 +71,10 @@ def test_pyrender_workarounds_are_in_place(monkeypatch):
     import OpenGL
 
     assert np.infty == np.inf
-    _check_pyopengl()
+    check_pyopengl()
     monkeypatch.setattr(OpenGL, "__version__", "3.1.0")
     with pytest.raises(RuntimeError, match="PyOpenGL>=3.1.5"):
-        _check_pyopengl()
+        check_pyopengl()
 
 
 def test_auto_backend_takes_the_first_egl_device_that_is_not_software():
@@ -92,12 +99,12 @@ def test_a_process_bound_to_osmesa_refuses_egl():
 _EGL_SCENE = """
 import sys
 import numpy as np
-from traj2events.camera import Camera, camera_pose
-from traj2events.illumination import Sun
-from traj2events.reflectance import ReflectanceParams
-from traj2events.render import TerrainRenderer
-from traj2events.terrain import ProceduralTerrain, TerrainParams
-from traj2events.tiles import TileSet
+from traj2events.geometry.camera import Camera, camera_pose
+from traj2events.scene.illumination import Sun
+from traj2events.scene.reflectance import ReflectanceParams
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+from traj2events.scene.tiles import TileSet
 sun = Sun(1.496e11, 105.0, 7.0)
 s = np.zeros(13); s[:3] = 0, 0, -800.0; s[6:9] = np.radians([0, 40.0, 10.0]); s[12] = 1e4
 tiles = TileSet(ProceduralTerrain(TerrainParams(seed=3)), sun.direction, 1737400.0, 140e3)
@@ -159,8 +166,8 @@ def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
     depth_render = frame.depth_m[rows.ravel(), cols.ravel()]
     assert np.all(np.isfinite(depth_cast)) and depth_cast.min() > 4000
     # Radiance stays within what the law allows (the shader clamps sliver-triangle extrapolation).
-    from traj2events.reflectance import ReflectanceParams as Params
-    from traj2events.reflectance import max_radiance_factor
+    from traj2events.scene.reflectance import ReflectanceParams as Params
+    from traj2events.scene.reflectance import max_radiance_factor
 
     assert (
         0 <= frame.radiance.min()
@@ -349,7 +356,7 @@ def test_rendered_regolith_backscatters():
 
 
 def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
-    from traj2events.stars import StarField
+    from traj2events.scene.stars import StarField
 
     camera = Camera(64, 64, 45.0)
     pose = camera_pose(state(x=-5000.0, altitude=2000.0, pitch=80.0))  # horizon across the image
@@ -392,13 +399,13 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
 @pytest.mark.parametrize("w, r0", [(0.36, 1.0 / 9.0), (0.75, 1.0 / 3.0), (0.0, 0.0), (1.0, 1.0)])
 def test_hapke_r0_for_the_shaders_is_the_published_formula(w, r0):
     """r0 = (1 - g) / (1 + g), g = sqrt(1 - w): g = 0.8 and 0.5 by hand, and the limits."""
-    from traj2events.render import hapke_r0_float32
+    from traj2events.renderer.draw import hapke_r0_float32
 
     assert hapke_r0_float32(w) == pytest.approx(r0, rel=1e-6, abs=1e-7)
 
 
 def test_shaders_take_the_reflectance_law_from_one_file():
-    from traj2events.render import expand_includes, shader_source
+    from traj2events.renderer.draw import expand_includes, shader_source
 
     vertex = shader_source("terrain.vert")
     assert "#include" not in vertex and vertex.count("float reflectance_factor(") == 1

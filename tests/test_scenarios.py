@@ -7,8 +7,8 @@ import pytest
 
 from conftest import ROOT, landing_bc
 from traj2events.config import load_config
-from traj2events.ocp import Solution
-from traj2events.scenarios import (
+from traj2events.trajectory.ocp import Solution
+from traj2events.trajectory.scenarios import (
     RANGE_KEYS,
     Acceptance,
     Scenario,
@@ -145,9 +145,9 @@ def test_the_default_descent_is_near_ventral(tmp_path):
     a quarter of the altitude lost (the earlier ranges gave 0.3-8)."""
     from traj2events.config import resolve_config
     from traj2events.formats.trajectory import read_solution_set
-    from traj2events.motion_stats import travel_per_drop
     from traj2events.stages.base_solution import base_solution
     from traj2events.stages.sample_trajectories import sample_trajectories
+    from traj2events.trajectory.motion_stats import travel_per_drop
 
     config = resolve_config(
         {"ocp": {"n_nodes": 30, "refine_n_nodes": 60}, "scenarios": {"descent": {"n_trajectories": 4}}}

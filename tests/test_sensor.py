@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from traj2events.defaults import section
-from traj2events.log_response import KNEE_DN
-from traj2events.sensor import SensorParams, photocurrent_a, sensor_dn, solar_band
+from traj2events.sensor.laws import KNEE_DN
+from traj2events.sensor.photocurrent import SensorParams, photocurrent_a, sensor_dn, solar_band
 
 Q, H, C, K = 1.602176634e-19, 6.62607015e-34, 299792458.0, 1.380649e-23
 
@@ -76,7 +76,7 @@ def test_unknown_sensor_key_is_named():
 
 
 def test_the_emulator_white_is_the_radiance_at_255_dn_on_either_scale():
-    from traj2events.sensor import emulator_white_w_m2_sr
+    from traj2events.sensor.photocurrent import emulator_white_w_m2_sr
 
     events = section("events")
     assert emulator_white_w_m2_sr({**events, "input": "display"}, 40.0) == 40.0

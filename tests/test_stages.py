@@ -7,11 +7,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from traj2events.camera import Camera
 from traj2events.config import resolve_config
 from traj2events.formats.events import read_events
 from traj2events.formats.trajectory import read_solution_set, read_trajectory
-from traj2events.scenarios import ScenarioSettings
+from traj2events.geometry.camera import Camera
 from traj2events.stages import pictures
 from traj2events.stages.base_solution import BaseSolveError, base_solution
 from traj2events.stages.camera_poses import camera_poses
@@ -21,7 +20,8 @@ from traj2events.stages.motion_field import motion_field
 from traj2events.stages.render import RenderSettings, render_trajectory
 from traj2events.stages.sample_trajectories import SAMPLE_TABLE_COLUMNS, initial_values, sample_trajectories
 from traj2events.stages.summary import dataset_summary
-from traj2events.state import MASS
+from traj2events.trajectory.scenarios import ScenarioSettings
+from traj2events.trajectory.state import MASS
 
 SIZE = 16
 

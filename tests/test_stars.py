@@ -4,8 +4,8 @@ splat's energy and position worked out by hand."""
 import numpy as np
 import pytest
 
-from traj2events.camera import Camera, CameraPose
-from traj2events.stars import StarField, add_stars, star_irradiance_w_m2, star_radiance, stars_brighter_than
+from traj2events.geometry.camera import Camera, CameraPose
+from traj2events.scene.stars import StarField, add_stars, star_irradiance_w_m2, star_radiance, stars_brighter_than
 
 
 def test_counts_per_magnitude_follow_the_law():

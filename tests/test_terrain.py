@@ -4,7 +4,7 @@ user grids and the curved-Moon geometry."""
 import numpy as np
 import pytest
 
-from traj2events.terrain import (
+from traj2events.scene.terrain import (
     GridTerrain,
     ProceduralTerrain,
     TerrainParams,
@@ -192,8 +192,8 @@ def test_boulders_crowd_the_ejecta_of_fresh_craters():
 def test_boulder_shadow_has_the_analytic_length():
     """A hemisphere of radius a on flat ground, Sun at elevation e: the shadow's tip lies
     a / sin(e) from its centre, straight away from the Sun."""
-    from traj2events.illumination import shadow_field, sun_direction
-    from traj2events.terrain import bilinear, boulder_profile
+    from traj2events.scene.illumination import shadow_field, sun_direction
+    from traj2events.scene.terrain import bilinear, boulder_profile
 
     a, spacing, elevation = 2.0, 0.05, 15.0
     x = np.arange(-20.0, 20.0 + spacing / 2, spacing)
@@ -231,7 +231,7 @@ def test_compiled_crater_pass_on_a_grid_equals_the_profiles_crater_by_crater():
 
 def hash_uniform(seed, stream, i, j):
     """The terrain's hashed uniforms at lattice points (i, j), element by element."""
-    from traj2events.terrain import _hash_pair, _stream_key
+    from traj2events.scene.terrain import _hash_pair, _stream_key
 
     i, j = np.broadcast_arrays(np.asarray(i).astype(np.int64), np.asarray(j).astype(np.int64))
     key = _stream_key(seed, stream)
@@ -259,7 +259,7 @@ def numpy_features_in_cells(seed, stream, lam, ix, iy):
 def test_features_per_cell_are_poisson_and_equal_the_numpy_reference(lam):
     """Counts per cell: the numpy reference's, bit for bit, with Poisson's mean and
     variance lam (capped at 51 where lam is large); the features' uniforms the same too."""
-    from traj2events.terrain import _features_in_cells, _stream_key
+    from traj2events.scene.terrain import _features_in_cells, _stream_key
 
     ix, iy = np.arange(-40.0, 40.0), np.arange(7.0, 57.0)
     keys = np.array([_stream_key(3, 8 + s) for s in range(5)], np.uint64)
@@ -280,7 +280,7 @@ def test_features_per_cell_are_poisson_and_equal_the_numpy_reference(lam):
 def test_value_noise_passes_through_the_lattice_values_and_is_continuous():
     """At lattice points the noise is the point's hashed uniform; between them it blends
     the four corners (so it stays in [0, 1)) and is continuous across cell edges."""
-    from traj2events.terrain import _value_noise
+    from traj2events.scene.terrain import _value_noise
 
     i, j = np.meshgrid(np.arange(-5.0, 5.0), np.arange(-3.0, 4.0), indexing="ij")
     np.testing.assert_array_equal(_value_noise(4, 1000, i, j), hash_uniform(4, 1000, i, j))

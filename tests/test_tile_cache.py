@@ -6,11 +6,11 @@ import json
 import numpy as np
 import pytest
 
-from traj2events.camera import Camera, camera_pose
 from traj2events.formats.tile_cache import TileCache
-from traj2events.illumination import Sun
-from traj2events.terrain import GridTerrain, ProceduralTerrain, TerrainParams
-from traj2events.tiles import LodSettings, TileSet
+from traj2events.geometry.camera import Camera, camera_pose
+from traj2events.scene.illumination import Sun
+from traj2events.scene.terrain import GridTerrain, ProceduralTerrain, TerrainParams
+from traj2events.scene.tiles import LodSettings, TileSet
 
 R_MOON = 1737400.0
 SUN = Sun(1.496e11, 105.0, 7.0)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from traj2events.tiles import _grid_faces, long_sweep_lit
+from traj2events.scene.tiles import _grid_faces, long_sweep_lit
 
 
 def test_grid_faces_draw_each_cell_as_two_triangles_in_turn():
@@ -23,8 +23,8 @@ def test_grid_faces_draw_each_cell_as_two_triangles_in_turn():
 
 
 def _tiles(sun=(0.3, 0.4, -0.2), **lod):
-    from traj2events.terrain import ProceduralTerrain, TerrainParams
-    from traj2events.tiles import LodSettings, TileSet
+    from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+    from traj2events.scene.tiles import LodSettings, TileSet
 
     sun = np.array(sun) / np.linalg.norm(sun)
     return TileSet(ProceduralTerrain(TerrainParams(seed=3)), sun, 1737400.0, 4000.0, LodSettings(cells=8, **lod))

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from traj2events.upsample import (
+from traj2events.trajectory.upsample import (
     ATOL,
     RTOL,
     ReintegratedStates,
@@ -86,7 +86,7 @@ def test_upsample_rejects_unknown_method_and_out_of_span_times(solved30, dynamic
 
 
 def test_shooting_check_agrees_with_dop853(solved30, dynamics):
-    from traj2events.upsample import ShootingCheck, final_state_error
+    from traj2events.trajectory.upsample import ShootingCheck, final_state_error
 
     fast = ShootingCheck(dynamics)(solved30.t, solved30.state, solved30.control)
     reference = final_state_error(dynamics, solved30.t, solved30.state, solved30.control)

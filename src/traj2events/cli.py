@@ -39,16 +39,16 @@ def cmd_check_config(args) -> int:
 
 
 def cmd_base(args) -> int:
-    from .scenarios import ScenarioSettings
     from .stages.base_solution import base_solution
+    from .trajectory.scenarios import ScenarioSettings
 
     base_solution(_settings(ScenarioSettings, args.settings), args.output, record_failure=args.record_failure)
     return 0
 
 
 def cmd_sample(args) -> int:
-    from .scenarios import ScenarioSettings
     from .stages.sample_trajectories import sample_trajectories
+    from .trajectory.scenarios import ScenarioSettings
 
     if args.jobs < 1:
         raise ValueError(f"sample: --jobs: expected >= 1, got {args.jobs}")
@@ -82,7 +82,7 @@ def cmd_render(args) -> int:
 
 
 def cmd_motion_field(args) -> int:
-    from .camera import Camera
+    from .geometry.camera import Camera
     from .stages.motion_field import motion_field
 
     motion_field(
@@ -100,7 +100,7 @@ def cmd_motion_field(args) -> int:
 def _sensor(overrides: str | None):
     """events.sensor's defaults with --sensor's JSON keys (inline or @file) on top."""
     from .defaults import section
-    from .sensor import SensorParams
+    from .sensor.photocurrent import SensorParams
 
     given = {}
     if overrides:
@@ -207,7 +207,7 @@ def cmd_picture(args) -> int:
     if args.kind == "frames":
         pictures.frames_picture(args.trajectory, args.video, args.output)
     elif args.kind == "motion-field":
-        from .camera import Camera
+        from .geometry.camera import Camera
 
         pictures.motion_field_picture(
             args.trajectory,

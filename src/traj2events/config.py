@@ -71,7 +71,7 @@ def _non_finite(value: Any, path: tuple = ()) -> list[str]:
 
 
 def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
-    from .scenarios import RANGE_KEYS
+    from .trajectory.scenarios import RANGE_KEYS
 
     errors = []
     if name in RESERVED_SCENARIO_NAMES:
@@ -112,7 +112,7 @@ def _elevation_grid_error(terrain: dict) -> list[str]:
     """The user's DEM, loaded once here so that a bad file stops the run before any job."""
     if not terrain.get("elevation_grid"):
         return []
-    from .terrain import load_elevation_grid
+    from .scene.terrain import load_elevation_grid
 
     try:
         load_elevation_grid(terrain["elevation_grid"], terrain.get("grid_spacing_m"))
@@ -164,7 +164,7 @@ def _semantic_errors(config: dict) -> list[str]:
 
 def _timing_errors(timing: dict) -> list[str]:
     """FrameTiming's own checks (the render job would fail on them), before any job starts."""
-    from .frame_timing import FrameTiming
+    from .geometry.frame_timing import FrameTiming
 
     try:
         FrameTiming(**timing)
@@ -176,8 +176,8 @@ def _timing_errors(timing: dict) -> list[str]:
 
 def _display_errors(config: dict) -> list[str]:
     """A display white far above any radiance the scene can have gives black videos."""
-    from .illumination import Sun
-    from .reflectance import ReflectanceParams, max_radiance_factor
+    from .scene.illumination import Sun
+    from .scene.reflectance import ReflectanceParams, max_radiance_factor
 
     factor = max_radiance_factor(ReflectanceParams(**config["render"]["reflectance"]), n=21)
     irradiance = max(Sun(**sc["sun"]).irradiance_w_m2 for sc in config["scenarios"].values())

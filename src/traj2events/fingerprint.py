@@ -87,8 +87,9 @@ def _without_docstrings(tree: ast.AST) -> ast.AST:
     return tree
 
 
-def data_files(tree: ast.AST) -> list[Path]:
-    """Package data (files, or the files of a folder) named by a string in the code; YAML excluded."""
+def data_files(tree: ast.AST, folder: Path = PACKAGE_DIR) -> list[Path]:
+    """Package data (files, or the files of a folder) named by a string in the code of a
+    module in `folder`; YAML excluded."""
     files: set[Path] = set()
     for node in ast.walk(tree):
         if (
@@ -100,7 +101,7 @@ def data_files(tree: ast.AST) -> list[Path]:
             and "\n" not in node.value
             and not node.value.startswith(".")
         ):
-            candidate = PACKAGE_DIR / node.value
+            candidate = folder / node.value
             if candidate.is_dir() and not (candidate / "__init__.py").exists():
                 files.update(p for p in candidate.iterdir() if p.is_file())
             elif candidate.is_file() and candidate.suffix not in (".py", ".yaml"):
@@ -114,6 +115,6 @@ def code_fingerprint(name: str) -> str:
     for module in import_closure(name):
         tree = ast.parse(module_path(module).read_text())
         digest.update(module.encode() + b"\0" + ast.dump(_without_docstrings(tree)).encode() + b"\0")
-        for path in data_files(tree):
+        for path in data_files(tree, module_path(module).parent):
             digest.update(path.relative_to(PACKAGE_DIR).as_posix().encode() + b"\0" + path.read_bytes())
     return digest.hexdigest()[:16]

@@ -13,7 +13,7 @@ from snakemake.settings.types import DeploymentMethod
 from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
 from traj2events.plan import dataset_plan, job_resources
-from traj2events.scenarios import ScenarioSettings
+from traj2events.trajectory.scenarios import ScenarioSettings
 from traj2events.stages.render import RenderSettings
 
 try:

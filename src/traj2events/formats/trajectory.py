@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from ..state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, STATE_NAMES, STATE_UNITS
+from ..trajectory.state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, STATE_NAMES, STATE_UNITS
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, plain, set_attrs, write_dataset
 
@@ -81,7 +81,7 @@ class Trajectory:
     @property
     def vehicle(self):
         """The vehicle.Vehicle of the root attributes (to re-integrate the dynamics)."""
-        from ..vehicle import Vehicle
+        from ..trajectory.vehicle import Vehicle
 
         return Vehicle(
             **{k: (tuple(self.attrs[k]) if k == "inertia_kgm2" else float(self.attrs[k])) for k in VEHICLE_KEYS}

@@ -8,9 +8,9 @@ from dataclasses import replace
 
 from .. import __version__
 from ..formats.trajectory import solution_attrs, vehicle_attrs, write_trajectory
-from ..ocp import LandingProblem, Solution, replace_tf_guess
 from ..progress import log
-from ..scenarios import ScenarioSettings, base_conditions
+from ..trajectory.ocp import LandingProblem, Solution, replace_tf_guess
+from ..trajectory.scenarios import ScenarioSettings, base_conditions
 
 # A cold start is robust (docs/trajectories.md); other t_f guesses are the retries.
 TF_GUESS_FACTORS = (1.0, 0.5, 2.0)

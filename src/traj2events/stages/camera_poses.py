@@ -6,11 +6,11 @@ from __future__ import annotations
 import os
 
 from .. import __version__
-from ..dynamics import Dynamics
 from ..formats.trajectory import read_solution_set, vehicle_attrs, write_trajectory
 from ..progress import log
-from ..scenarios import ScenarioSettings
-from ..upsample import upsample
+from ..trajectory.dynamics import Dynamics
+from ..trajectory.scenarios import ScenarioSettings
+from ..trajectory.upsample import upsample
 
 # Solve facts copied from solutions.h5 into each trajectory.h5 (so it stands alone).
 SOLVE_ATTRS = ("initial_state", "final_state", "transcription", "N", "solver_status", "iterations", "solve_time_s",

@@ -3,7 +3,7 @@ images) and write events.h5, plus the exports the config asks for.
 
 Inputs, each read in chunks so memory stays bounded:
     frames.h5        linear radiance as photocurrent through the sensor model (the HDR path;
-                     src/traj2events/sensor.py), or on the videos' display scale
+                     src/traj2events/sensor/photocurrent.py), or on the videos' display scale
     a video          8-bit grey, as v2e reads it
     a folder         8-bit grey images, sorted by name (needs the frame rate)
 """
@@ -19,16 +19,16 @@ from typing import Generator
 import numpy as np
 
 from .. import __version__
-from ..emulator import PRESETS, EmulatorParams, EventEmulator
 from ..formats.events import MAX_T_US, EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
-from ..log_response import display_dn_per_radiance
 from ..progress import log
 from ..read_ahead import read_ahead
-from ..sensor import SensorParams, dn_per_radiance
-from ..state import BODY_RATES
+from ..sensor.emulator import PRESETS, EmulatorParams, EventEmulator
+from ..sensor.laws import display_dn_per_radiance
+from ..sensor.photocurrent import SensorParams, dn_per_radiance
+from ..trajectory.state import BODY_RATES
 from ..video import iter_video, video_info
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")

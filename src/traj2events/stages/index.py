@@ -10,7 +10,7 @@ import pandas as pd
 from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_trajectory
 from ..progress import log
-from ..state import MASS
+from ..trajectory.state import MASS
 from .summary import read_sample_table
 
 

@@ -10,13 +10,13 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
-from ..camera import Camera
 from ..formats.atomic import atomic_directory
 from ..formats.flow import motion_field_file, write_flo
 from ..formats.frames import FramesFile
 from ..formats.hdf5 import set_attrs, write_dataset
 from ..formats.trajectory import read_trajectory
-from ..motion_field import (
+from ..geometry.camera import Camera
+from ..geometry.motion_field import (
     OCCLUDED,
     OUT_OF_VIEW,
     SKY,

@@ -8,12 +8,12 @@ import os
 
 import numpy as np
 
-from ..camera import Camera
 from ..figures import dataset_figure, event_frame, event_mosaic, frame_mosaic, motion_field_mosaic
 from ..formats.atomic import atomic_output
 from ..formats.events import read_events_attrs, read_events_window
 from ..formats.trajectory import read_solution_set, read_trajectory
-from ..motion_field import sphere_flow
+from ..geometry.camera import Camera
+from ..geometry.motion_field import sphere_flow
 from ..video import read_video
 
 PAPER_FRACTIONS = (0.0, 0.25, 0.5, 0.75, 1.0)  # of t_f: the paper's five times

@@ -16,21 +16,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import __version__
-from ..camera import Camera
-from ..dynamics import Dynamics
 from ..formats.frames import FramesWriter
 from ..formats.trajectory import read_trajectory
-from ..frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
-from ..illumination import Sun
+from ..geometry.camera import Camera
+from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
-from ..reflectance import ReflectanceParams
-from ..render import TerrainRenderer
-from ..sensor import emulator_white_w_m2_sr
-from ..stars import StarField
-from ..state import POSE
-from ..terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
-from ..tiles import LodSettings, TileSet
-from ..upsample import ReintegratedStates
+from ..renderer.draw import TerrainRenderer
+from ..scene.illumination import Sun
+from ..scene.reflectance import ReflectanceParams
+from ..scene.stars import StarField
+from ..scene.terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
+from ..scene.tiles import LodSettings, TileSet
+from ..sensor.photocurrent import emulator_white_w_m2_sr
+from ..trajectory.dynamics import Dynamics
+from ..trajectory.state import POSE
+from ..trajectory.upsample import ReintegratedStates
 from ..video import VideoWriter, display_frame
 
 
@@ -176,7 +176,7 @@ def render_trajectory(
 ) -> None:
     """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv and, unless
     `preview` is None, preview.mp4 (render.preview; its H.264 encoder costs CPU: docs/benchmarks.md).
-    `backend`: the OpenGL backend (render.resolve_backend); `tile_cache`: a folder where
+    `backend`: the OpenGL backend (renderer.context.resolve_backend); `tile_cache`: a folder where
     tile heights are shared with other jobs (formats/tile_cache.py). Neither changes the scene."""
     s = settings
     tr = read_trajectory(trajectory)

@@ -14,13 +14,13 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
-from ..batch import print_progress, solve_samples
 from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_trajectory, solution_attrs, write_solution_set
-from ..ocp import Solution
 from ..progress import log
-from ..scenarios import RANGE_KEYS, SampleResult, ScenarioSettings, base_conditions
-from ..state import ATTITUDE, MASS, POSITION, VELOCITY
+from ..trajectory.batch import print_progress, solve_samples
+from ..trajectory.ocp import Solution
+from ..trajectory.scenarios import RANGE_KEYS, SampleResult, ScenarioSettings, base_conditions
+from ..trajectory.state import ATTITUDE, MASS, POSITION, VELOCITY
 
 
 def initial_values(x0: np.ndarray) -> dict:

@@ -37,7 +37,7 @@ from typing import Protocol
 import numpy as np
 from numba import njit
 
-from .defaults import section
+from ..defaults import section
 
 _TERRAIN = section("terrain")
 

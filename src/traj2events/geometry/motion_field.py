@@ -16,16 +16,14 @@ compare against) re-projects each pixel's surface point at frame k into frame k+
 Arrays: x_s is a row (1, W) and y_s a column (H, 1); terms that depend on one of them
 only are computed on the row or column and broadcast, which keeps a 1024 x 1024 field to
 a handful of full-size operations. The motion-field stage computes a field's flow, exact
-displacement and each pixel's status in one compiled pass (numba, `_motion_pixels`,
-`sphere_motion` and `depth_motion`): the same float64 operations, in the same order, as
-the numpy expressions (bit for bit in float64); per 1024^2 field 11-12 ms over the sphere
-and 14-16 ms from a depth map (docs/benchmarks.md).
+displacement and each pixel's status in one compiled pass (`sphere_motion` and
+`depth_motion`, whose machinery is `motion_pass`): the same float64 operations, in the
+same order, as the numpy expressions here (bit for bit in float64).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from .camera import Camera
 
@@ -160,23 +158,9 @@ def depth_flow(camera: Camera, state: np.ndarray, depth_m: np.ndarray) -> tuple[
 def field_difference(flow_a: np.ndarray, flow_b: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, float]:
     """Mean (u, v) and RMS length of flow_a - flow_b (H, W, 2) over the mask's pixels (NaN
     where the mask is empty), accumulated in float64 in one pass."""
-    return _difference_sums(flow_a, flow_b, mask)
+    from .motion_pass import difference_sums
 
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _difference_sums(flow_a, flow_b, mask):
-    su = sv = s2 = 0.0
-    n = 0
-    for i in range(mask.shape[0]):
-        for j in range(mask.shape[1]):
-            if mask[i, j]:
-                du = np.float64(flow_a[i, j, 0]) - np.float64(flow_b[i, j, 0])
-                dv = np.float64(flow_a[i, j, 1]) - np.float64(flow_b[i, j, 1])
-                su += du
-                sv += dv
-                s2 += du * du + dv * dv
-                n += 1
-    return np.array([su / n, sv / n]), np.sqrt(s2 / n)  # n = 0: NaN (numpy error model)
+    return difference_sums(flow_a, flow_b, mask)
 
 
 # Status of each pixel of a displacement field (motion_field.h5 `status_*`, uint8): where
@@ -195,7 +179,7 @@ def sphere_displacement(
     """Exact displacement (H, W, 2) in px from frame k to frame k+1 over the sphere, and
     each pixel's status (H, W) uint8: VISIBLE, OUT_OF_VIEW, OCCLUDED (beyond the limb
     seen from camera k+1), BEHIND_CAMERA or SKY. Sky pixels move as directions at infinity
-    (rotation only). float64, in one compiled pass (`_motion_pixels`) with the sphere's
+    (rotation only). float64, in one compiled pass (`motion_pass`) with the sphere's
     inverse depth (`inverse_depth_sphere`'s formula) computed per pixel."""
     _, displacement, status = sphere_motion(camera, state_k, state_next, radius_m, np.float64, with_flow=False)
     return displacement, status
@@ -221,7 +205,9 @@ def sphere_motion(
     q = pose_next.rotation.T @ (pose_next.position - np.array([0.0, 0.0, radius_m]))
     sphere = np.array([*normal, radius_m + height, height * (2.0 * radius_m + height), float(height > 0)])
     rates = _rates(camera, state_k) if with_flow else None
-    return _motion(camera, pose_k, pose_next, _NO_DEPTH, sphere, q, _NO_DEPTH, 0.0, rates, dtype)
+    from .motion_pass import fused_motion
+
+    return fused_motion(camera, pose_k, pose_next, _NO_DEPTH, sphere, q, _NO_DEPTH, 0.0, rates, dtype)
 
 
 def depth_displacement(
@@ -238,7 +224,7 @@ def depth_displacement(
     every pixel around where it lands at k+1 shows something nearer than its own depth by
     more than `rel_tol` (relative: the rasteriser interpolates depth across edges; sky
     counts as infinitely far: it hides nothing); without it occlusion is not checked.
-    float64, in one compiled pass (`_motion_pixels`)."""
+    float64, in one compiled pass (`motion_pass`)."""
     _, displacement, status = depth_motion(
         camera, state_k, state_next, depth_m, depth_next_m, rel_tol, np.float64, with_flow=False
     )
@@ -263,7 +249,9 @@ def depth_motion(
     depth_next = _NO_DEPTH if depth_next_m is None else np.asarray(depth_next_m)
     pose_k, pose_next = camera.pose(state_k), camera.pose(state_next)
     rates = _rates(camera, state_k) if with_flow else None
-    return _motion(camera, pose_k, pose_next, depth, _NO_SPHERE, _NO_SPHERE, depth_next, rel_tol, rates, dtype)
+    from .motion_pass import fused_motion
+
+    return fused_motion(camera, pose_k, pose_next, depth, _NO_SPHERE, _NO_SPHERE, depth_next, rel_tol, rates, dtype)
 
 
 _NO_DEPTH = np.empty((0, 0))
@@ -274,192 +262,3 @@ def _rates(camera: Camera, state: np.ndarray) -> np.ndarray:
     """(v_cx, v_cy, v_cz, p, q, r): the camera's velocity (m/s) and body rates (rad/s), camera frame."""
     v_c, omega = camera.motion(state)
     return np.concatenate([v_c, omega]).astype(np.float64)
-
-
-def _motion(camera: Camera, pose_k, pose_next, depth, sphere, q, depth_next, rel_tol: float, rates, dtype):
-    """(flow (H, W, 2) px/s or empty, displacement (H, W, 2) px, status (H, W) uint8) of
-    frame k's pixels: their surface from the depth map `depth` or, when it is empty, from
-    the sphere `sphere` (normal (3), R + H, K, above); occlusion from `q` (the sphere's
-    limb) or from frame k+1's depth map `depth_next` (neither: not checked); the flow
-    from the camera's `rates` (None: not computed)."""
-    x_s, y_s = camera.pixel_coordinates(np.float64)
-    x_s, y_s = x_s[0], y_s[:, 0]
-    f = camera.focal_px
-    # A ray's direction in camera k+1's frame is M (a, b, 1), M = R_next^T R_k; camera k's
-    # position in frame k+1 is the shift (small numbers: no loss to the Moon's radius).
-    m = pose_next.rotation.T @ pose_k.rotation
-    shift = pose_next.rotation.T @ (pose_k.position - pose_next.position)
-    shape = (camera.height, camera.width)
-    flow = np.empty((*shape, 2) if rates is not None else (0, 0, 2), dtype)
-    displacement = np.empty((*shape, 2), dtype)
-    status = np.empty(shape, np.uint8)
-    rates = np.zeros(6) if rates is None else rates
-    _motion_pixels(
-        x_s / f,
-        y_s / f,
-        depth,
-        sphere,
-        m,
-        shift,
-        q,
-        depth_next,
-        rel_tol,
-        f,
-        x_s,
-        y_s,
-        rates,
-        # (H, 2 W) views: (u, v) pairs along a row, a stride of 2 the compiler knows
-        flow.reshape(flow.shape[0], 2 * flow.shape[1]),
-        displacement.reshape(shape[0], 2 * shape[1]),
-        status,
-    )
-    return flow, displacement, status
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _motion_pixels(
-    a_cols,
-    b_rows,
-    depth,
-    sphere,
-    m,
-    shift,
-    q,
-    depth_next,
-    rel_tol,
-    f,
-    x_cols,
-    y_rows,
-    rates,
-    flow,
-    displacement,
-    status,
-):
-    """Row by row (ray (a, b, 1) per column and row): the inverse depth h (1 / depth where
-    that is a positive finite number, else 0; or the sphere's near root, as
-    `inverse_depth_sphere`), the point relative to camera k+1 (a direction where h = 0),
-    its projection, the instantaneous flow (`motion_field`'s formula, when flow is not
-    empty), and the status, the first that applies of SKY, BEHIND_CAMERA, OCCLUDED,
-    OUT_OF_VIEW, VISIBLE. Float64 throughout, in the same operations and order as the
-    numpy expressions. The arithmetic loops are branch-free and write row buffers so that
-    LLVM vectorises them (2.5x the single per-pixel loop); only the status loop branches.
-    flow and displacement come as (H, 2 W) views, (u, v) pairs along each row."""
-    width, height = a_cols.size, b_rows.size
-    from_depth, limb, from_next = depth.size > 0, q.size > 0, depth_next.size > 0
-    above = sphere.size > 0 and sphere[5] > 0.0  # camera above the sphere's surface
-    vx, vy, vz, p, q_rate, r = rates[0], rates[1], rates[2], rates[3], rates[4], rates[5]
-    m00, m01, m02, m10, m11, m12, m20, m21, m22 = m.ravel()
-    # h, the point (x, y, z) at k+1, displacement (u, v), flow (u, v), maybe occluded
-    rows = np.zeros((9, width))
-    h_row, x_row, y_row, z_row, u_row, v_row = rows[0], rows[1], rows[2], rows[3], rows[4], rows[5]
-    flow_u_row, flow_v_row, maybe_row = rows[6], rows[7], rows[8]
-    for i in range(height):
-        b, y_s = b_rows[i], y_rows[i]
-        if from_depth:
-            _inverse_depth_row(depth[i], h_row)
-        elif above:
-            _sphere_row(a_cols, b, sphere[0], sphere[1], sphere[2], sphere[3], sphere[4], h_row)
-        for j in range(width):
-            a, h = a_cols[j], h_row[j]
-            dx = (m00 * a + m01 * b) + m02
-            dy = (m10 * a + m11 * b) + m12
-            dz = (m20 * a + m21 * b) + m22
-            depth_k, hit = 1.0 / h, h > 0.0
-            x = depth_k * dx + shift[0] if hit else dx
-            y = depth_k * dy + shift[1] if hit else dy
-            z = depth_k * dz + shift[2] if hit else dz
-            x_row[j], y_row[j], z_row[j] = x, y, z
-            u_row[j] = f * x / z - x_cols[j]
-            v_row[j] = f * y / z - y_s
-        for j in range(width):  # both components in one loop: LLVM vectorises the interleaved store
-            displacement[i, 2 * j] = u_row[j]
-            displacement[i, 2 * j + 1] = v_row[j]
-        if flow.size > 0:
-            for j in range(width):
-                h, x_s = h_row[j], x_cols[j]
-                xy_over_f = x_s * (y_s / f)
-                flow_u_row[j] = h * (x_s * vz - f * vx) + (p * xy_over_f + ((-(f + x_s * x_s / f) * q_rate) + y_s * r))
-                flow_v_row[j] = h * (y_s * vz - f * vy) + (
-                    (-q_rate) * xy_over_f + (((f + y_s * y_s / f) * p) - x_s * r)
-                )
-            for j in range(width):
-                flow[i, 2 * j] = flow_u_row[j]
-                flow[i, 2 * j + 1] = flow_v_row[j]
-        if from_next:  # branch-free: whether the first pixel around the landing point is nearer
-            _first_corner_nearer_row(x_cols, u_row, y_s, v_row, z_row, depth_next, rel_tol, maybe_row)
-        for j in range(width):
-            h, x, y, z = h_row[j], x_row[j], y_row[j], z_row[j]
-            col, row = x_cols[j] + u_row[j], y_s + v_row[j]  # centred coordinates at k+1
-            if not h > 0.0:
-                status[i, j] = SKY
-            elif not z > 0.0:
-                status[i, j] = BEHIND_CAMERA
-            elif limb and not -(x * (x + q[0]) + y * (y + q[1]) + z * (z + q[2])) > 0.0:
-                status[i, j] = OCCLUDED  # beyond the sphere's limb seen from camera k+1
-            elif from_next and maybe_row[j] > 0.0 and _behind_nearer(col, row, z, depth_next, rel_tol):
-                status[i, j] = OCCLUDED
-            elif not (abs(col) <= width / 2 and abs(row) <= height / 2):
-                status[i, j] = OUT_OF_VIEW
-            else:
-                status[i, j] = VISIBLE
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _inverse_depth_row(depth_row, h_row):
-    """h = 1 / depth where the depth is a positive finite number, else 0 (sky)."""
-    for j in range(depth_row.size):
-        d = np.float64(depth_row[j])
-        inverse = 1.0 / d  # computed everywhere, kept where valid: no branch
-        h_row[j] = inverse if (d > 0.0 and d < np.inf) else 0.0
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _sphere_row(a_cols, b, n_x, n_y, n_z, r_plus_h, k, h_row):
-    """`inverse_depth_sphere` along one row of rays (a, b, 1)."""
-    for j in range(a_cols.size):
-        a = a_cols[j]
-        dot = (n_x * a + n_z) + n_y * b
-        s = (a * a + 1.0) + b * b
-        disc = (r_plus_h * r_plus_h) * (dot * dot) - k * s
-        root = (r_plus_h * dot + np.sqrt(max(disc, 0.0))) / k
-        h_row[j] = root if (disc >= 0.0 and dot > 0.0) else 0.0
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _first_corner_nearer_row(x_cols, u_row, y_s, v_row, z_row, depth_next, rel_tol, maybe_row):
-    """1 where a row's point lands in view at k+1 and the first of the four pixels around
-    it (`_behind_nearer`'s first test, the same arithmetic) shows a surface nearer than it,
-    else 0: a necessary condition for `_behind_nearer`, computed without branches (the
-    per-pixel test, which mostly stops at that pixel, mispredicts)."""
-    height, width = depth_next.shape
-    for j in range(x_cols.size):
-        col = (x_cols[j] + u_row[j]) + width / 2 - 0.5
-        row = (y_s + v_row[j]) + height / 2 - 0.5
-        inside = (col > -1) & (col < width) & (row > -1) & (row < height)
-        # Clamped before the integer conversion (NaN to 0): an index for any point, used only inside.
-        col = min(col if col > 0.0 else 0.0, width - 1.0)
-        row = min(row if row > 0.0 else 0.0, height - 1.0)
-        d = np.float64(depth_next[np.int64(row), np.int64(col)])
-        nearer = (d > 0.0) & (d < z_row[j] * (1.0 - rel_tol))
-        maybe_row[j] = 1.0 if inside & nearer else 0.0
-
-
-@njit(cache=True, nogil=True, error_model="numpy")
-def _behind_nearer(col_s, row_s, z, depth_next, rel_tol):
-    """Whether a point at centred (col_s, row_s) in frame k+1, z along its boresight, lands
-    in view with all four pixels around it showing a surface nearer than it by more than
-    rel_tol (sky is infinitely far: it hides nothing)."""
-    height, width = depth_next.shape
-    col = col_s + width / 2 - 0.5  # continuous pixel index
-    row = row_s + height / 2 - 0.5
-    if not (col > -1 and col < width and row > -1 and row < height):
-        return False
-    c0 = min(max(int(np.floor(col)), 0), width - 1)
-    r0 = min(max(int(np.floor(row)), 0), height - 1)
-    c1, r1 = min(c0 + 1, width - 1), min(r0 + 1, height - 1)
-    nearer_than = z * (1.0 - rel_tol)
-    for r, c in ((r0, c0), (r0, c1), (r1, c0), (r1, c1)):
-        d = np.float64(depth_next[r, c])
-        if not (d > 0.0 and d < nearer_than):  # sky, or not nearer: a visible point stops at the first
-            return False
-    return True

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .defaults import section
-from .state import ATTITUDE, BODY_RATES, CONVENTIONS, POSITION, VELOCITY, rotation_matrix
+from ..defaults import section
+from ..trajectory.state import ATTITUDE, BODY_RATES, CONVENTIONS, POSITION, VELOCITY, rotation_matrix
 
 _CAMERA = section("camera")
 

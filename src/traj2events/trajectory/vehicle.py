@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
-from .defaults import section
+from ..defaults import section
 
 _VEHICLE = section("vehicle")
 

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass, replace
 import casadi as ca
 import numpy as np
 
-from .defaults import section
+from ..defaults import section
 from .dynamics import N_STATE, Vehicle, split_control_dynamics
 from .state import MASS_KG, PITCH, STATE_SCALE, TIME_S
 

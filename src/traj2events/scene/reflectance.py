@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .defaults import section
+from ..defaults import section
 
 MODELS = ("hapke", "lunar-lambert")
 

@@ -33,9 +33,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .camera import Camera, CameraPose
-from .defaults import section
-from .formats.tile_cache import TileCache
+from ..defaults import section
+from ..formats.tile_cache import TileCache
+from ..geometry.camera import Camera, CameraPose
 from .illumination import ShadowField, no_obstruction, shadow_field
 from .terrain import Terrain, surface_points
 
@@ -105,7 +105,7 @@ class TileSet:
     def heights_identity(self) -> dict:
         """What a tile's heights depend on: the terrain, the quadtree and the Sun's side
         (the margin's), and the terrain code."""
-        from .fingerprint import code_fingerprint
+        from ..fingerprint import code_fingerprint
 
         if not hasattr(self.terrain, "identity"):
             raise TypeError(f"tile cache: {type(self.terrain).__name__} has no identity() to key the cache by")
@@ -115,14 +115,14 @@ class TileSet:
             "cells": self.lod.cells,
             "margin": self.lod.margin,
             "sun_side": [bool(self.sun_dir[0] > 0), bool(self.sun_dir[1] > 0)],
-            "code": code_fingerprint("traj2events.terrain"),
+            "code": code_fingerprint("traj2events.scene.terrain"),
         }
 
     def shading_identity(self, levels: int) -> dict:
         """What a drawn tile's shading texture depends on: its descendants' heights, the
         exact Sun direction and the Moon's radius (their shadows and normals), where the
         quadtree ends, the levels, and the tile code (illumination and terrain with it)."""
-        from .fingerprint import code_fingerprint
+        from ..fingerprint import code_fingerprint
 
         return {
             "kind": "shading_texture",
@@ -131,7 +131,7 @@ class TileSet:
             "radius_m": float(self.radius_m),
             "min_spacing_m": float(self.lod.min_spacing_m),
             "levels": int(levels),
-            "code": code_fingerprint("traj2events.tiles"),
+            "code": code_fingerprint("traj2events.scene.tiles"),
         }
 
     def texture_disk(self, levels: int) -> TileCache | None:

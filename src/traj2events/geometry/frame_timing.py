@@ -24,8 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..sensor.laws import log_intensity_8bit, radiance_to_dn
 from .camera import Camera
-from .log_response import log_intensity_8bit, radiance_to_dn
 from .motion_field import depth_flow
 
 MODES = ("fixed", "adaptive")

@@ -1,0 +1,10 @@
+"""Geometry: the camera and what it sees move (docs/geometry.md).
+
+Read first (the model):
+    camera         the pinhole camera, its mounting and poses, frame conventions
+    motion_field   the motion field's equations in numpy: flow, exact displacement, status
+
+Machinery a reader may skip:
+    motion_pass    the same motion field in one compiled pass per field (numba), bit for bit
+    frame_timing   when to render: fixed rate, or adaptive from the predicted log change
+"""

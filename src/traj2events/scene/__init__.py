@@ -1,0 +1,12 @@
+"""The scene: the lunar surface, its light and the sky (docs/rendering.md). Nothing here
+knows of OpenGL; `renderer` draws what these modules describe.
+
+Read first (the model):
+    terrain        procedural heights: craters, boulders, a DEM when given
+    illumination   the Sun (direction, irradiance) and horizon-march shadows
+    reflectance    the Hapke law (the shaders evaluate the same law)
+    stars          the star field seen in the sky
+
+Machinery a reader may skip:
+    tiles          level of detail: a quadtree of terrain tiles chosen per frame, cached
+"""

@@ -1,0 +1,361 @@
+"""Event-camera emulator: frames -> events (docs/events.md: the model and its checks).
+
+Each pixel keeps a low-passed log intensity, a reference `base` and its last event time.
+Per frame interval [t_k, t_k+1]:
+  1. log response L(I): linear below the 20 DN knee, ln above            (laws)
+  2. first-order low-pass, bandwidth growing with I, solved exactly       (laws, pixel.advance)
+  3. per-pixel thresholds N(theta, sigma) clipped at 0.01, drawn once      (__init__)
+  4. an event wherever the filtered L, linear within the interval, crosses
+     base + theta_on or base - theta_off, timed where its own pixel crosses
+     (ESIM); base moves by one threshold per crossing                      (pixel.advance, pixel.emit)
+  5. refractory period: a crossing closer than T_ref to the pixel's last
+     event is dropped and base still moves ("drop", ESIM), or stays pending
+     and fires at the first frame after the period ("defer", v2e)          (laws, pixel.emit)
+  6. leak: base drifts down by theta_on per leak period (rate
+     R_leak 10^(0.1 N(0, 1)) per pixel, from a random phase)               (pixel.advance)
+  7. shot noise: Poisson ON/OFF events at R_shot g(I) theta_nom / theta(x);
+     a noise event resets the pixel's reference to its current signal       (_shot_noise, noise)
+  8. hot pixels: a fraction of pixels firing ON at a fixed rate            (_hot_pixel_events)
+
+Events are a numpy structured array (x, y, t, p) in tonic's convention: x column, y row
+(uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t (or, from
+`intervals(columns=True)`, a dict of those four columns). On request (`labels=True`) each
+event also gets its cause (`formats.events.EVENT_LABELS`): signal, shot noise, leak or hot
+pixel; the labels never change the events. Streaming: `EventEmulator.process` takes any
+number of frames at a time and keeps only per-pixel state, and every random draw is keyed
+by (seed, frame interval), so the output is the same bytes however the video is chunked.
+Input: 8-bit DN, or float DN-equivalents of linear radiance (radiance times `input_scale`,
+applied per pixel in float64 inside the kernels).
+
+Read this module, `pixel` (the per-pixel loop) and `laws`; the machinery behind them is
+`noise` (drawing shot noise fast), `ordering` (sorting each interval's events) and
+`parallel` (the per-pixel pass split over threads).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Iterator
+
+import numpy as np
+
+from ..formats.events import EVENT_DTYPE, HOT_PIXEL, SHOT_NOISE
+from .laws import log_intensity_8bit, lowpass_gain, shot_noise_gain
+from .noise import alias_table, noise_candidates, reset_reference
+from .ordering import assemble
+from .parallel import RangedPass, pixel_ranges
+from .pixel import advance, emit, refractory_mask
+
+
+@dataclass(frozen=True)
+class EmulatorParams:
+    """The pixel model's parameters; the defaults are the paper's Table 2 (preset "paper")."""
+
+    theta_on: float = 0.25
+    theta_off: float = 0.25
+    sigma: float = 0.03  # threshold mismatch (std of the per-pixel thresholds)
+    cutoff_hz: float = 3.0  # photoreceptor bandwidth at full scale (255 DN); 0 disables
+    refractory_s: float = 0.0
+    leak_hz: float = 0.1
+    shot_noise_hz: float = 5.0
+    hot_pixel_fraction: float = 0.0
+    hot_pixel_hz: float = 0.0
+    refractory_mode: str = "drop"  # "drop" (ESIM) or "defer" (v2e): step 5
+
+    def __post_init__(self) -> None:
+        if self.refractory_mode not in ("drop", "defer"):
+            raise ValueError(f"emulator.refractory_mode: expected 'drop' or 'defer', got {self.refractory_mode!r}")
+        for key, value in asdict(self).items():
+            if key == "refractory_mode":
+                continue
+            if not value >= 0:
+                raise ValueError(f"emulator.{key}: expected >= 0, got {value}")
+        if self.theta_on < 0.01 or self.theta_off < 0.01:
+            raise ValueError("emulator.theta_on/theta_off: expected >= 0.01")
+        if self.hot_pixel_fraction > 1:
+            raise ValueError(f"emulator.hot_pixel_fraction: expected <= 1, got {self.hot_pixel_fraction}")
+
+
+PRESETS = {
+    # The paper's Table 2.
+    "paper": EmulatorParams(),
+    # No noise, no low-pass, no mismatch: events only where the log intensity crosses.
+    "clean": EmulatorParams(theta_on=0.25, theta_off=0.25, sigma=0.0, cutoff_hz=0.0, leak_hz=0.0, shot_noise_hz=0.0),
+}
+
+
+def _rng(seed: int, *key: int) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence([seed, *key]))
+
+
+_LOG_LUT_8BIT = log_intensity_8bit(np.arange(256.0))  # every value 8-bit input can take
+_NO_TABLE = np.empty(0)
+_NO_EVENTS = (np.empty(0, np.int64), np.empty(0), np.empty(0, np.bool_))  # (pixel, t s, ON)
+
+
+class EventEmulator:
+    """Streaming emulator for frames of a fixed size; see the module docstring."""
+
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        params: EmulatorParams = PRESETS["paper"],
+        seed: int = 0,
+        labels: bool = False,
+        input_scale: float = 1.0,
+        threads: int = 1,
+    ) -> None:
+        """`labels`: also label each event with its cause (`process_with_labels`).
+        `input_scale`: the frames times this are the model's DN (e.g. radiance times
+        `sensor.dn_per_radiance`), applied per pixel in float64, so float32 frames need
+        no float64 copy; 8-bit frames with a scale of 1 use tables. `threads`: the per-pixel
+        pass split over up to this many threads (rows of at least PIXELS_PER_THREAD pixels
+        each); the same events however many."""
+        if not (input_scale > 0 and np.isfinite(input_scale)):
+            raise ValueError(f"EventEmulator: input_scale: expected a finite value > 0, got {input_scale}")
+        if not (isinstance(threads, int) and threads >= 1):
+            raise ValueError(f"EventEmulator: threads: expected an integer >= 1, got {threads!r}")
+        self.width, self.height, self.params, self.seed, self.labels = width, height, params, seed, labels
+        self.input_scale = float(input_scale)
+        n = width * height
+        rng = _rng(seed, 0)
+        self.theta_on = (
+            np.maximum(rng.normal(params.theta_on, params.sigma, n), 0.01)
+            if params.sigma
+            else np.full(n, params.theta_on)
+        )
+        self.theta_off = (
+            np.maximum(rng.normal(params.theta_off, params.sigma, n), 0.01)
+            if params.sigma
+            else np.full(n, params.theta_off)
+        )
+        self.leak_rate = params.leak_hz * 10.0 ** (0.1 * rng.standard_normal(n)) if params.leak_hz else np.zeros(n)
+        self.leak_phase = rng.uniform(0.0, 1.0, n)
+        # Shot noise per pixel scales with theta_nominal / theta(x) (frozen: computed once).
+        self._noise_theta = 0.5 * (self.theta_on + self.theta_off)
+        # Thinning majorant: g(I) at its largest (I = 0) times each pixel's theta_nom / theta(x);
+        # candidates pick their pixel by that weight (alias table), so none is wasted on it.
+        self._g_max = float(shot_noise_gain(0.0))
+        weights = params.theta_on / self._noise_theta
+        self._noise_rate_total = params.shot_noise_hz * self._g_max * float(weights.sum())
+        self._alias = alias_table(weights) if params.shot_noise_hz > 0 else None
+        hot = rng.uniform(size=n) < params.hot_pixel_fraction
+        self.hot_pixels = np.flatnonzero(hot)
+        self._filtered: np.ndarray | None = None  # low-passed log intensity at the last frame
+        self._intensity: np.ndarray | None = None  # input (DN) at the last frame
+        self._base: np.ndarray | None = None
+        self._last_event = np.full(n, -np.inf)  # s
+        # Base's drift per second, and the thresholds, in float32: less for the per-frame
+        # pass to read, and these are random draws whose last bits carry nothing.
+        self._leak_step = (self.theta_on * self.leak_rate).astype(np.float32)
+        self.theta_on, self.theta_off = self.theta_on.astype(np.float32), self.theta_off.astype(np.float32)
+        # Work arrays of the compiled kernels, reused every frame.
+        self._count = np.zeros(n, np.int64)
+        self._x0 = np.zeros(n)
+        self._x1 = np.zeros(n)
+        self._active = np.zeros(n, np.int64)
+        self._n_leak = np.zeros(n, np.int64)
+        self._leak_drift = _NO_TABLE  # unspent leak drift per pixel (labels only)
+        self._ranged_pass = RangedPass(pixel_ranges(n, threads))
+        self._t: float | None = None
+        self._interval = 0  # index of the next frame interval (keys the random draws)
+
+    def process(self, frames_dn: np.ndarray, times_s: np.ndarray) -> np.ndarray:
+        """Feed frames (K, H, W) in DN (8-bit values, or float DN-equivalents, e.g. from
+        `radiance_to_dn`), times `input_scale`, with their times (K,) in s; events up to
+        the last one."""
+        return self._joined(self.intervals(frames_dn, times_s))[0]
+
+    def process_with_labels(self, frames_dn: np.ndarray, times_s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """As `process`, and each event's label (uint8, `formats.events.EVENT_LABELS`): the
+        same events, byte for byte. Needs `labels=True` from the start."""
+        if not self.labels:
+            raise ValueError("EventEmulator: labels need labels=True when the emulator is made")
+        return self._joined(self.intervals(frames_dn, times_s))
+
+    def intervals(
+        self, frames_dn: np.ndarray, times_s: np.ndarray, columns: bool = False
+    ) -> Iterator[tuple[np.ndarray | dict[str, np.ndarray], np.ndarray | None]]:
+        """As `process` (with labels: `process_with_labels`), one frame interval's events
+        (and labels, else None) at a time: the same events, with memory for one interval's
+        events instead of the chunk's (a writer can take each as it comes). `columns`: each
+        interval's events as a dict of contiguous x, y, t, p arrays instead of a structured
+        array (the same values; EventsWriter takes either, columns ~3 ns per event faster)."""
+        frames = np.asarray(frames_dn)
+        times = np.asarray(times_s, dtype=np.float64)
+        if frames.ndim != 3 or frames.shape[1:] != (self.height, self.width) or len(times) != len(frames):
+            raise ValueError(
+                f"frames: expected (K, {self.height}, {self.width}) with K timestamps, "
+                f"got {frames.shape} and {times.shape}"
+            )
+        # min and max propagate NaN: two passes, no temporary arrays.
+        if frames.dtype.kind == "f" and frames.size and not (frames.min() >= 0 and frames.max() < np.inf):
+            bad = int(
+                np.argmax(
+                    ~np.isfinite(frames).reshape(len(frames), -1).all(axis=1)
+                    | (frames.reshape(len(frames), -1).min(axis=1) < 0)
+                )
+            )
+            raise ValueError(
+                f"frames: expected finite values >= 0 (intensity), frame {bad} of this chunk "
+                f"(t = {times[bad]:.6f} s) has NaN, inf or negative values"
+            )
+        if frames.dtype == np.uint8 and self.input_scale != 1.0:
+            frames = frames.astype(np.float32)  # scaled 8-bit: no tables (exact in float32)
+        elif frames.dtype.kind != "f" and frames.dtype != np.uint8:
+            frames = frames.astype(np.float64)
+        for frame, t in zip(frames, times):
+            # 8-bit frames stay 8-bit (the kernel reads tables); float frames are read as
+            # they are (float32 or float64) and scaled in the kernels.
+            intensity = frame.reshape(-1)
+            if self._t is None:
+                self._start(intensity, float(t))
+                continue
+            if not t > self._t:
+                raise ValueError(f"timestamps: expected strictly increasing, got {t} after {self._t}")
+            yield self._interval_events(intensity, float(t), columns)
+        if self._intensity is not None and self._intensity.base is not None:
+            self._intensity = self._intensity.copy()  # kept for the next call: not a view of this chunk
+
+    def _joined(
+        self, intervals: Iterator[tuple[np.ndarray, np.ndarray | None]]
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        chunks = list(intervals)
+        # Joined as bytes: NumPy copies the 13-byte packed records one by one, bytes in bulk (3-4x).
+        events = (
+            np.concatenate([c[0].view(np.uint8) for c in chunks]).view(EVENT_DTYPE)
+            if chunks
+            else np.empty(0, EVENT_DTYPE)
+        )
+        if not self.labels:
+            return events, None
+        return events, np.concatenate([c[1] for c in chunks]) if chunks else np.empty(0, np.uint8)
+
+    def _start(self, intensity: np.ndarray, t: float) -> None:
+        log_i = log_intensity_8bit(np.asarray(intensity, dtype=np.float64) * self.input_scale)
+        self._filtered, self._intensity, self._t = log_i.copy(), intensity, t
+        # Random leak phase: base starts a random fraction of theta_on below the signal.
+        phase_drift = self.leak_phase * self.theta_on * (self.leak_rate > 0)
+        self._base = log_i - phase_drift
+        if self.labels:  # that offset is leak drift, pending from the start
+            self._leak_drift = phase_drift.astype(np.float64)
+
+    def _advance_ranges(self, intensity0, intensity1, cutoff_hz, dt, log_lut, gain_lut) -> int:
+        """`pixel.advance` over every pixel, a range of pixels per thread; returns how many
+        pixels cross, listed in pixel order in the slots."""
+        per_pixel = (self._filtered, self._base, self.theta_on, self.theta_off, self._leak_step)
+        slots = (self._count, self._x0, self._x1, self._active)
+
+        def advance_range(start: int, stop: int) -> int:
+            r = slice(start, stop)
+            return advance(
+                intensity0[r], intensity1[r], *(a[r] for a in per_pixel), cutoff_hz, dt, self.input_scale,
+                *(a[r] for a in slots), log_lut, gain_lut, self._leak_drift[r] if self.labels else self._leak_drift,
+                self._n_leak[r], start,
+            )  # fmt: skip
+
+        return self._ranged_pass(advance_range, (*slots, self._n_leak))
+
+    def _interval_events(
+        self, intensity: np.ndarray, t1: float, columns: bool = False
+    ) -> tuple[np.ndarray | dict[str, np.ndarray], np.ndarray | None]:
+        p = self.params
+        t0, dt = self._t, t1 - self._t
+        # x = signal - base, linear in t within the interval: low-pass (exact, bandwidth from
+        # the interval's mean input), log, the leak's drift of base, crossings.
+        if intensity.dtype != self._intensity.dtype:  # 8-bit and float frames mixed: all float
+            intensity, self._intensity = intensity.astype(np.float64), self._intensity.astype(np.float64)
+        if intensity.dtype == np.uint8:
+            log_lut = _LOG_LUT_8BIT
+            gain_lut = lowpass_gain(0.5 * np.arange(511.0), p.cutoff_hz, dt)  # by I0 + I1
+        else:
+            log_lut = gain_lut = _NO_TABLE
+        n_active = self._advance_ranges(self._intensity, intensity, float(p.cutoff_hz), dt, log_lut, gain_lut)
+        n_signal = int(np.abs(self._count[:n_active]).sum())
+        self._interval += 1
+        # Noise and hot-pixel events are drawn first (the draws depend on the input alone), so
+        # that the signal's events go straight into arrays with room for them: no copy of the
+        # signal's (most of the events) to join them.
+        noise = self._shot_noise(intensity, t0, dt)
+        hot = self._hot_pixel_events(t0, dt)
+        n_room = n_signal + len(noise[0]) + len(hot[0])
+        pix = np.empty(n_room, np.int64)
+        t = np.empty(n_room, np.float64)
+        on = np.empty(n_room, np.bool_)
+        label = np.empty(n_room, np.uint8)
+        k = emit(
+            self._active,
+            n_active,
+            self._count,
+            self._x0,
+            self._x1,
+            self.theta_on,
+            self.theta_off,
+            self._base,
+            self._last_event,
+            t0,
+            dt,
+            float(p.refractory_s),
+            p.refractory_mode == "defer",
+            self._n_leak,
+            pix,
+            t,
+            on,
+            label,
+        )
+        noise = self._noise_after_signal(*noise)
+        self._intensity, self._t = intensity, t1
+        end = k
+        for part, cause in ((noise, SHOT_NOISE), (hot, HOT_PIXEL)):
+            n = len(part[0])
+            pix[end : end + n], t[end : end + n], on[end : end + n] = part
+            label[end : end + n] = cause
+            end += n
+        n_pixels = self.width * self.height
+        return assemble(
+            pix[:end], t[:end], on[:end], label[:end] if self.labels else None, self.width, n_pixels, columns
+        )
+
+    def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
+        """Mask of the events to emit (step 5): with T_ref > 0, an event closer than T_ref to
+        its pixel's previous emitted event is suppressed. `pix` grouped, `t` increasing per pixel."""
+        if self.params.refractory_s > 0:  # without one, the last event times are never needed
+            return refractory_mask(pix, t, self._last_event, float(self.params.refractory_s))
+        return np.ones(len(t), bool)
+
+    def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        p = self.params
+        if p.shot_noise_hz <= 0:
+            return _NO_EVENTS
+        rng = _rng(self.seed, 1, self._interval)
+        n = int(rng.poisson(self._noise_rate_total * dt))
+        state = np.uint64(rng.integers(0, 2**63, dtype=np.int64))
+        pix = np.empty(n, np.int64)
+        t = np.empty(n, np.float64)
+        on = np.empty(n, np.bool_)
+        k = noise_candidates(n, state, self._alias, intensity, self.input_scale, self._g_max, t0, dt, pix, t, on)
+        return pix[:k], t[:k], on[:k]
+
+    def _noise_after_signal(self, pix: np.ndarray, t: np.ndarray, on: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The interval's shot noise once its signal events are emitted: the refractory
+        period against those, and each noise event's reset of its pixel."""
+        if self.params.refractory_s > 0:
+            order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
+            pix, t, on = pix[order], t[order], on[order]
+            keep = self._refractory(pix, t)
+            pix, t, on = pix[keep], t[keep], on[keep]
+        # A noise event resets the pixel like a real one: its reference jumps to the current
+        # signal (for a real crossing that is base +- theta). Applied at the interval's end.
+        reset_reference(pix, self._base, self._filtered, self._leak_drift)
+        return pix, t, on
+
+    def _hot_pixel_events(self, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        p = self.params
+        if not len(self.hot_pixels) or p.hot_pixel_hz <= 0:
+            return _NO_EVENTS
+        rng = _rng(self.seed, 2, self._interval)
+        counts = rng.poisson(p.hot_pixel_hz * dt, len(self.hot_pixels))
+        pix = np.repeat(self.hot_pixels, counts)
+        t = t0 + dt * rng.uniform(size=len(pix))
+        return pix.astype(np.int64), t, np.ones(len(pix), np.bool_)
