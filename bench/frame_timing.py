@@ -42,7 +42,7 @@ Poses at every time come from the re-integrated dynamics (upsample.ReintegratedS
 size, with the tiles and textures chosen for the frame's own size (the same scene), and
 averaged over each pixel's S x S block, as a pixel's area integrates the light:
 the renderer point-samples, and sub-pixel relief and shadows near the horizon flip whole
-pixels between lit and dark from one 0.5 ms step to the next (docs/benchmarks.md). Those
+pixels between lit and dark from one 0.5 ms step to the next (docs/performance.md). Those
 events no frame timing can place; averaging separates them from what timing can fix.
 """
 

@@ -61,7 +61,7 @@ def timed(log: list[float], function):
 
 
 # Probes of the textured fragment shader: (committed text, replacement), each taking one
-# part out; together they split a frame's time (docs/benchmarks.md, session 22).
+# part out; together they split a frame's time (docs/performance.md).
 _LAW = "    float rf = reflectance_factor_of_phase(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
 _BODY = _LAW.join(
     [

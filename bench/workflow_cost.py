@@ -16,7 +16,7 @@ once untimed on the first clip first, so that no timed run compiles kernels. Dis
 each output comes from the longest clip. Then the config's dataset (`traj2events.plan`'s
 frame, field and trajectory counts, t_f = tf_guess_s) at those rates: CPU core-hours per
 stage and in all, and disk per output kind. Rates are averaged over the trajectories
-given. The trajectory solves are left out (~0.02 core-hours for 500, docs/benchmarks.md).
+given. The trajectory solves are left out (~0.02 core-hours for 500, docs/performance.md).
 The header names the OpenGL backend the render command takes (`render.backend`); with
 EGL on a GPU the render's CPU seconds are its CPU side only, and its wall seconds
 (printed per run) bound the GPU's share: GPU-hours are not fitted here.

@@ -36,7 +36,7 @@ def test_without_the_preview_neither_its_disk_nor_its_encoder_is_planned():
 
 
 def test_default_dataset_plan_is_near_what_it_measured():
-    # Measured 2026-11-23 (docs/benchmarks.md): 18 671 frames, ~5 min of rendering on one core;
+    # Measured 2026-11-23 (docs/performance.md): 18 671 frames, ~5 min of rendering on one core;
     # session 9 (sensor model, stars): 19 115 frames, 1.59 GB under results/.
     plan = dataset_plan(load_config(ROOT / "config" / "config.yaml"))
     assert 0.9 < plan.frames / 18_671 < 1.25

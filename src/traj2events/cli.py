@@ -123,10 +123,9 @@ def keep_freed_memory() -> None:
     """Ask glibc's malloc to keep the memory a process frees for its next allocations. The
     render and events commands allocate and free large arrays every frame (events: ~60 B per
     event, ~75 MB per 1024^2 interval on the sensor path); by default glibc hands much of it
-    back to the kernel, which must clear those pages again at the next frame: 3-5 % of the
-    events command, ~7 % of the render command's (docs/benchmarks.md, "Session 23: freed
-    memory kept"). The results cannot change; the process's memory stays at its peak instead
-    of falling between frames. A no-op where the C library has no mallopt (macOS) or
+    back to the kernel, which must clear those pages again at the next frame (bench/events_command.py
+    and bench/render.py measure it). The results cannot change; the process's memory stays at its peak
+    instead of falling between frames. A no-op where the C library has no mallopt (macOS) or
     ignores it (musl)."""
     import ctypes
 
@@ -508,8 +507,8 @@ def main(argv: list[str] | None = None) -> int:
 def run() -> None:
     """The process's entry point (the `traj2events` script, `python -m traj2events`): main,
     then exit with its status. Every object left is frozen out of the garbage collector
-    first: with numba's kernels loaded, the interpreter's shutdown otherwise takes 0.3-0.4 s
-    (of a ~3 s events job on a 1 s clip; docs/benchmarks.md). Outputs are closed by then;
+    first: with numba's kernels loaded, the interpreter's shutdown otherwise takes a
+    noticeable part of a short events job. Outputs are closed by then;
     reference counts still free what they can."""
     status = main()
     gc.freeze()

@@ -1,7 +1,7 @@
 """The planned size of a dataset, before any job runs: frames, disk per output kind and
 CPU time, from the config alone. Solved final times are not known yet, so each
 trajectory is taken to last its scenario's `tf_guess_s`; the per-pixel costs below were
-measured on this project's 2-core VM (docs/benchmarks.md) and are estimates, not bounds.
+measured on this project's 2-core VM (docs/performance.md) and are estimates, not bounds.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ EVENTS_S = (0.0005, 1.1e-7)  # the whole events command (decoding, emulation, wr
 FIELD_S_PER_PX = 1.0e-7  # motion field with the terrain-true field: 0.08-0.12 s at 1024^2 (sessions 11-12)
 # Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
 # the smoke descent trajectory (694 frames) at 128^2 and 512^2, the motion field at 256^2
-# and 1024^2 (docs/benchmarks.md).
+# and 1024^2 (docs/performance.md).
 MEMORY_MB = {
     "render": (1000.0, 4.5e-3),  # 1.15 GB at 128^2, 2.25 GB at 512^2 (tiles in view grow with it)
     "motion_field": (300.0, 4e-4),  # 68 MB at 256^2 with terrain, 0.27 GB at 1024^2 sphere only: one field at a time

@@ -51,7 +51,7 @@ def code(stage):
 
 def resources_of(stage, key):
     """A cluster resource of one job of `stage` (mem_mb, runtime in minutes), estimated from
-    the config (traj2events.plan.job_resources; the measured costs are in docs/benchmarks.md)."""
+    the config (traj2events.plan.job_resources; the measured costs are in docs/performance.md)."""
     return lambda wildcards, threads: job_resources(config, stage, wildcards.get("scenario"), threads)[key]
 
 

@@ -20,14 +20,13 @@ MAX_T_US = np.iinfo(np.uint32).max  # events/t's range after t_offset (~71.6 min
 
 # events.h5's columns: (type, Blosc (codec, level, bit shuffle)). Each codec is the fastest to
 # write of zstd-1 / LZ4 with bit or byte shuffle that does not make its column larger
-# (docs/benchmarks.md, session 23): together 3.5 ns less per event than zstd-1 + bit shuffle
-# everywhere (DSEC's), and smaller.
+# (bench/events_command.py): faster than zstd-1 + bit shuffle everywhere (DSEC's), and smaller.
 COLUMNS = {
-    "x": ("<u2", ("lz4", 1, True)),  # 1.6x faster, +0.2 % bytes
-    "y": ("<u2", ("zstd", 1, True)),  # LZ4: 1.9x faster but +10 %
-    "t": ("<u4", ("zstd", 1, False)),  # sorted times: byte shuffle 1.7x faster and half the bytes
-    "p": ("u1", ("lz4", 1, True)),  # 1.7x faster, +3 % of a small column
-    "label": ("u1", ("zstd", 1, True)),  # only with labels; LZ4: 1.6x faster but twice the bytes
+    "x": ("<u2", ("lz4", 1, True)),
+    "y": ("<u2", ("zstd", 1, True)),  # LZ4 would be faster but larger
+    "t": ("<u4", ("zstd", 1, False)),  # sorted times: byte shuffle is faster and smaller
+    "p": ("u1", ("lz4", 1, True)),
+    "label": ("u1", ("zstd", 1, True)),  # only with labels; LZ4 would be faster but larger
 }
 
 
@@ -99,7 +98,7 @@ class EventsWriter:
             ms = np.arange(self._next_ms, last_ms + 1, dtype=np.int64)
             self._ms_to_idx.append(self.n + np.searchsorted(t, ms * 1000, side="left"))
             self._next_ms = last_ms + 1
-        # uint32 (DSEC's type): half the bytes of int64 to shuffle and compress (2x faster to write).
+        # uint32 (DSEC's type): half the bytes of int64 to shuffle and compress.
         self._take({"x": events["x"], "y": events["y"], "t": t.astype(np.uint32), "p": events["p"], "label": labels})
         self._last_t = int(t[-1])
 

@@ -58,8 +58,8 @@ def motion_field_file(
     attributes to the file. The file appears under `path` only if the block completes, so
     memory stays one field whatever K."""
     n = len(t)
-    # LZ4 + byte shuffle: a 1024^2 field's float32 datasets compress in ~18 ms against ~29
-    # with bit shuffle (~90 ms with zstd-1, ~480 with gzip-4), 5 % larger (docs/benchmarks.md).
+    # LZ4 + byte shuffle: faster to compress float32 fields than bit shuffle, zstd or gzip,
+    # for a few per cent more bytes (bench/motion_field_command.py).
     compression = blosc("lz4", 5, bitshuffle=False)
     with atomic_output(path) as tmp, create(tmp) as f:
         write_dataset(f, "t", t)

@@ -23,10 +23,10 @@ def create(path: Path) -> h5py.File:
 def blosc(cname: str = "zstd", clevel: int = 1, bitshuffle: bool = True) -> dict:
     """create_dataset keywords for a Blosc filter (hdf5plugin: readers `import hdf5plugin`).
     zstd-1 + bit shuffle, the default (and DSEC's; events.h5 picks one per column:
-    formats.events.COLUMNS), writes float32 images ~3x faster than
-    gzip-1 and reads them ~1.7x faster, ~17 % larger; LZ4 is ~1.5-2x faster again, and
-    with byte shuffle (motion_field.h5) ~1.6x faster than with bit shuffle for 5 % more
-    bytes on full-precision floats (docs/benchmarks.md)."""
+    formats.events.COLUMNS), writes and reads float32 images faster than gzip-1 for a
+    slightly larger file; LZ4 is faster again, and with byte shuffle (motion_field.h5)
+    faster than with bit shuffle on full-precision floats for a few per cent more bytes
+    (bench/frames_store.py, bench/motion_field_command.py)."""
     import hdf5plugin  # registers the Blosc filter with HDF5
 
     shuffle = hdf5plugin.Blosc.BITSHUFFLE if bitshuffle else hdf5plugin.Blosc.SHUFFLE
@@ -180,8 +180,7 @@ class ChunkWriter:
     """Writes item i of a dataset chunked one item per chunk (`chunks=(1, *shape)`) with
     `blosc(...)`: the chunk is compressed here, by the Blosc filter's own library with the
     dataset's own parameters, and handed to HDF5 whole (`write_direct_chunk`). HDF5's
-    filter pipeline copies each chunk on its way; skipping it wrote a 1024^2 motion
-    field's datasets in 36-41 ms instead of 43-55 (LZ4 + bit shuffle, docs/benchmarks.md). Items written in order
+    filter pipeline copies each chunk on its way, which this skips. Items written in order
     give the file the filter would have written, byte for byte."""
 
     def __init__(self, dataset: h5py.Dataset):
@@ -189,7 +188,7 @@ class ChunkWriter:
         if parameters is None:
             raise ValueError(f"{dataset.name}: expected one Blosc filter and one item per chunk")
         self._parameters, self._codec, self.dataset = parameters, _blosc_codec(), dataset
-        # One output buffer, reused (a fresh one per chunk costs page faults, ~1 ms per 4 MB),
+        # One output buffer, reused (a fresh one per chunk costs page faults),
         # no larger than the item: as the filter, which leaves a chunk that does not shrink raw.
         self._buffer = np.empty(dataset.dtype.itemsize * math.prod(dataset.shape[1:]), np.uint8)
 

@@ -84,7 +84,7 @@ def _motion_pixels(
     empty), and the status, the first that applies of SKY, BEHIND_CAMERA, OCCLUDED,
     OUT_OF_VIEW, VISIBLE. Float64 throughout, in the same operations and order as the
     numpy expressions. The arithmetic loops are branch-free and write row buffers so that
-    LLVM vectorises them (2.5x the single per-pixel loop); only the status loop branches.
+    LLVM vectorises them (a single per-pixel loop does not vectorise); only the status loop branches.
     flow and displacement come as (H, 2 W) views, (u, v) pairs along each row."""
     width, height = a_cols.size, b_rows.size
     from_depth, limb, from_next = depth.size > 0, q.size > 0, depth_next.size > 0

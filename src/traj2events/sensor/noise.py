@@ -119,8 +119,8 @@ def noise_candidates(n, state, table, intensity, scale, g_max, t0, dt, out_pix, 
     pixel (high 32 bits) and alias coin (low 32); keep (high 32), time within the interval
     (31 bits: 5 ps steps at 10 ms, 5 ns at 10 s) and polarity (1). The table and the
     intensity are read at random places, out of cache: a candidate's draws are made
-    PREFETCH_AHEAD candidates before it is thinned and its reads prefetched then (2.3x
-    faster from a cold cache). Written without data-dependent branches (every candidate
+    PREFETCH_AHEAD candidates before it is thinned and its reads prefetched then, so
+    that their memory latencies overlap. Written without data-dependent branches (every candidate
     is stored, the count advances only if kept): a mispredicted branch would cancel the
     reads in flight."""
     n_pixels = np.uint64(table.size)

@@ -61,7 +61,7 @@ def sorted_keys(pix, t_s, on, label, n_pixels):
     ascending order. Sorted by a counting pass on t_us (one bucket per microsecond, or per
     2^s us when the events span more microseconds than they number), then each bucket: the
     signal's events come in pixel order, so a microsecond's keys are in order already but
-    for the few noise and hot-pixel events (np.sort's general sort took 30 % of the events
+    for the few noise and hot-pixel events (np.sort's general sort was a large part of the events
     command on the sensor path)."""
     n = pix.size
     labels = label.size > 0

@@ -55,8 +55,8 @@ class FrameSource:
 
 
 # ffmpeg's decoder threads for a video: one, beside the emulator's. ffmpeg's default, a
-# thread per CPU, oversubscribed two CPUs (~4-9 % slower, docs/benchmarks.md, sessions 22
-# and 24) and ignored --threads.
+# thread per CPU, oversubscribed two CPUs (slower: bench/events_command.py) and ignored
+# --threads.
 VIDEO_DECODER_CPUS = 1
 
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.

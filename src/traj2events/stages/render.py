@@ -175,7 +175,7 @@ def render_trajectory(
     tile_cache: str | None = None,
 ) -> None:
     """Render every pose of trajectory.h5: frames.h5 (radiance, depth), video.mkv and, unless
-    `preview` is None, preview.mp4 (render.preview; its H.264 encoder costs CPU: docs/benchmarks.md).
+    `preview` is None, preview.mp4 (render.preview; its H.264 encoder costs CPU: docs/performance.md).
     `backend`: the OpenGL backend (renderer.context.resolve_backend); `tile_cache`: a folder where
     tile heights are shared with other jobs (formats/tile_cache.py). Neither changes the scene."""
     s = settings

@@ -209,7 +209,7 @@ class LandingProblem:
                 "mumps_permuting_scaling": 0,
                 # Start the barrier at 1e-3 instead of 0.1: from a base-solution warm
                 # start, 0.1 first pushes every iterate back to the central path (the
-                # paper batch: 0.82x the time and no failures, docs/benchmarks.md).
+                # paper batch is faster with no more failures: bench/trajectories.py).
                 "mu_init": 1e-3,
                 **(ipopt_options or {}),
             },

@@ -136,7 +136,7 @@ def final_state_error(
 
 class ShootingCheck:
     """Final-state error of a solution by re-integration in C++ (CVODES, tolerance 1e-12 on
-    nondimensional states, all intervals in one `mapaccum` call): about 15x faster than
+    nondimensional states, all intervals in one `mapaccum` call): much faster than
     the DOP853 loop above and within 1e-6 m of it; the batch uses it to accept samples.
     One instance per vehicle; it builds (and caches) a function per node count.
     """
