@@ -35,8 +35,8 @@ import numpy as np  # noqa: E402
 from traj2events.formats.frames import FramesWriter  # noqa: E402
 from traj2events.geometry.camera import Camera, camera_pose  # noqa: E402
 from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.scene.illumination import Sun  # noqa: E402
 from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
+from traj2events.scene.sun import Sun  # noqa: E402
 from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
 from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
 from traj2events.video import VideoWriter, display_frame  # noqa: E402

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from traj2events.scene.illumination import Sun, local_sun_tan_elevation, shadow_field, sun_direction
+from traj2events.scene.illumination import local_sun_tan_elevation, shadow_field
 from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.scene.sun import Sun, sun_direction
 
 FLAT = 1e15  # radius of a Moon so large its surface is a plane
 

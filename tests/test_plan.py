@@ -4,7 +4,7 @@ import pytest
 
 from conftest import ROOT
 from traj2events.config import ConfigError, load_config, resolve_config
-from traj2events.plan import BYTES_PER_PX, dataset_plan
+from traj2events.plan import BYTES_PER_PX, dataset_plan, events_bytes_per_px
 
 ONE = {"scenarios": {"descent": {"n_trajectories": 3, "tf_guess_s": 10.0}}}
 
@@ -71,3 +71,17 @@ def test_adaptive_timing_plans_the_measured_extra_frames():
     assert dataset_plan(resolve_config({**ONE, "render": {"timing": capped}})).core_hours["render"] == pytest.approx(
         2.0 * fixed.core_hours["render"]
     )
+
+
+def test_the_paper_plan_is_what_its_commands_measured():
+    # bench/workflow_cost.py on the paper config's braking and descent clips (2026-11-25):
+    # events.h5 2.50 MB per 1024^2 frame (8.35 TB for the config), 160-178 core-hours.
+    plan = dataset_plan(load_config(ROOT / "config" / "paper.yaml"))
+    assert plan.disk_bytes["events.h5"] == pytest.approx(8.35e12, rel=0.1)
+    assert 150 < plan.total_core_hours < 190
+
+
+def test_events_grow_faster_than_the_pixels_as_measured():
+    # 0.49 bytes per pixel over the default dataset at 128^2, 2.38 at 1024^2
+    assert events_bytes_per_px(128) == pytest.approx(0.49)
+    assert events_bytes_per_px(1024) == pytest.approx(2.38, rel=0.03)

@@ -12,8 +12,8 @@ from traj2events.geometry.camera import Camera, CameraPose, camera_pose
 from traj2events.renderer import draw as render_module
 from traj2events.renderer.context import check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
 from traj2events.renderer.draw import TerrainRenderer
-from traj2events.scene.illumination import Sun
 from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.scene.sun import Sun
 from traj2events.scene.terrain import (
     GridTerrain,
     ProceduralTerrain,
@@ -100,7 +100,7 @@ _EGL_SCENE = """
 import sys
 import numpy as np
 from traj2events.geometry.camera import Camera, camera_pose
-from traj2events.scene.illumination import Sun
+from traj2events.scene.sun import Sun
 from traj2events.scene.reflectance import ReflectanceParams
 from traj2events.renderer.draw import TerrainRenderer
 from traj2events.scene.terrain import ProceduralTerrain, TerrainParams

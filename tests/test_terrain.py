@@ -10,7 +10,6 @@ from traj2events.scene.terrain import (
     TerrainParams,
     degraded_crater_profile,
     fresh_crater_profile,
-    horizon_distance_m,
     load_elevation_grid,
     site_pad_weight,
     surface_points,
@@ -104,11 +103,6 @@ def test_surface_points_on_the_sphere_and_tangent_at_the_site():
     assert p[3, 2] > 1800  # 80 km out, the surface has dropped ~1.8 km below the site's plane
 
 
-def test_horizon_distance():
-    assert horizon_distance_m(2000.0, 0.0, R_MOON) == pytest.approx(np.sqrt(2 * R_MOON * 2000 + 2000**2))
-    assert horizon_distance_m(2000.0, 100.0, R_MOON) > horizon_distance_m(2000.0, 0.0, R_MOON)
-
-
 def test_user_grids_load_and_interpolate(tmp_path):
     heights = np.add.outer(np.arange(5.0), 10 * np.arange(4.0))
     np.save(tmp_path / "dem.npy", heights)
@@ -192,7 +186,8 @@ def test_boulders_crowd_the_ejecta_of_fresh_craters():
 def test_boulder_shadow_has_the_analytic_length():
     """A hemisphere of radius a on flat ground, Sun at elevation e: the shadow's tip lies
     a / sin(e) from its centre, straight away from the Sun."""
-    from traj2events.scene.illumination import shadow_field, sun_direction
+    from traj2events.scene.illumination import shadow_field
+    from traj2events.scene.sun import sun_direction
     from traj2events.scene.terrain import bilinear, boulder_profile
 
     a, spacing, elevation = 2.0, 0.05, 15.0

@@ -8,7 +8,7 @@ import pytest
 
 from traj2events.formats.tile_cache import TileCache
 from traj2events.geometry.camera import Camera, camera_pose
-from traj2events.scene.illumination import Sun
+from traj2events.scene.sun import Sun
 from traj2events.scene.terrain import GridTerrain, ProceduralTerrain, TerrainParams
 from traj2events.scene.tiles import LodSettings, TileSet
 

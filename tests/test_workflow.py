@@ -118,6 +118,15 @@ def test_smoke_dataset_is_complete(built):
     assert set(summary["scenario"]) == {"descent", "hover"} and (summary["failed"] == 0).all()
     assert (results / "logs" / "descent" / "sample_trajectories.log").read_text().count("sample ") >= 2
     assert not list(results.rglob("*.part"))  # no temporary files left
+    # Every job's cost, recorded by Snakemake's benchmark directive (bench/job_costs.py reads them)
+    costs = {p.relative_to(results / "benchmarks").as_posix() for p in (results / "benchmarks").rglob("*.tsv")}
+    per_trajectory = ["camera_poses", "render", "motion_field", "events"]
+    per_trajectory += ["frames_picture", "motion_field_picture", "events_picture"]
+    assert {f"descent/0001/{rule}.tsv" for rule in per_trajectory} <= costs
+    assert {"descent/base_solution.tsv", "descent/sample_trajectories.tsv", "descent/dataset_index.tsv"} <= costs
+    assert {"dataset_picture.tsv", "trajectory_summary.tsv"} <= costs
+    render = pd.read_csv(results / "benchmarks" / "descent" / "0001" / "render.tsv", sep="\t")
+    assert render["cpu_time"].iloc[0] > 0 and render["max_rss"].iloc[0] > 50  # MB
 
 
 def test_the_loader_reads_the_built_dataset(built):
@@ -210,12 +219,15 @@ def same_h5(a, b, path=""):
         assert a[()].tobytes() == b[()].tobytes(), path
 
 
+RECORDS = {"logs", "benchmarks"}  # what a run records of itself (times differ)
+
+
 def assert_same_dataset(a, b):
-    """Every file under results/ (logs aside) the same: bytes, or for the solver's files
-    everything but the wall-clock solve times."""
-    files = sorted(p.relative_to(a) for p in (a / "results").rglob("*") if p.is_file() and "logs" not in p.parts)
+    """Every file under results/ (the run's logs and job costs aside) the same: bytes, or for
+    the solver's files everything but the wall-clock solve times."""
+    files = sorted(p.relative_to(a) for p in (a / "results").rglob("*") if p.is_file() and not RECORDS & set(p.parts))
     assert files == sorted(
-        p.relative_to(b) for p in (b / "results").rglob("*") if p.is_file() and "logs" not in p.parts
+        p.relative_to(b) for p in (b / "results").rglob("*") if p.is_file() and not RECORDS & set(p.parts)
     )
     for rel in files:
         if rel.name in ("base.h5", "solutions.h5", "trajectory.h5"):
@@ -294,15 +306,16 @@ def edited_source(built, tmp_path):
 def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
     assert edited_source("cli.py", 'help="frames read at a time', 'help="frames read together') == {}
     assert (
-        edited_source("emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;') == {}
+        edited_source(
+            "sensor/emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;'
+        )
+        == {}
     )
-    assert edited_source("render.py", "\nimport os\n", "\nimport os  # a comment\n") == {}
+    assert edited_source("renderer/context.py", "\nimport os\n", "\nimport os  # a comment\n") == {}
 
 
 def test_emulator_change_reruns_events_and_their_dependants_only(edited_source):
-    jobs = edited_source(
-        "emulator.py", "return -np.expm1(-2.0 * np.pi * f_c * dt_s)", "return -np.expm1(-6.3 * f_c * dt_s)"
-    )
+    jobs = edited_source("sensor/pixel.py", "two_pi_dt = 2.0 * np.pi * dt", "two_pi_dt = 6.3 * dt")
     assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
 
 
@@ -318,10 +331,10 @@ def test_figure_change_reruns_pictures_only(edited_source):
 
 
 def test_solver_change_reruns_the_solves_and_everything_after(edited_source):
-    jobs = edited_source("upsample.py", "def frame_times(", "def frame_times(  # moved\n")
+    jobs = edited_source("trajectory/upsample.py", "def frame_times(", "def frame_times(  # moved\n")
     assert jobs == {}  # a comment, still nothing
     jobs = edited_source(
-        "upsample.py",
+        "trajectory/upsample.py",
         "from scipy.integrate import solve_ivp",
         "from scipy.integrate import solve_ivp as _s\nsolve_ivp = _s",
     )

@@ -71,7 +71,7 @@ def _non_finite(value: Any, path: tuple = ()) -> list[str]:
 
 
 def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
-    from .trajectory.scenarios import RANGE_KEYS
+    from .settings import RANGE_KEYS
 
     errors = []
     if name in RESERVED_SCENARIO_NAMES:
@@ -164,7 +164,7 @@ def _semantic_errors(config: dict) -> list[str]:
 
 def _timing_errors(timing: dict) -> list[str]:
     """FrameTiming's own checks (the render job would fail on them), before any job starts."""
-    from .geometry.frame_timing import FrameTiming
+    from .settings import FrameTiming
 
     try:
         FrameTiming(**timing)
@@ -176,8 +176,8 @@ def _timing_errors(timing: dict) -> list[str]:
 
 def _display_errors(config: dict) -> list[str]:
     """A display white far above any radiance the scene can have gives black videos."""
-    from .scene.illumination import Sun
     from .scene.reflectance import ReflectanceParams, max_radiance_factor
+    from .scene.sun import Sun
 
     factor = max_radiance_factor(ReflectanceParams(**config["render"]["reflectance"]), n=21)
     irradiance = max(Sun(**sc["sun"]).irradiance_w_m2 for sc in config["scenarios"].values())

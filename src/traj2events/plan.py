@@ -1,55 +1,28 @@
 """The planned size of a dataset, before any job runs: frames, disk per output kind and
 CPU time, from the config alone. Solved final times are not known yet, so each
-trajectory is taken to last its scenario's `tf_guess_s`; the per-pixel costs below were
-measured on this project's 2-core VM (docs/performance.md) and are estimates, not bounds.
+trajectory is taken to last its scenario's `tf_guess_s`. The cost rates come from one
+table, costs.yaml beside this module (measured with the benches it names; the workflow's
+jobs record their own costs, which `bench/job_costs.py` sets beside the table): estimates,
+not bounds.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
-# Bytes per pixel per frame (per field for the motion field), measured on the default
-# dataset (128 x 128) and bench/frames_store.py (1024 x 1024).
-BYTES_PER_PX = {
-    "frames.h5": 2.9,  # radiance + depth, 16 significant bits, LZ4 + byte shuffle: 2.6-3.1 at 1024^2
-    "video.mkv": 0.43,  # FFV1 of the 8-bit display frames
-    "preview.mp4": 0.03,
-    "events.h5": 1.0,  # paper preset through the sensor model: 1.03 at 1024^2 (bench/workflow_cost.py), 0.49 at 128^2
-    "motion_field.h5": 21.7,  # per field written: sphere and terrain flow, displacement, masks
-    "flow/*.flo": 8.0,  # per field written
-}
-EXPORT_BYTES_PER_EVENTS_BYTE = {"npz": 1.84, "evt3": 1.9, "aedat4": 2.7}  # measured on the default dataset
-# Seconds of one core: per frame (a fixed part and a per-pixel part), per motion field;
-# at 1024^2 from bench/workflow_cost.py (CPU time of the whole commands, encoders included).
-RENDER_S = (0.012, 1.4e-7)  # 1024^2: 0.16 s/frame with the two encoders, shaded per pixel (session 15)
-PREVIEW_S_PER_PX = 2.5e-8  # of RENDER_S: the preview's encoder, 21-32 ms at 1024^2 (bench/preview_cost.py)
-EVENTS_S = (0.0005, 1.1e-7)  # the whole events command (decoding, emulation, writing): 0.08-0.15 s at 1024^2
-FIELD_S_PER_PX = 1.0e-7  # motion field with the terrain-true field: 0.08-0.12 s at 1024^2 (sessions 11-12)
-# Peak memory per job (MB): a fixed part and one per pixel, measured with /usr/bin/time on
-# the smoke descent trajectory (694 frames) at 128^2 and 512^2, the motion field at 256^2
-# and 1024^2 (docs/performance.md).
-MEMORY_MB = {
-    "render": (1000.0, 4.5e-3),  # 1.15 GB at 128^2, 2.25 GB at 512^2 (tiles in view grow with it)
-    "motion_field": (300.0, 4e-4),  # 68 MB at 256^2 with terrain, 0.27 GB at 1024^2 sphere only: one field at a time
-    # events: one interval's events at a time, 16 frames read at a time (session 18): 0.20 /
-    # 0.22 / 0.29 / 0.49 GB at 128^2 / 256^2 / 512^2 / 1024^2, sensor path with labels (1 s
-    # descent clip; 0.20 / 0.24 / 0.34 / 0.74 GB reading 64 frames at a time). Session 23,
-    # freed memory kept for reuse (cli.keep_freed_memory): 0.22 / 0.29 / 0.55 GB at 256^2 /
-    # 512^2 / 1024^2 (the same clip), 0.59-0.65 GB on the 1 s braking clip at 1024^2 (1.24 M
-    # events per frame; 0.55-0.56 GB before)
-    "events": (230.0, 4.0e-4),
-    "sample_trajectories": (500.0, 0.0),  # plus 500 MB per process
-}
-# Adaptive timing (render.timing) renders extra frames for the emulator where the scene
-# moves: over the default dataset's whole braking flight at 128^2, 1.72x the camera's
-# frames at max_log_change 0.5 and 3.65x at 0.2 (descent: 1.50x, 2.81x; bench/frame_timing.py
-# --whole); over windows spread across both flights at 256^2 (--flight 12), 1.28x, 1.90x,
-# 3.28x and 7.5x at 2, 1, 0.5 and 0.2: the extra frames grow as width^1.6-1.9 (edges move
-# more pixels and sharpen). Estimate: 1 + a (width / 128)^q max_log_change^-p, or with a
-# displacement bound alone, 1 + a (width / 128)^q (2 max_displacement_px)^-p (1 px was about
-# 0.5 in log change); never more than max_fps / fps. At 1024^2 that reaches the cap: an
-# extrapolation from 256^2, not measured.
-ADAPTIVE_EXTRA = (0.27, 1.42, 1.7)  # (a, p, q)
+import yaml
+
+COSTS_PATH = Path(__file__).with_name("costs.yaml")
+COSTS = yaml.safe_load(COSTS_PATH.read_text())
+BYTES_PER_PX = COSTS["bytes_per_px"]  # per pixel per frame (per field written for the motion field)
+EXPORT_BYTES_PER_EVENTS_BYTE = COSTS["export_bytes_per_events_byte"]
+RENDER_S = tuple(COSTS["cpu_s"]["render_per_frame"])  # (per frame, per pixel), encoders included
+PREVIEW_S_PER_PX = COSTS["cpu_s"]["preview_per_px"]  # of RENDER_S: the preview's encoder
+EVENTS_S = tuple(COSTS["cpu_s"]["events_per_frame"])  # (per frame, per pixel): decoding, emulation, writing
+FIELD_S_PER_PX = COSTS["cpu_s"]["motion_field_per_px"]
+MEMORY_MB = {stage: tuple(v) for stage, v in COSTS["memory_mb"].items()}  # (fixed, per pixel)
+ADAPTIVE_EXTRA = tuple(COSTS["adaptive_extra"])  # (a, p, q): see rendered_per_frame
 RUNTIME_MARGIN = 3.0  # requested run time / estimate: t_f may exceed its guess, nodes vary
 # Beyond these, `allow_large_dataset: true` must say the user means it.
 MAX_CORE_HOURS = 10_000.0
@@ -102,8 +75,17 @@ def _fields(frames: int, every_n_frames: int) -> int:
     return -(-(frames - 1) // every_n_frames)
 
 
+def events_bytes_per_px(width: int) -> float:
+    """events.h5's bytes per pixel per frame, growing with the image width as measured
+    (finer detail crosses more thresholds): a (width / 128)^q."""
+    a, q = COSTS["events_bytes_per_px"]
+    return a * (width / 128.0) ** q
+
+
 def rendered_per_frame(config: dict) -> float:
-    """Frames rendered per camera frame: 1 with fixed timing, the estimate above with adaptive."""
+    """Frames rendered per camera frame: 1 with fixed timing; with adaptive timing, the
+    measured extra frames 1 + a (width / 128)^q bound^-p (the bound: max_log_change, or
+    twice max_displacement_px), never more than max_fps / fps."""
     timing, camera = config["render"]["timing"], config["camera"]
     if timing["mode"] != "adaptive":
         return 1.0
@@ -130,7 +112,7 @@ def dataset_plan(config: dict) -> Plan:
     rendered = rendered_per_frame(config)  # frames.h5 and the emulator get the adaptive frames too
     disk = {
         "video.mkv": BYTES_PER_PX["video.mkv"] * px_frames,
-        "events.h5": BYTES_PER_PX["events.h5"] * px_frames,
+        "events.h5": events_bytes_per_px(camera["width"]) * px_frames,
         "motion_field.h5": BYTES_PER_PX["motion_field.h5"] * px_fields,
         "flow/*.flo": BYTES_PER_PX["flow/*.flo"] * px_fields,
     }

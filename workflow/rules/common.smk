@@ -13,8 +13,7 @@ from snakemake.settings.types import DeploymentMethod
 from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
 from traj2events.plan import dataset_plan, job_resources
-from traj2events.trajectory.scenarios import ScenarioSettings
-from traj2events.stages.render import RenderSettings
+from traj2events.settings import render_settings as render_settings_of, solve_settings
 
 try:
     _resolved = resolve_config(config)
@@ -51,18 +50,18 @@ def code(stage):
 
 def resources_of(stage, key):
     """A cluster resource of one job of `stage` (mem_mb, runtime in minutes), estimated from
-    the config (traj2events.plan.job_resources; the measured costs are in docs/performance.md)."""
+    the config and the cost table (traj2events.plan.job_resources, src/traj2events/costs.yaml)."""
     return lambda wildcards, threads: job_resources(config, stage, wildcards.get("scenario"), threads)[key]
 
 
 def scenario_settings(wildcards):
     """Everything the solves of one scenario depend on, as JSON (vehicle, ocp, ranges, seed)."""
-    return ScenarioSettings.from_config(config, wildcards.scenario).to_json()
+    return json.dumps(solve_settings(config, wildcards.scenario), sort_keys=True)
 
 
 def render_settings(wildcards):
     """Everything one scenario's frames depend on, as JSON (camera, terrain, Sun, reflectance, LOD)."""
-    return RenderSettings.from_config(config, wildcards.scenario).to_json()
+    return json.dumps(render_settings_of(config, wildcards.scenario), sort_keys=True)
 
 
 def elevation_grid(wildcards):

@@ -11,6 +11,8 @@ rule events:
         events="results/{scenario}/{id}/events.h5",
     log:
         "results/logs/{scenario}/{id}/events.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/events.tsv"
     conda:
         ENV
     # One core per job: many jobs side by side use the cores better than threads within one.

@@ -11,6 +11,8 @@ rule motion_field:
         flo=directory("results/{scenario}/{id}/flow"),
     log:
         "results/logs/{scenario}/{id}/motion_field.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/motion_field.tsv"
     conda:
         ENV
     resources:

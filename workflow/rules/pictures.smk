@@ -16,6 +16,8 @@ rule frames_picture:
         ),
     log:
         "results/logs/{scenario}/{id}/frames_picture.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/frames_picture.tsv"
     conda:
         ENV
     params:
@@ -37,6 +39,8 @@ rule motion_field_picture:
         ),
     log:
         "results/logs/{scenario}/{id}/motion_field_picture.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/motion_field_picture.tsv"
     conda:
         ENV
     params:
@@ -60,6 +64,8 @@ rule events_picture:
         ),
     log:
         "results/logs/{scenario}/{id}/events_picture.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/events_picture.tsv"
     conda:
         ENV
     params:
@@ -81,6 +87,8 @@ rule dataset_picture:
         ),
     log:
         "results/logs/dataset_picture.log",
+    benchmark:
+        "results/benchmarks/dataset_picture.tsv"
     conda:
         ENV
     params:

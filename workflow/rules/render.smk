@@ -10,6 +10,8 @@ rule render:
         **render_outputs("results/{scenario}/{id}"),
     log:
         "results/logs/{scenario}/{id}/render.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/render.tsv"
     conda:
         "../../envs/render.yaml"
     threads: 1

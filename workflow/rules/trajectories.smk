@@ -9,6 +9,8 @@ rule base_solution:
         "results/{scenario}/base.h5",
     log:
         "results/logs/{scenario}/base_solution.log",
+    benchmark:
+        "results/benchmarks/{scenario}/base_solution.tsv"
     conda:
         ENV
     params:
@@ -26,6 +28,8 @@ rule sample_trajectories:
         table="results/{scenario}/samples.csv",
     log:
         "results/logs/{scenario}/sample_trajectories.log",
+    benchmark:
+        "results/benchmarks/{scenario}/sample_trajectories.tsv"
     conda:
         ENV
     threads: workflow.cores
@@ -47,6 +51,8 @@ rule camera_poses:
         "results/{scenario}/{id}/trajectory.h5",
     log:
         "results/logs/{scenario}/{id}/camera_poses.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/camera_poses.tsv"
     conda:
         ENV
     params:
@@ -66,6 +72,8 @@ rule dataset_index:
         "results/{scenario}/index.csv",
     log:
         "results/logs/{scenario}/dataset_index.log",
+    benchmark:
+        "results/benchmarks/{scenario}/dataset_index.tsv"
     conda:
         ENV
     params:
@@ -86,6 +94,8 @@ rule trajectory_summary:
         ),
     log:
         "results/logs/trajectory_summary.log",
+    benchmark:
+        "results/benchmarks/trajectory_summary.tsv"
     conda:
         ENV
     params:

@@ -20,40 +20,13 @@ nothing in view moves or changes, no frame is added.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..sensor.laws import log_intensity_8bit, radiance_to_dn
+from ..settings import FrameTiming
 from .camera import Camera
 from .motion_field import depth_flow
-
-MODES = ("fixed", "adaptive")
-
-
-@dataclass(frozen=True)
-class FrameTiming:
-    """render.timing: `fixed` renders at the camera's fps only; `adaptive` adds frames
-    between those until the predicted log change per interval is at most
-    `max_log_change` and the largest displacement of a terrain pixel at most
-    `max_displacement_px` (null: no such bound), never closer than 1 / `max_fps` s."""
-
-    mode: str = "fixed"
-    max_log_change: float | None = 0.5
-    max_displacement_px: float | None = None
-    max_fps: float = 2000.0
-
-    def __post_init__(self) -> None:
-        if self.mode not in MODES:
-            raise ValueError(f"render.timing.mode: expected one of {MODES}, got {self.mode!r}")
-        for key in ("max_log_change", "max_displacement_px"):
-            value = getattr(self, key)
-            if value is not None and not value > 0:
-                raise ValueError(f"render.timing.{key}: expected > 0 or null, got {value}")
-        if not self.max_fps > 0:
-            raise ValueError(f"render.timing.max_fps: expected > 0, got {self.max_fps}")
-        if self.mode == "adaptive" and self.max_log_change is None and self.max_displacement_px is None:
-            raise ValueError("render.timing: adaptive needs max_log_change or max_displacement_px (both are null)")
 
 
 def log_change_rate(log_intensity: np.ndarray, flow_px_s: np.ndarray) -> np.ndarray:

@@ -30,9 +30,9 @@ from importlib import resources
 import numpy as np
 
 from ..geometry.camera import Camera, CameraPose, opengl_camera_to_world
-from ..scene.illumination import Sun
 from ..scene.reflectance import ReflectanceParams, max_radiance_factor
 from ..scene.stars import StarField, add_stars
+from ..scene.sun import Sun
 from ..scene.tiles import TileKey, TileSet, border_ring, depth_range
 from .context import gl_context, resolve_backend
 

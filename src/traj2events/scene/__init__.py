@@ -3,7 +3,8 @@ knows of OpenGL; `renderer` draws what these modules describe.
 
 Read first (the model):
     terrain        procedural heights: craters, boulders, a DEM when given
-    illumination   the Sun (direction, irradiance) and horizon-march shadows
+    sun            the Sun: direction and irradiance
+    illumination   horizon-march shadows under it
     reflectance    the Hapke law (the shaders evaluate the same law)
     stars          the star field seen in the sky
 

@@ -1,13 +1,4 @@
-"""The Sun and terrain shadows.
-
-Sun convention (config `scenarios.<name>.sun`: range_m, azimuth_deg, elevation_deg):
-the Sun is a directional light. Its azimuth is measured in the site's horizontal plane
-from the inertial +x axis (the direction of flight, down-range towards the site) towards
-+y (right), i.e. clockwise seen from above, as a compass with +x as north and +y as east.
-Its elevation is above the site's horizontal plane. The unit vector towards the Sun is
-    d = (cos el cos az, cos el sin az, -sin el)        (z down)
-so a Sun at azimuth 90 deg lights slopes that face +y. The range only sets the
-irradiance: E = 1361 W/m^2 (1 AU / range)^2.
+"""Terrain shadows under the Sun (`sun.Sun`: its direction and irradiance).
 
 Shadows: a horizon march over the height field, once per Sun position, written as a
 recurrence. For a point P, let S(P) be the lowest height at P from which the Sun is
@@ -31,30 +22,7 @@ from numba import njit
 
 from .terrain import bilinear
 
-SOLAR_CONSTANT_W_M2 = 1361.0  # at 1 AU
-AU_M = 1.495978707e11
 DARK_M = 1.0e12  # shadow height where the Sun is below the horizon (finite, to interpolate)
-
-
-@dataclass(frozen=True)
-class Sun:
-    range_m: float
-    azimuth_deg: float
-    elevation_deg: float
-
-    @property
-    def direction(self) -> np.ndarray:
-        """Unit vector toward the Sun in the inertial frame (z down)."""
-        return sun_direction(self.azimuth_deg, self.elevation_deg)
-
-    @property
-    def irradiance_w_m2(self) -> float:
-        return SOLAR_CONSTANT_W_M2 * (AU_M / self.range_m) ** 2
-
-
-def sun_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
-    az, el = np.radians(azimuth_deg), np.radians(elevation_deg)
-    return np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)])
 
 
 def local_sun_tan_elevation(x_m: np.ndarray, y_m: np.ndarray, sun_dir: np.ndarray, radius_m: float) -> np.ndarray:

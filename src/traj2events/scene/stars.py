@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.camera import Camera, CameraPose
-from .illumination import SOLAR_CONSTANT_W_M2
+from .sun import SOLAR_CONSTANT_W_M2
 
 COUNT_LOG10_AT_V0 = 0.74  # log10 N(< V) = COUNT_LOG10_AT_V0 + COUNT_SLOPE V, whole sky
 COUNT_SLOPE = 0.48

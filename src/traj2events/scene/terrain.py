@@ -561,10 +561,3 @@ def surface_points(x_m: np.ndarray, y_m: np.ndarray, height_m: np.ndarray, radiu
     # z = R - (R + h) R / norm, written without cancelling R - R for small x, y, h.
     z = (radius_m * (norm - radius_m) - height_m * radius_m) / norm
     return np.stack([x_m * scale, y_m * scale, z], axis=-1)
-
-
-def horizon_distance_m(altitude_m: float, relief_m: float, radius_m: float) -> float:
-    """Ground range beyond which terrain of height <= relief_m is hidden from a camera at
-    altitude_m: the two tangent distances to the sphere, camera's and the peaks'."""
-    a, r = max(altitude_m, 0.0), max(relief_m, 0.0)
-    return float(np.sqrt(a * (2 * radius_m + a)) + np.sqrt(r * (2 * radius_m + r)))

@@ -22,12 +22,13 @@ from ..geometry.camera import Camera
 from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
 from ..renderer.draw import TerrainRenderer
-from ..scene.illumination import Sun
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField
-from ..scene.terrain import ProceduralTerrain, TerrainParams, horizon_distance_m, load_elevation_grid
+from ..scene.sun import Sun
+from ..scene.terrain import ProceduralTerrain, TerrainParams, load_elevation_grid
 from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
+from ..settings import render_settings
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.state import POSE
 from ..trajectory.upsample import ReintegratedStates
@@ -54,39 +55,19 @@ class RenderSettings:
     display_gamma: float
     timing: dict
     stars: dict
-    emulator_white_w_m2_sr: float | None  # adaptive timing: the emulator's 255 DN (its log response's scale)
+    emulator_input: dict | None  # adaptive timing: events.input and events.sensor (its log's scale)
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
-        sc = config["scenarios"][name]
-        radius = float(config["motion_field"]["moon_radius_m"])
-        # Out to the horizon of the scenario's highest camera (with a margin for climbs
-        # and relief), from the farthest start point.
-        reach = max(abs(v) for v in sc["downrange_m"]) + max(abs(v) for v in sc["crossrange_m"])
-        horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
-        r = config["render"]
-        return cls(
-            name,
-            int(config["camera"]["width"]),
-            int(config["camera"]["height"]),
-            float(config["camera"]["fov_deg"]),
-            float(config["camera"]["mount_height_m"]),
-            radius,
-            dict(config["terrain"]),
-            dict(sc["sun"]),
-            dict(r["reflectance"]),
-            dict(r["lod"]),
-            float(reach + horizon),
-            float(r["display_white_w_m2_sr"]),
-            float(r["display_gamma"]),
-            dict(r["timing"]),
-            dict(r["stars"]),
-            # Only adaptive frames depend on the emulator's input scale (None: fixed renders
-            # do not rerun when the sensor settings change).
-            emulator_white_w_m2_sr(config["events"], float(r["display_white_w_m2_sr"]))
-            if r["timing"]["mode"] == "adaptive"
-            else None,
-        )
+        return cls(**render_settings(config, name))
+
+    @property
+    def emulator_white_w_m2_sr(self) -> float | None:
+        """The radiance the emulator's input puts at 255 DN (adaptive timing predicts its
+        log); None with fixed timing."""
+        if self.emulator_input is None:
+            return None
+        return emulator_white_w_m2_sr(self.emulator_input, self.display_white_w_m2_sr)
 
     def to_json(self) -> str:
         return json.dumps(self.__dict__, sort_keys=True)

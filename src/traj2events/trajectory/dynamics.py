@@ -24,7 +24,20 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from .state import CONTROL_NAMES, N_CONTROL, N_STATE, STATE_NAMES, rotation_body_to_inertial, rotation_matrix
+from .state import (
+    BODY_RATES,
+    CONTROL_NAMES,
+    MASS,
+    N_CONTROL,
+    N_STATE,
+    PITCH,
+    ROLL,
+    STATE_NAMES,
+    VELOCITY,
+    YAW,
+    rotation_body_to_inertial,
+    rotation_matrix,
+)
 from .vehicle import Vehicle
 
 __all__ = [
@@ -43,10 +56,10 @@ def _state_derivative_sx(vehicle: Vehicle) -> ca.Function:
     """Build f(x, u) -> dx/dt symbolically; u is the physical 4-vector."""
     x = ca.SX.sym("x", N_STATE)
     u = ca.SX.sym("u", N_CONTROL)
-    v = x[3:6]
-    phi, theta, psi = x[6], x[7], x[8]
-    omega = x[9:12]
-    m = x[12]
+    v = x[VELOCITY]
+    phi, theta, psi = x[ROLL], x[PITCH], x[YAW]
+    omega = x[BODY_RATES]
+    m = x[MASS]
     R = rotation_body_to_inertial(phi, theta, psi, lib=ca)
     thrust_dir = ca.vertcat(R[0][2], R[1][2], R[2][2])  # body +z in the inertial frame
     accel = ca.vertcat(0, 0, vehicle.g_m_s2) - vehicle.thrust_main_N * u[0] / m * thrust_dir

@@ -28,15 +28,22 @@ import numpy as np
 
 from ..defaults import section
 from .dynamics import N_STATE, Vehicle, split_control_dynamics
-from .state import MASS_KG, PITCH, STATE_SCALE, TIME_S
+from .state import MASS, MASS_KG, PITCH, ROLL, STATE_SCALE, TIME_S, YAW, Z
 
 TRANSCRIPTIONS = ("hermite-simpson", "trapezoidal")
 
 COST_SCALE = 1000.0  # J is divided by this so that it is O(1)
 
+
+def landing_cost(fuel_kg, effort, epsilon: float):
+    """The objective, J = (1 - eps) m_fuel + eps T integral |u|^2 dt (kg; T the time scale):
+    the paper's fuel with a small control-effort term that smooths the bang-bang throttle."""
+    return (1 - epsilon) * fuel_kg + epsilon * TIME_S * effort
+
+
 # Final state: position, velocity, roll, pitch and body rates are fixed (pinpoint,
 # upright, at rest); yaw and mass are free.
-FINAL_FIXED = np.array([0, 1, 2, 3, 4, 5, 6, 7, 9, 10, 11])
+FINAL_FIXED = np.array([i for i in range(N_STATE) if i not in (YAW, MASS)])
 
 
 _OCP = section("ocp")
@@ -177,22 +184,22 @@ class LandingProblem:
             effort = ca.sum2(h * (Lk[:-1] + Lk[1:])) / 2
 
         eps = settings.epsilon
-        fuel_kg = MASS_KG * (x0[12] - X[12, -1])
-        opti.minimize(((1 - eps) * fuel_kg + eps * TIME_S * effort) / COST_SCALE)
+        fuel_kg = MASS_KG * (x0[MASS] - X[MASS, -1])
+        opti.minimize(landing_cost(fuel_kg, effort, eps) / COST_SCALE)
 
         opti.subject_to(opti.bounded(0, ca.vec(W), 1))
         cos_tilt = np.cos(np.radians(vehicle.tilt_max_deg))
-        opti.subject_to(ca.cos(X[6, :]) * ca.cos(X[7, :]) >= cos_tilt)
+        opti.subject_to(ca.cos(X[ROLL, :]) * ca.cos(X[PITCH, :]) >= cos_tilt)
         # Roll and pitch bounds halfway between the tilt limit and 90 deg: never active
         # at a solution (the tilt limit is tighter), but as variable bounds they hold
         # at every iterate, so the Euler-rate singularity at theta = +-90 deg stays out
         # of reach (without them ~2-5 % of solves diverged there).
         angle_max = np.radians(0.5 * (vehicle.tilt_max_deg + 90.0))
-        opti.subject_to(opti.bounded(-angle_max, ca.vec(X[6:8, :]), angle_max))
+        opti.subject_to(opti.bounded(-angle_max, ca.vec(X[ROLL : PITCH + 1, :]), angle_max))
         if settings.pitch_decreasing:
             opti.subject_to(X[PITCH, 1:] <= X[PITCH, :-1])
-        opti.subject_to(X[2, :] <= 0)  # above the ground (z down)
-        opti.subject_to(X[12, :] >= vehicle.dry_mass_kg / MASS_KG)
+        opti.subject_to(X[Z, :] <= 0)  # above the ground (z down)
+        opti.subject_to(X[MASS, :] >= vehicle.dry_mass_kg / MASS_KG)
         opti.subject_to(X[:, 0] == x0)
         opti.subject_to(X[FINAL_FIXED.tolist(), -1] == xf)
         opti.subject_to(opti.bounded(settings.tf_min_s / TIME_S, tau, settings.tf_max_s / TIME_S))
@@ -224,7 +231,7 @@ class LandingProblem:
         final = np.where(np.isnan(bc.final), bc.initial, bc.final)
         s = self.fractions[:, None]
         state = (1 - s) * bc.initial + s * final
-        hover = np.clip(bc.initial[12] * self.vehicle.g_m_s2 / self.vehicle.thrust_main_N, 0, 1)
+        hover = np.clip(bc.initial[MASS] * self.vehicle.g_m_s2 / self.vehicle.thrust_main_N, 0, 1)
         control = np.zeros((n, 4))
         control[:, 0] = hover
         return bc.tf_guess_s * self.fractions, state, control
@@ -253,7 +260,7 @@ class LandingProblem:
         tf = float(value(self._tau)) * TIME_S
         control = np.hstack([W[:, :1], W[:, 1:4] - W[:, 4:7]])
         eps = self.settings.epsilon
-        cost = (1 - eps) * (bc.initial[12] - X[-1, 12]) + eps * TIME_S * float(value(self._effort))
+        cost = landing_cost(bc.initial[MASS] - X[-1, MASS], float(value(self._effort)), eps)
         return Solution(
             t=tf * self.fractions,
             state=X,

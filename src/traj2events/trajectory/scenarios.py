@@ -17,21 +17,9 @@ from typing import Callable
 
 import numpy as np
 
+from ..settings import RANGE_KEYS, solve_settings
 from .dynamics import N_STATE, Vehicle
 from .ocp import BoundaryConditions, LandingProblem, OcpSettings, Solution
-
-# Range keys in the order they are drawn (changing it changes every sample).
-RANGE_KEYS = (
-    "downrange_m",
-    "crossrange_m",
-    "altitude_m",
-    "speed_forward_m_s",
-    "speed_cross_m_s",
-    "speed_down_m_s",
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
-)
 
 
 @dataclass(frozen=True)
@@ -252,15 +240,7 @@ class ScenarioSettings:
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "ScenarioSettings":
-        vehicle = dict(config["vehicle"])
-        vehicle["inertia_kgm2"] = tuple(vehicle["inertia_kgm2"])
-        pitch_decreasing = bool(config["scenarios"][name].get("pitch_decreasing", False))
-        return cls(
-            Vehicle(**vehicle),
-            OcpSettings(**config["ocp"], pitch_decreasing=pitch_decreasing),
-            Scenario.from_config(name, config["scenarios"][name]),
-            int(config["seed"]),
-        )
+        return cls.from_json(json.dumps(solve_settings(config, name)))
 
     def to_json(self) -> str:
         return json.dumps(

@@ -33,6 +33,7 @@ CONVENTIONS = {
 POSITION = slice(0, 3)  # m, inertial
 VELOCITY = slice(3, 6)  # m/s, inertial
 ATTITUDE = slice(6, 9)  # rad: roll phi, pitch theta, yaw psi
+X, Y, Z = 0, 1, 2  # m: the position's elements (Z down: altitude = -z)
 ROLL, PITCH, YAW = 6, 7, 8  # rad: the attitude's elements
 BODY_RATES = slice(9, 12)  # rad/s: p, q, r
 MASS = 12  # kg
