@@ -226,11 +226,11 @@ def test_compiled_crater_pass_on_a_grid_equals_the_profiles_crater_by_crater():
 
 def hash_uniform(seed, stream, i, j):
     """The terrain's hashed uniforms at lattice points (i, j), element by element."""
-    from traj2events.scene.terrain import _hash_pair, _stream_key
+    from traj2events.scene.terrain_kernels import hash_pair, stream_key
 
     i, j = np.broadcast_arrays(np.asarray(i).astype(np.int64), np.asarray(j).astype(np.int64))
-    key = _stream_key(seed, stream)
-    return np.array([_hash_pair(key, a, b) for a, b in zip(i.ravel(), j.ravel())]).reshape(i.shape)
+    key = stream_key(seed, stream)
+    return np.array([hash_pair(key, a, b) for a, b in zip(i.ravel(), j.ravel())]).reshape(i.shape)
 
 
 def numpy_features_in_cells(seed, stream, lam, ix, iy):
@@ -254,11 +254,11 @@ def numpy_features_in_cells(seed, stream, lam, ix, iy):
 def test_features_per_cell_are_poisson_and_equal_the_numpy_reference(lam):
     """Counts per cell: the numpy reference's, bit for bit, with Poisson's mean and
     variance lam (capped at 51 where lam is large); the features' uniforms the same too."""
-    from traj2events.scene.terrain import _features_in_cells, _stream_key
+    from traj2events.scene.terrain_kernels import features_in_cells, stream_key
 
     ix, iy = np.arange(-40.0, 40.0), np.arange(7.0, 57.0)
-    keys = np.array([_stream_key(3, 8 + s) for s in range(5)], np.uint64)
-    ci, cj, uniforms = _features_in_cells(keys, lam, np.exp(-lam), ix[0], len(ix), iy[0], len(iy))
+    keys = np.array([stream_key(3, 8 + s) for s in range(5)], np.uint64)
+    ci, cj, uniforms = features_in_cells(keys, lam, np.exp(-lam), ix[0], len(ix), iy[0], len(iy))
     ref_ci, ref_cj, ref_uniforms = numpy_features_in_cells(3, 8, lam, ix, iy)
     assert ci.tobytes() == ref_ci.tobytes() and cj.tobytes() == ref_cj.tobytes()
     assert all(a.tobytes() == b.tobytes() for a, b in zip(uniforms, ref_uniforms))
@@ -275,18 +275,18 @@ def test_features_per_cell_are_poisson_and_equal_the_numpy_reference(lam):
 def test_value_noise_passes_through_the_lattice_values_and_is_continuous():
     """At lattice points the noise is the point's hashed uniform; between them it blends
     the four corners (so it stays in [0, 1)) and is continuous across cell edges."""
-    from traj2events.scene.terrain import _value_noise
+    from traj2events.scene.terrain_kernels import value_noise
 
     i, j = np.meshgrid(np.arange(-5.0, 5.0), np.arange(-3.0, 4.0), indexing="ij")
-    np.testing.assert_array_equal(_value_noise(4, 1000, i, j), hash_uniform(4, 1000, i, j))
+    np.testing.assert_array_equal(value_noise(4, 1000, i, j), hash_uniform(4, 1000, i, j))
     rng = np.random.default_rng(0)
     u, v = rng.uniform(-50, 50, 10_000), rng.uniform(-50, 50, 10_000)
-    noise = _value_noise(4, 1000, u, v)
+    noise = value_noise(4, 1000, u, v)
     assert noise.min() >= 0.0 and noise.max() < 1.0
     edge = np.round(u)  # either side of a cell edge: the fade's zero slope makes the jump tiny
-    below, above = _value_noise(4, 1000, edge - 1e-9, v), _value_noise(4, 1000, edge + 1e-9, v)
+    below, above = value_noise(4, 1000, edge - 1e-9, v), value_noise(4, 1000, edge + 1e-9, v)
     assert np.abs(below - above).max() < 1e-8
     # Midway along an edge: the mean of its two corners (the fade is 1/2 there).
-    mid = _value_noise(4, 1000, i + 0.5, j)
+    mid = value_noise(4, 1000, i + 0.5, j)
     corners = 0.5 * (hash_uniform(4, 1000, i, j) + hash_uniform(4, 1000, i + 1, j))
     np.testing.assert_allclose(mid, corners, rtol=0, atol=1e-15)

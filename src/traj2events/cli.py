@@ -16,6 +16,7 @@ from pathlib import Path
 
 from . import __version__
 from .defaults import section
+from .memory import keep_freed_memory
 
 
 def _settings(kind, value: str):
@@ -119,27 +120,8 @@ def _positive(option: str, value: float | None) -> None:
         raise ValueError(f"{option}: expected a value > 0, got {value}")
 
 
-def keep_freed_memory() -> None:
-    """Ask glibc's malloc to keep the memory a process frees for its next allocations. The
-    render and events commands allocate and free large arrays every frame (events: ~60 B per
-    event, ~75 MB per 1024^2 interval on the sensor path); by default glibc hands much of it
-    back to the kernel, which must clear those pages again at the next frame (bench/events_command.py
-    and bench/render.py measure it). The results cannot change; the process's memory stays at its peak
-    instead of falling between frames. A no-op where the C library has no mallopt (macOS) or
-    ignores it (musl)."""
-    import ctypes
-
-    try:
-        mallopt = ctypes.CDLL(None).mallopt
-    except (OSError, AttributeError):
-        return
-    m_trim_threshold, m_mmap_threshold = -1, -3  # glibc's <malloc.h>
-    mallopt(m_mmap_threshold, 256 << 20)  # arrays below 256 MiB from the heap, not mmap
-    mallopt(m_trim_threshold, (1 << 31) - 1)  # and its free top kept (up to 2 GiB)
-
-
 def cmd_events(args) -> int:
-    from .stages.events import CHUNK_FRAMES, emulate, emulator_params, export_events, frame_source
+    from .stages.events import emulator_params, events_command
 
     for option, value in (("--fps", args.fps), ("--white", args.white), ("--window-ms", args.window_ms)):
         _positive(option, value)
@@ -147,7 +129,8 @@ def cmd_events(args) -> int:
         raise ValueError(f"--seed: expected a value >= 0, got {args.seed}")
     if args.threads is not None and args.threads < 1:
         raise ValueError(f"--threads: expected a value >= 1, got {args.threads}")
-
+    if args.white is not None and args.input_scale != "display":
+        raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
     params = emulator_params(
         args.preset,
         refractory_s=args.refractory_s,
@@ -155,48 +138,29 @@ def cmd_events(args) -> int:
         hot_pixel_fraction=args.hot_pixel_fraction,
         hot_pixel_hz=args.hot_pixel_hz,
     )
-    if args.trajectory:
-        from .formats.trajectory import read_trajectory
-
-        read_trajectory(args.trajectory)  # refused now, not after the emulation
-    if args.white is not None and args.input_scale != "display":
-        raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
-    sensor = _sensor(args.sensor) if args.input_scale == "sensor" else None
-    chunk = CHUNK_FRAMES if args.chunk is None else args.chunk
-    threads = len(os.sched_getaffinity(0)) if args.threads is None else args.threads
-    source = frame_source(args.input, chunk, args.fps, args.white, sensor, ahead=threads > 1)
     keep_freed_memory()
-    from .progress import log
-
-    log(
-        f"{args.input}: {source.width} x {source.height} {source.kind} -> {args.output} "
-        f"(preset {args.preset}, seed {args.seed})"
-    )
-    _, _, t_last = emulate(
-        source,
-        params,
-        args.seed,
+    source = events_command(
+        args.input,
         args.output,
+        params,
         args.preset,
-        str(args.input),
-        progress_every=chunk * 10,
+        args.seed,
+        fps=args.fps,
+        white=args.white,
+        sensor=_sensor(args.sensor) if args.input_scale == "sensor" else None,
+        chunk=args.chunk,
+        threads=len(os.sched_getaffinity(0)) if args.threads is None else args.threads,
         labels=args.labels,
-        threads=threads,
+        exports={"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4},
+        trajectory=args.trajectory,
     )
     if args.frames_png:
         from .stages.pictures import events_picture
 
+        title = args.title or str(args.output)
         events_picture(
-            args.output,
-            t_last,
-            source.width,
-            source.height,
-            args.window_ms,
-            args.title or str(args.output),
-            args.frames_png,
+            args.output, source.t_last_s, source.width, source.height, args.window_ms, title, args.frames_png
         )
-    frames = str(args.input) if Path(args.input).suffix == ".h5" else None
-    export_events(args.output, args.npz, args.evt3, args.aedat4, args.trajectory, frames)
     return 0
 
 

@@ -9,5 +9,6 @@ Read first (the model):
     stars          the star field seen in the sky
 
 Machinery a reader may skip:
+    terrain_kernels  the terrain's compiled hashing, feature lookup and value noise
     tiles          level of detail: a quadtree of terrain tiles chosen per frame, cached
 """

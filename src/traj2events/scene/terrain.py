@@ -26,7 +26,6 @@ a low-pass version of the fine one, not a different surface).
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import math
 import os
@@ -38,6 +37,13 @@ import numpy as np
 from numba import njit
 
 from ..defaults import section
+from .terrain_kernels import (
+    as_regular_grid,
+    features_in_cells,
+    points_near,
+    stream_key,
+    value_noise,
+)
 
 _TERRAIN = section("terrain")
 
@@ -129,32 +135,6 @@ def degraded_crater_profile(rho: np.ndarray, depth_m: float) -> np.ndarray:
     return np.where(rho < DEGRADED_EXTENT, -0.5 * depth_m * (1.0 + np.cos(np.pi * rho / DEGRADED_EXTENT)), 0.0)
 
 
-# --- deterministic hashing (counter-based, so any patch is evaluated on its own) -----------
-
-
-@njit(cache=True, nogil=True)
-def _mix64(z):
-    """splitmix64 finaliser of one uint64: a bijective, well-mixed map (wrapping arithmetic)."""
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    return z ^ (z >> np.uint64(31))
-
-
-@functools.cache  # a few hundred streams, asked for by every tile: _mix64 from Python costs ~40 us
-def _stream_key(seed: int, stream: int) -> np.uint64:
-    """The hash key of one (seed, stream)."""
-    with np.errstate(over="ignore"):
-        return np.uint64(_mix64(np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream)))
-
-
-@njit(cache=True, nogil=True)
-def _hash_pair(key, i, j):
-    """A uniform [0, 1) number keyed by (the stream's key, i, j), for integer lattice indices."""
-    h = _mix64(key ^ (np.uint64(i) * np.uint64(0xD1B54A32D192ED03)))
-    h = _mix64(h ^ (np.uint64(j) * np.uint64(0x8CB92BA72F3D8DD7)))
-    return np.float64(h >> np.uint64(11)) * 2.0**-53
-
-
 # --- procedural terrain --------------------------------------------------------------------
 
 
@@ -227,10 +207,10 @@ class ProceduralTerrain:
         i0, i1 = np.floor((x_range[0] - reach) / cell), np.floor((x_range[1] + reach) / cell)
         j0, j1 = np.floor((y_range[0] - reach) / cell), np.floor((y_range[1] + reach) / cell)
         lam = density_per_m2 * cell**2
-        keys = np.array([_stream_key(self.params.seed, stream + s) for s in range(5)], np.uint64)
+        keys = np.array([stream_key(self.params.seed, stream + s) for s in range(5)], np.uint64)
         # One compiled call: a tile asks ~15 octaves of craters and boulders each, and
         # numpy's per-call overhead on these small arrays was ~40 % of tile building.
-        ci, cj, uniforms = _features_in_cells(keys, lam, np.exp(-lam), i0, int(i1 - i0) + 1, j0, int(j1 - j0) + 1)
+        ci, cj, uniforms = features_in_cells(keys, lam, np.exp(-lam), i0, int(i1 - i0) + 1, j0, int(j1 - j0) + 1)
         return ci, cj, list(uniforms)
 
     def boulders_in(
@@ -283,9 +263,9 @@ class ProceduralTerrain:
             return h
         bx, by, bd = self.boulders_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()), 2 * spacing_m)
         flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
-        grid = _as_regular_grid(x_m, y_m)
+        grid = as_regular_grid(x_m, y_m)
         for cx, cy, d in zip(bx, by, bd):
-            idx = _points_near(grid, flat_x, flat_y, cx, cy, d / 2)
+            idx = points_near(grid, flat_x, flat_y, cx, cy, d / 2)
             rho = np.hypot(flat_x[idx] - cx, flat_y[idx] - cy) / (d / 2)
             flat_h[idx] = np.maximum(flat_h[idx], boulder_profile(rho, d / 2))  # on top of each other: the higher
         return flat_h.reshape(x_m.shape)
@@ -307,7 +287,7 @@ class ProceduralTerrain:
             return h
         craters = self.craters_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()), min_diameter_m=2 * spacing_m)
         flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
-        grid = _as_regular_grid(x_m, y_m)
+        grid = as_regular_grid(x_m, y_m)
         if grid is not None:  # the tiles' case: one compiled pass over each crater's sub-block
             c = craters
             _add_craters_on_grid(
@@ -317,7 +297,7 @@ class ProceduralTerrain:
         for cx, cy, d, fresh, depth, rim, reach in zip(
             craters.x_m, craters.y_m, craters.diameter_m, craters.fresh, craters.depth_m, craters.rim_m, craters.reach_m
         ):
-            idx = _points_near(grid, flat_x, flat_y, cx, cy, reach)
+            idx = points_near(grid, flat_x, flat_y, cx, cy, reach)
             rho = np.hypot(flat_x[idx] - cx, flat_y[idx] - cy) / (d / 2)
             flat_h[idx] += fresh_crater_profile(rho, depth, rim) if fresh else degraded_crater_profile(rho, depth)
         return flat_h.reshape(x_m.shape)
@@ -334,7 +314,7 @@ class ProceduralTerrain:
             if short is None or short == (wavelength <= p.pad_relief_wavelength_max_m):
                 # Value noise: uniform values on a lattice, smooth (quintic) interpolation.
                 amplitude = p.roughness_m_at_1m * wavelength**p.roughness_hurst * np.sqrt(12.0)
-                h += amplitude * (_value_noise(p.seed, 1000 + octave, x_m / wavelength, y_m / wavelength) - 0.5)
+                h += amplitude * (value_noise(p.seed, 1000 + octave, x_m / wavelength, y_m / wavelength) - 0.5)
             wavelength /= 2
             octave += 1
         return h
@@ -350,84 +330,9 @@ class ProceduralTerrain:
 
 
 @njit(cache=True, nogil=True)
-def _features_in_cells(keys, lam, exp_minus_lam, i0, n_i, j0, n_j):
-    """`_in_cells` for the cells (i0 + a, j0 + b), a < n_i, b < n_j, in that order ('ij'):
-    per cell a Poisson(lam) count by inversion of its uniform (keys[0]): the smallest k
-    with u < P(X <= k), summed term by term, at most 51; then per feature m of cell (i, j)
-    four uniforms keyed (keys[1 + s], 256 i + m, j). Returns (ci, cj, uniforms (4, n))."""
-    counts = np.zeros(n_i * n_j, np.int64)
-    for a in range(n_i):
-        for b in range(n_j):
-            u = _hash_pair(keys[0], np.int64(i0 + a), np.int64(j0 + b))
-            term, cdf, k = exp_minus_lam, exp_minus_lam, 0
-            while u >= cdf and k <= 50:
-                k += 1
-                term *= lam / k
-                cdf = cdf + term
-            counts[a * n_j + b] = k
-    n = counts.sum()
-    ci, cj, uniforms = np.empty(n), np.empty(n), np.empty((4, n))
-    f = 0
-    for a in range(n_i):
-        for b in range(n_j):
-            i, j = i0 + a, j0 + b
-            for m in range(counts[a * n_j + b]):
-                ci[f], cj[f] = i, j
-                for s in range(4):
-                    uniforms[s, f] = _hash_pair(keys[1 + s], np.int64(i * 256 + m), np.int64(j))
-                f += 1
-    return ci, cj, uniforms
-
-
-def _value_noise(seed: int, stream: int, u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Value noise at lattice coordinates (u, v): the hashed uniforms of the four corners
-    around each point, blended with the quintic fade 6 f^5 - 15 f^4 + 10 f^3."""
-    u, v = np.broadcast_arrays(np.asarray(u, float), np.asarray(v, float))
-    out = np.empty(u.shape)
-    _value_noise_pass(_stream_key(seed, stream), u.ravel(), v.ravel(), out.reshape(-1))
-    return out
-
-
-@njit(cache=True, nogil=True)
-def _value_noise_pass(key, u, v, out):
-    """`_value_noise` point by point, compiled (a tile's roughness asks for ~20 octaves)."""
-    for k in range(u.size):
-        i0, j0 = np.floor(u[k]), np.floor(v[k])
-        fu, fv = u[k] - i0, v[k] - j0
-        su = fu * fu * fu * (fu * (fu * 6 - 15) + 10)
-        sv = fv * fv * fv * (fv * (fv * 6 - 15) + 10)
-        i, j = np.int64(i0), np.int64(j0)
-        c00, c10 = _hash_pair(key, i, j), _hash_pair(key, i + 1, j)
-        c01, c11 = _hash_pair(key, i, j + 1), _hash_pair(key, i + 1, j + 1)
-        out[k] = (c00 * (1 - su) + c10 * su) * (1 - sv) + (c01 * (1 - su) + c11 * su) * sv
-
-
-def _as_regular_grid(x: np.ndarray, y: np.ndarray):
-    """(x0, dx, nx, y0, dy, ny) if the points form an 'ij' grid (x varies along axis 0),
-    so that a crater only touches the sub-block it reaches; else None."""
-    if x.ndim != 2 or x.shape[0] < 2 or x.shape[1] < 2:
-        return None
-    dx, dy = x[1, 0] - x[0, 0], y[0, 1] - y[0, 0]
-    if dx <= 0 or dy <= 0 or not (np.all(x[:, :1] == x[:, -1:]) and np.all(y[:1, :] == y[-1:, :])):
-        return None
-    return x[0, 0], dx, x.shape[0], y[0, 0], dy, x.shape[1]
-
-
-def _points_near(grid, flat_x, flat_y, cx, cy, reach):
-    if grid is None:
-        return np.flatnonzero((np.abs(flat_x - cx) <= reach) & (np.abs(flat_y - cy) <= reach))
-    x0, dx, nx, y0, dy, ny = grid
-    i0, i1 = max(int(np.floor((cx - reach - x0) / dx)), 0), min(int(np.ceil((cx + reach - x0) / dx)) + 1, nx)
-    j0, j1 = max(int(np.floor((cy - reach - y0) / dy)), 0), min(int(np.ceil((cy + reach - y0) / dy)) + 1, ny)
-    if i0 >= i1 or j0 >= j1:
-        return np.empty(0, dtype=np.int64)
-    return (np.arange(i0, i1)[:, None] * ny + np.arange(j0, j1)[None, :]).ravel()
-
-
-@njit(cache=True, nogil=True)
 def _add_craters_on_grid(x0, dx, nx, y0, dy, ny, flat_x, flat_y, flat_h, cx, cy, diameter, fresh, depth, rim, reach):
     """The loop of `crater_relief_m` over craters on a regular grid, compiled: each crater's
-    profile added on the sub-block it reaches (`_points_near`), with the profiles'
+    profile added on the sub-block it reaches (`points_near`), with the profiles'
     operations in the order of `fresh_crater_profile` and `degraded_crater_profile`."""
     tail = 1.0 / EJECTA_EXTENT**3
     for c in range(cx.size):
