@@ -218,18 +218,42 @@ def test_cli_defaults_come_from_the_defaults_file():
     from traj2events.cli import build_parser
 
     d = default_config()
+    from traj2events.cli import _camera_settings
+
     args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f"])
-    assert (args.width, args.fov_deg, args.every) == (
+    camera = _camera_settings(args)
+    assert (camera["width"], camera["fov_deg"], camera["moon_radius_m"], args.every) == (
         d["camera"]["width"],
         d["camera"]["fov_deg"],
+        d["motion_field"]["moon_radius_m"],
         d["motion_field"]["every_n_frames"],
     )
+    args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f", "--settings",
+                                      '{"width": 64, "height": 48}', "--height", "32"])  # fmt: skip
+    assert (_camera_settings(args)["width"], _camera_settings(args)["height"]) == (64, 32)
+    from traj2events.cli import _events_settings
+
     args = build_parser().parse_args(["events", "in.mkv", "-o", "e.h5"])
-    assert (args.preset, args.refractory_mode, args.window_ms) == (
+    settings = _events_settings(args)
+    assert (settings["preset"], settings["refractory_mode"], settings["sensor"], args.window_ms) == (
         d["events"]["preset"],
         d["events"]["refractory_mode"],
+        d["events"]["sensor"],
         d["events"]["window_ms"],
     )
+    # --settings (what the workflow passes) sets them, an option given overrides it
+    args = build_parser().parse_args(
+        ["events", "in.mkv", "-o", "e.h5", "--settings", '{"preset": "clean", "labels": false}', "--no-labels",
+         "--refractory-s", "0.01", "--sensor", '{"f_number": 4}']
+    )  # fmt: skip
+    settings = _events_settings(args)
+    assert (settings["preset"], settings["labels"], settings["refractory_s"]) == ("clean", False, 0.01)
+    assert settings["sensor"] == {**d["events"]["sensor"], "f_number": 4}
+    args = build_parser().parse_args(["events", "in.mkv", "-o", "e.h5", "--settings", '{"preset": "clean"}',
+                                      "--preset", "paper"])  # fmt: skip
+    assert _events_settings(args)["preset"] == "paper"
+    with pytest.raises(ValueError, match="--settings: unknown keys"):
+        _events_settings(build_parser().parse_args(["events", "i", "-o", "e", "--settings", '{"presets": "x"}']))
 
 
 def test_non_utf8_and_non_mapping_configs_are_named(tmp_path):

@@ -9,7 +9,7 @@ import pytest
 
 from conftest import ROOT
 from traj2events.config import load_config
-from traj2events.settings import FrameTiming, render_settings, solve_settings
+from traj2events.settings import FrameTiming, camera_settings, events_settings, render_settings, solve_settings
 
 CONFIGS = ["config/config.yaml", "config/smoke.yaml", "config/paper.yaml"]
 
@@ -27,6 +27,24 @@ def test_the_stages_read_back_what_the_workflow_passes(path):
         )
         render = json.dumps(render_settings(config, name), sort_keys=True)
         assert RenderSettings.from_json(render).to_json() == render
+
+
+@pytest.mark.parametrize("path", CONFIGS)
+def test_the_events_command_reads_back_the_workflows_events_settings(path):
+    from traj2events.cli import _events_settings, build_parser
+
+    settings = events_settings(load_config(ROOT / path))
+    args = build_parser().parse_args(["events", "in.h5", "-o", "e.h5", "--settings", json.dumps(settings)])
+    assert _events_settings(args) == settings
+
+
+def test_the_motion_field_command_reads_back_the_workflows_camera():
+    from traj2events.cli import _camera_settings, build_parser
+
+    settings = camera_settings(load_config(ROOT / "config/paper.yaml"))
+    args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f",
+                                      "--settings", json.dumps(settings)])  # fmt: skip
+    assert _camera_settings(args) == settings and settings["width"] == 1024
 
 
 def test_only_adaptive_renders_depend_on_the_sensor():

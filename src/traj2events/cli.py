@@ -83,13 +83,12 @@ def cmd_render(args) -> int:
 
 
 def cmd_motion_field(args) -> int:
-    from .geometry.camera import Camera
     from .stages.motion_field import motion_field
 
     motion_field(
         args.trajectory,
-        Camera(args.width, args.height, args.fov_deg, args.mount_height_m),
-        args.moon_radius_m,
+        _camera(c := _camera_settings(args)),
+        c["moon_radius_m"],
         args.every,
         args.output,
         args.flo_dir,
@@ -98,21 +97,42 @@ def cmd_motion_field(args) -> int:
     return 0
 
 
-def _sensor(overrides: str | None):
-    """events.sensor's defaults with --sensor's JSON keys (inline or @file) on top."""
-    from .defaults import section
-    from .sensor.photocurrent import SensorParams
+def _json_option(option: str, value: str) -> dict:
+    """A JSON object given inline or as @file."""
+    text = Path(value[1:]).read_text() if value.startswith("@") else value
+    try:
+        given = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{option}: expected a JSON object: {exc}") from None
+    if not isinstance(given, dict):
+        raise ValueError(f"{option}: expected a JSON object, got {text!r}")
+    return given
 
-    given = {}
-    if overrides:
-        text = Path(overrides[1:]).read_text() if overrides.startswith("@") else overrides
-        try:
-            given = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ValueError(f"--sensor: expected a JSON object of events.sensor keys: {exc}") from None
-        if not isinstance(given, dict):
-            raise ValueError(f"--sensor: expected a JSON object of events.sensor keys, got {text!r}")
-    return SensorParams.from_config({**section("events")["sensor"], **given})
+
+def _layered(defaults: dict, settings: str | None, options: dict) -> dict:
+    """Settings in layers: the defaults, then --settings (JSON or @file), then each option given."""
+    layered = dict(defaults)
+    if settings:
+        given = _json_option("--settings", settings)
+        unknown = sorted(set(given) - set(layered))
+        if unknown:
+            raise ValueError(f"--settings: unknown keys {unknown}; expected {sorted(layered)}")
+        layered.update(given)
+    layered.update({k: v for k, v in options.items() if v is not None})
+    return layered
+
+
+def _events_settings(args) -> dict:
+    """events settings: defaults.yaml's, then --settings, then each option given."""
+    from .settings import events_settings
+
+    options = {"preset": args.preset, "refractory_s": args.refractory_s, "refractory_mode": args.refractory_mode,
+               "hot_pixel_fraction": args.hot_pixel_fraction, "hot_pixel_hz": args.hot_pixel_hz,
+               "labels": args.labels, "input": args.input_scale}  # fmt: skip
+    settings = _layered(events_settings({"events": section("events")}), args.settings, options)
+    if args.sensor:
+        settings["sensor"] = {**settings["sensor"], **_json_option("--sensor", args.sensor)}
+    return settings
 
 
 def _positive(option: str, value: float | None) -> None:
@@ -121,6 +141,7 @@ def _positive(option: str, value: float | None) -> None:
 
 
 def cmd_events(args) -> int:
+    from .sensor.photocurrent import SensorParams
     from .stages.events import emulator_params, events_command
 
     for option, value in (("--fps", args.fps), ("--white", args.white), ("--window-ms", args.window_ms)):
@@ -129,28 +150,24 @@ def cmd_events(args) -> int:
         raise ValueError(f"--seed: expected a value >= 0, got {args.seed}")
     if args.threads is not None and args.threads < 1:
         raise ValueError(f"--threads: expected a value >= 1, got {args.threads}")
-    if args.white is not None and args.input_scale != "display":
+    e = _events_settings(args)
+    if args.white is not None and e["input"] != "display":
         raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
-    params = emulator_params(
-        args.preset,
-        refractory_s=args.refractory_s,
-        refractory_mode=args.refractory_mode,
-        hot_pixel_fraction=args.hot_pixel_fraction,
-        hot_pixel_hz=args.hot_pixel_hz,
-    )
+    overrides = ("refractory_s", "refractory_mode", "hot_pixel_fraction", "hot_pixel_hz")
+    params = emulator_params(e["preset"], **{k: e[k] for k in overrides})
     keep_freed_memory()
     source = events_command(
         args.input,
         args.output,
         params,
-        args.preset,
+        e["preset"],
         args.seed,
         fps=args.fps,
         white=args.white,
-        sensor=_sensor(args.sensor) if args.input_scale == "sensor" else None,
+        sensor=SensorParams.from_config(e["sensor"]) if e["input"] == "sensor" else None,
         chunk=args.chunk,
         threads=len(os.sched_getaffinity(0)) if args.threads is None else args.threads,
-        labels=args.labels,
+        labels=e["labels"],
         exports={"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4},
         trajectory=args.trajectory,
     )
@@ -170,12 +187,10 @@ def cmd_picture(args) -> int:
     if args.kind == "frames":
         pictures.frames_picture(args.trajectory, args.video, args.output)
     elif args.kind == "motion-field":
-        from .geometry.camera import Camera
-
         pictures.motion_field_picture(
             args.trajectory,
-            Camera(args.width, args.height, args.fov_deg, args.mount_height_m),
-            args.moon_radius_m,
+            _camera(c := _camera_settings(args)),
+            c["moon_radius_m"],
             args.output,
             args.video,
         )
@@ -203,23 +218,38 @@ def cmd_summary(args) -> int:
 
 def _add_camera(p: argparse.ArgumentParser) -> None:
     camera, field = section("camera"), section("motion_field")
-    p.add_argument("--width", type=int, default=camera["width"], help="image width, px (default %(default)s)")
-    p.add_argument("--height", type=int, default=camera["height"], help="image height, px (default %(default)s)")
     p.add_argument(
-        "--fov-deg", type=float, default=camera["fov_deg"], help="horizontal field of view, deg (default %(default)s)"
+        "--settings",
+        help="the camera and sphere as JSON (or @file): width, height, fov_deg, mount_height_m, moon_radius_m "
+        "(the workflow passes the config's; the options below override them)",
     )
+    p.add_argument("--width", type=int, help=f"image width, px (default {camera['width']})")
+    p.add_argument("--height", type=int, help=f"image height, px (default {camera['height']})")
+    p.add_argument("--fov-deg", type=float, help=f"horizontal field of view, deg (default {camera['fov_deg']})")
     p.add_argument(
         "--mount-height-m",
         type=float,
-        default=camera["mount_height_m"],
-        help="camera height above the trajectory point along -z_b, m (default %(default)s)",
+        help=f"camera height above the trajectory point along -z_b, m (default {camera['mount_height_m']})",
     )
     p.add_argument(
         "--moon-radius-m",
         type=float,
-        default=field["moon_radius_m"],
-        help="radius of the sphere through the landing site, m (default %(default)s)",
+        help=f"radius of the sphere through the landing site, m (default {field['moon_radius_m']})",
     )
+
+
+def _camera_settings(args) -> dict:
+    """camera settings: defaults.yaml's, then --settings, then each option given."""
+    from .settings import camera_settings
+
+    defaults = camera_settings({"camera": section("camera"), "motion_field": section("motion_field")})
+    return _layered(defaults, args.settings, {k: getattr(args, k) for k in defaults})
+
+
+def _camera(settings: dict):
+    from .geometry.camera import Camera
+
+    return Camera(settings["width"], settings["height"], settings["fov_deg"], settings["mount_height_m"])
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -337,20 +367,24 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("input", help="frames.h5, a video file, or a folder of images")
     p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc)")
     p.add_argument(
+        "--settings",
+        help="the emulator settings as JSON (or @file): preset, refractory_s, refractory_mode, hot_pixel_fraction, "
+        "hot_pixel_hz, labels, input, sensor (the workflow passes the config's; the options below override "
+        "them; default: defaults.yaml's events section)",
+    )
+    p.add_argument(
         "--preset",
         choices=("paper", "clean"),
-        default=events["preset"],
         help="paper: the paper's Table 2 (thresholds 0.25, sigma 0.03, 5 Hz shot noise, 0.1 Hz leak, "
-        "3 Hz low-pass); clean: no noise, no low-pass, no mismatch (default %(default)s)",
+        f"3 Hz low-pass); clean: no noise, no low-pass, no mismatch (default {events['preset']})",
     )
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
     p.add_argument(
         "--input-scale",
         choices=("sensor", "display"),
-        default=events["input"],
         help="frames.h5's radiance as the sensor's photocurrent (--sensor; docs/events.md 'Sensor model') or as "
-        "255 L / white, the videos' scale (default %(default)s)",
+        f"255 L / white, the videos' scale (default {events['input']})",
     )
     p.add_argument(
         "--sensor",
@@ -363,32 +397,21 @@ def build_parser() -> argparse.ArgumentParser:
         type=float,
         help="with --input-scale display: radiance at full scale (default: frames.h5's display white)",
     )
-    p.add_argument(
-        "--refractory-s", type=float, default=events["refractory_s"], help="refractory period, s (default %(default)s)"
-    )
+    p.add_argument("--refractory-s", type=float, help=f"refractory period, s (default {events['refractory_s']})")
     p.add_argument(
         "--refractory-mode",
         choices=("drop", "defer"),
-        default=events["refractory_mode"],
-        help="suppressed crossings: dropped (ESIM) or pending (v2e) (default %(default)s)",
+        help=f"suppressed crossings: dropped (ESIM) or pending (v2e) (default {events['refractory_mode']})",
     )
     p.add_argument(
-        "--hot-pixel-fraction",
-        type=float,
-        default=events["hot_pixel_fraction"],
-        help="fraction of hot pixels (default %(default)s)",
+        "--hot-pixel-fraction", type=float, help=f"fraction of hot pixels (default {events['hot_pixel_fraction']})"
     )
-    p.add_argument(
-        "--hot-pixel-hz",
-        type=float,
-        default=events["hot_pixel_hz"],
-        help="rate of the hot pixels, Hz (default %(default)s)",
-    )
+    p.add_argument("--hot-pixel-hz", type=float, help=f"rate of the hot pixels, Hz (default {events['hot_pixel_hz']})")
     p.add_argument(
         "--labels",
         action=argparse.BooleanOptionalAction,
-        default=events["labels"],
-        help="also write each event's cause (events/label: signal, shot_noise, leak, hot_pixel) (default %(default)s)",
+        help="also write each event's cause (events/label: signal, shot_noise, leak, hot_pixel) "
+        f"(default {events['labels']})",
     )
     p.add_argument(
         "--chunk",

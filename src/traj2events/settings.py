@@ -7,6 +7,8 @@ model's objects (`trajectory.scenarios.ScenarioSettings`, `stages.render.RenderS
 
     solve_settings    base and sample solves of a scenario: vehicle, ocp, ranges, seed
     render_settings   one scenario's frames: camera, terrain, Sun, reflectance, detail, timing
+    events_settings   the emulation: pixel-model preset and overrides, labels, input, sensor
+    camera_settings   the camera and the Moon's sphere (motion field, its picture)
 """
 
 from __future__ import annotations
@@ -107,3 +109,22 @@ def render_settings(config: dict, name: str) -> dict:
         if adaptive
         else None,
     }
+
+
+EVENTS_KEYS = ("preset", "refractory_s", "refractory_mode", "hot_pixel_fraction", "hot_pixel_hz", "labels", "input")
+
+
+def events_settings(config: dict) -> dict:
+    """Everything the emulation depends on (the seed aside, per trajectory): the pixel
+    model's preset and the keys that override it, labels, the input scale and the sensor."""
+    events = config["events"]
+    return {**{key: events[key] for key in EVENTS_KEYS}, "sensor": dict(events["sensor"])}
+
+
+CAMERA_KEYS = ("width", "height", "fov_deg", "mount_height_m")
+
+
+def camera_settings(config: dict) -> dict:
+    """The camera (image size, field of view, mounting) and the sphere through the site."""
+    camera = config["camera"]
+    return {**{key: camera[key] for key in CAMERA_KEYS}, "moon_radius_m": config["motion_field"]["moon_radius_m"]}

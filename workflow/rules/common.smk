@@ -13,6 +13,8 @@ from snakemake.settings.types import DeploymentMethod
 from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
 from traj2events.plan import dataset_plan, job_resources
+from traj2events.settings import camera_settings as camera_settings_of
+from traj2events.settings import events_settings as events_settings_of
 from traj2events.settings import render_settings as render_settings_of, solve_settings
 
 try:
@@ -96,13 +98,9 @@ def preview_option(wildcards, output):
     return f"--preview {output.preview}" if config["render"]["preview"] else ""
 
 
-def camera_options(wildcards):
-    """The camera and sphere of the config as command-line options."""
-    c = config["camera"]
-    return (
-        f"--width {c['width']} --height {c['height']} --fov-deg {c['fov_deg']} --mount-height-m {c['mount_height_m']} "
-        f"--moon-radius-m {config['motion_field']['moon_radius_m']}"
-    )
+def camera_settings(wildcards):
+    """The camera and sphere of the config, as JSON."""
+    return json.dumps(camera_settings_of(config), sort_keys=True)
 
 
 EXPORT_FILES = {"npz": "events.npz", "evt3": "events.raw", "aedat4": "events.aedat4"}
@@ -117,14 +115,9 @@ def export_flags(wildcards, output):
     return " ".join(f"--{name} {output[name]}" for name in config["events"]["exports"])
 
 
-def event_options(wildcards):
-    """The emulator settings of the config as command-line options."""
-    e = config["events"]
-    return (
-        f"--preset {e['preset']} --refractory-s {e['refractory_s']} --refractory-mode {e['refractory_mode']} "
-        f"--hot-pixel-fraction {e['hot_pixel_fraction']} --hot-pixel-hz {e['hot_pixel_hz']} "
-        f"--{'' if e['labels'] else 'no-'}labels --input-scale {e['input']} --sensor {shlex.quote(json.dumps(e['sensor']))}"
-    )
+def events_settings(wildcards):
+    """The emulator settings of the config, as JSON."""
+    return json.dumps(events_settings_of(config), sort_keys=True)
 
 
 def event_seed(wildcards):

@@ -21,10 +21,10 @@ rule events:
         mem_mb=resources_of("events", "mem_mb"),
         runtime=resources_of("events", "runtime"),
     params:
-        options=event_options,
+        settings=events_settings,
         seed=event_seed,
         exports=export_flags,
         code=code("events"),
     shell:
-        "traj2events events {input.frames} --output {output.events} --seed {params.seed} {params.options} "
+        "traj2events events {input.frames} --output {output.events} --seed {params.seed} --settings {params.settings:q} "
         "--trajectory {input.trajectory} {params.exports} --threads {threads} 2> {log}"

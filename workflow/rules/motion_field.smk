@@ -19,9 +19,9 @@ rule motion_field:
         mem_mb=resources_of("motion_field", "mem_mb"),
         runtime=resources_of("motion_field", "runtime"),
     params:
-        camera=camera_options,
+        camera=camera_settings,
         every=config["motion_field"]["every_n_frames"],
         code=code("motion_field"),
     shell:
-        "traj2events motion-field {input.trajectory} --frames {input.frames} {params.camera} "
+        "traj2events motion-field {input.trajectory} --frames {input.frames} --settings {params.camera:q} "
         "--every {params.every} --output {output.field} --flo-dir {output.flo} 2> {log}"

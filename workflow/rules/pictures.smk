@@ -44,10 +44,10 @@ rule motion_field_picture:
     conda:
         ENV
     params:
-        camera=camera_options,
+        camera=camera_settings,
         code=code("pictures"),
     shell:
-        "traj2events picture motion-field {input.trajectory} {params.camera} --video {input.video} "
+        "traj2events picture motion-field {input.trajectory} --settings {params.camera:q} --video {input.video} "
         "--output {output} 2> {log}"
 
 
