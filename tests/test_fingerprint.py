@@ -110,3 +110,16 @@ def test_a_code_change_changes_the_stages_that_import_it(package_copy):
     assert {s for s in STAGES if again[s] != after[s]} == {"events", "render"}
     package_copy("renderer/shaders/terrain.frag", "void main", "// a shader comment is text, and counts\nvoid main")
     assert code_fingerprint("traj2events.stages.render") != before["render"]
+
+
+def test_a_stages_settings_rerun_that_stage_and_not_the_others(package_copy):
+    before = all_fingerprints()
+    package_copy(
+        "settings/render.py", 'TIMING_MODES = ("fixed", "adaptive")', 'TIMING_MODES = ("fixed", "adaptive", "x")'
+    )
+    after = all_fingerprints()
+    assert {s for s in STAGES if after[s] != before[s]} == {"render"}
+    package_copy("settings/solve.py", '    "yaw_deg",\n)', '    "yaw_deg",\n    "extra",\n)')
+    again = all_fingerprints()
+    changed = {s for s in STAGES if again[s] != after[s]}
+    assert {"base_solution", "sample_trajectories"} <= changed and not {"render", "events", "motion_field"} & changed

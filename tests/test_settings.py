@@ -9,7 +9,10 @@ import pytest
 
 from conftest import ROOT
 from traj2events.config import load_config
-from traj2events.settings import FrameTiming, camera_settings, events_settings, render_settings, solve_settings
+from traj2events.settings.camera import camera_settings
+from traj2events.settings.events import events_settings
+from traj2events.settings.render import FrameTiming, render_settings
+from traj2events.settings.solve import solve_settings
 
 CONFIGS = ["config/config.yaml", "config/smoke.yaml", "config/paper.yaml"]
 

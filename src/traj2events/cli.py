@@ -124,7 +124,7 @@ def _layered(defaults: dict, settings: str | None, options: dict) -> dict:
 
 def _events_settings(args) -> dict:
     """events settings: defaults.yaml's, then --settings, then each option given."""
-    from .settings import events_settings
+    from .settings.events import events_settings
 
     options = {"preset": args.preset, "refractory_s": args.refractory_s, "refractory_mode": args.refractory_mode,
                "hot_pixel_fraction": args.hot_pixel_fraction, "hot_pixel_hz": args.hot_pixel_hz,
@@ -240,7 +240,7 @@ def _add_camera(p: argparse.ArgumentParser) -> None:
 
 def _camera_settings(args) -> dict:
     """camera settings: defaults.yaml's, then --settings, then each option given."""
-    from .settings import camera_settings
+    from .settings.camera import camera_settings
 
     defaults = camera_settings({"camera": section("camera"), "motion_field": section("motion_field")})
     return _layered(defaults, args.settings, {k: getattr(args, k) for k in defaults})

@@ -71,7 +71,7 @@ def _non_finite(value: Any, path: tuple = ()) -> list[str]:
 
 
 def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
-    from .settings import RANGE_KEYS
+    from .settings.solve import RANGE_KEYS
 
     errors = []
     if name in RESERVED_SCENARIO_NAMES:
@@ -164,7 +164,7 @@ def _semantic_errors(config: dict) -> list[str]:
 
 def _timing_errors(timing: dict) -> list[str]:
     """FrameTiming's own checks (the render job would fail on them), before any job starts."""
-    from .settings import FrameTiming
+    from .settings.render import FrameTiming
 
     try:
         FrameTiming(**timing)

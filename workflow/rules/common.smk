@@ -13,9 +13,10 @@ from snakemake.settings.types import DeploymentMethod
 from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
 from traj2events.plan import dataset_plan, job_resources
-from traj2events.settings import camera_settings as camera_settings_of
-from traj2events.settings import events_settings as events_settings_of
-from traj2events.settings import render_settings as render_settings_of, solve_settings
+from traj2events.settings.camera import camera_settings as camera_settings_of
+from traj2events.settings.events import events_settings as events_settings_of
+from traj2events.settings.render import render_settings as render_settings_of
+from traj2events.settings.solve import solve_settings
 
 try:
     _resolved = resolve_config(config)

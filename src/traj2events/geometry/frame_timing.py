@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from ..sensor.laws import log_intensity_8bit, radiance_to_dn
-from ..settings import FrameTiming
+from ..settings.render import FrameTiming
 from .camera import Camera
 from .motion_field import depth_flow
 

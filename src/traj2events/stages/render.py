@@ -28,7 +28,7 @@ from ..scene.sun import Sun
 from ..scene.terrain import ProceduralTerrain, TerrainParams, load_elevation_grid
 from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
-from ..settings import render_settings
+from ..settings.render import render_settings
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.state import POSE
 from ..trajectory.upsample import ReintegratedStates

@@ -17,7 +17,7 @@ from .. import __version__
 from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_trajectory, solution_attrs, write_solution_set
 from ..progress import log
-from ..settings import RANGE_KEYS
+from ..settings.solve import RANGE_KEYS
 from ..trajectory.batch import print_progress, solve_samples
 from ..trajectory.ocp import Solution
 from ..trajectory.scenarios import SampleResult, ScenarioSettings, base_conditions

@@ -17,7 +17,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..settings import RANGE_KEYS, solve_settings
+from ..settings.solve import RANGE_KEYS, solve_settings
 from .dynamics import N_STATE, Vehicle
 from .ocp import BoundaryConditions, LandingProblem, OcpSettings, Solution
 
