@@ -19,9 +19,14 @@ from .defaults import section
 from .memory import keep_freed_memory
 
 
+def _inline_or_file(value: str) -> str:
+    """An option's text, given inline or as @file."""
+    return Path(value[1:]).read_text() if value.startswith("@") else value
+
+
 def _settings(kind, value: str):
     """--settings (JSON inline, or @file) as a `kind` settings object."""
-    text = Path(value[1:]).read_text() if value.startswith("@") else value
+    text = _inline_or_file(value)
     try:
         return kind.from_json(text)
     except (ValueError, TypeError, KeyError, AttributeError) as exc:
@@ -99,7 +104,7 @@ def cmd_motion_field(args) -> int:
 
 def _json_option(option: str, value: str) -> dict:
     """A JSON object given inline or as @file."""
-    text = Path(value[1:]).read_text() if value.startswith("@") else value
+    text = _inline_or_file(value)
     try:
         given = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -156,7 +161,7 @@ def cmd_events(args) -> int:
     overrides = ("refractory_s", "refractory_mode", "hot_pixel_fraction", "hot_pixel_hz")
     params = emulator_params(e["preset"], **{k: e[k] for k in overrides})
     keep_freed_memory()
-    source = events_command(
+    source, t_last_s = events_command(
         args.input,
         args.output,
         params,
@@ -175,9 +180,7 @@ def cmd_events(args) -> int:
         from .stages.pictures import events_picture
 
         title = args.title or str(args.output)
-        events_picture(
-            args.output, source.t_last_s, source.width, source.height, args.window_ms, title, args.frames_png
-        )
+        events_picture(args.output, t_last_s, source.width, source.height, args.window_ms, title, args.frames_png)
     return 0
 
 

@@ -317,13 +317,6 @@ class EventEmulator:
             pix[:end], t[:end], on[:end], label[:end] if self.labels else None, self.width, n_pixels, columns
         )
 
-    def _refractory(self, pix: np.ndarray, t: np.ndarray) -> np.ndarray:
-        """Mask of the events to emit (step 5): with T_ref > 0, an event closer than T_ref to
-        its pixel's previous emitted event is suppressed. `pix` grouped, `t` increasing per pixel."""
-        if self.params.refractory_s > 0:  # without one, the last event times are never needed
-            return refractory_mask(pix, t, self._last_event, float(self.params.refractory_s))
-        return np.ones(len(t), bool)
-
     def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         p = self.params
         if p.shot_noise_hz <= 0:
@@ -340,10 +333,10 @@ class EventEmulator:
     def _noise_after_signal(self, pix: np.ndarray, t: np.ndarray, on: np.ndarray) -> tuple[np.ndarray, ...]:
         """The interval's shot noise once its signal events are emitted: the refractory
         period against those, and each noise event's reset of its pixel."""
-        if self.params.refractory_s > 0:
+        if self.params.refractory_s > 0:  # step 5 (without it, the last event times are never needed)
             order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
             pix, t, on = pix[order], t[order], on[order]
-            keep = self._refractory(pix, t)
+            keep = refractory_mask(pix, t, self._last_event, float(self.params.refractory_s))
             pix, t, on = pix[keep], t[keep], on[keep]
         # A noise event resets the pixel like a real one: its reference jumps to the current
         # signal (for a real crossing that is base +- theta). Applied at the interval's end.

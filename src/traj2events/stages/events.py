@@ -52,7 +52,6 @@ class FrameSource:
     scene: dict = field(default_factory=dict)  # what frames.h5 says of the camera and the scene
     input_scale: float = 1.0  # the chunks' values times this are the emulator's DN
     decoder_cpus: int = 0  # CPUs a child process takes decoding the input (ffmpeg's, for a video)
-    t_last_s: float = 0.0  # the last frame's time, once emulated
 
 
 # ffmpeg's decoder threads for a video: one, beside the emulator's. ffmpeg's default, a
@@ -304,21 +303,21 @@ def events_command(
     labels: bool = False,
     exports: dict[str, str | None] | None = None,
     trajectory: str | None = None,
-) -> FrameSource:
+) -> tuple[FrameSource, float]:
     """The events stage as the command runs it: `input` (frames.h5 through `sensor`, or on
     the display scale without one; a video; a folder of images) emulated into events.h5,
     then the exports (`exports`: npz, evt3, aedat4 paths or None; the .npz takes
     `trajectory`'s states and frames.h5's range meter). Returns the source (its size) and
-    sets its `t_last_s` (the last frame's time): what the event-frame picture needs."""
+    the last frame's time (s): what the event-frame picture needs."""
     if trajectory:
         read_trajectory(trajectory)  # refused now, not after the emulation
     chunk = CHUNK_FRAMES if chunk is None else chunk
     source = frame_source(input, chunk, fps, white, sensor, ahead=threads > 1)
     log(f"{input}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset}, seed {seed})")
-    _, _, source.t_last_s = emulate(
+    _, _, t_last_s = emulate(
         source, params, seed, output, preset, str(input), progress_every=chunk * 10, labels=labels, threads=threads
     )
     frames = str(input) if Path(input).suffix == ".h5" else None
     e = exports or {}
     export_events(output, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)
-    return source
+    return source, t_last_s

@@ -37,13 +37,6 @@ class Scenario:
             if lo > hi:
                 raise ValueError(f"scenarios.{self.name}.{key}: expected [min, max] with min <= max, got [{lo}, {hi}]")
 
-    @classmethod
-    def from_config(cls, name: str, cfg: dict) -> "Scenario":
-        ranges = {k: (float(cfg[k][0]), float(cfg[k][1])) for k in RANGE_KEYS}
-        return cls(
-            name=name, n_trajectories=int(cfg["n_trajectories"]), tf_guess_s=float(cfg["tf_guess_s"]), ranges=ranges
-        )
-
     def to_dict(self) -> dict:
         d = asdict(self)
         d["ranges"] = {k: list(v) for k, v in self.ranges.items()}
