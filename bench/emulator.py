@@ -42,7 +42,8 @@ from scipy.ndimage import gaussian_filter  # noqa: E402
 
 import traj2events.sensor.emulator as emulator  # noqa: E402
 from traj2events.formats.events import EVENT_LABELS, EventsWriter  # noqa: E402
-from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.emulator import EventEmulator  # noqa: E402
+from traj2events.stages.events import preset_params  # noqa: E402
 
 
 def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.ndarray:
@@ -61,7 +62,7 @@ def flickering(frames: np.ndarray, period_frames: int, dim: float) -> np.ndarray
 
 def load_kernels(frames: np.ndarray) -> None:
     """Load (or compile) the kernels for this input type, so that no timing includes it."""
-    EventEmulator(frames.shape[2], frames.shape[1], PRESETS["paper"], seed=0).process(frames[:2], [0.0, 0.01])
+    EventEmulator(frames.shape[2], frames.shape[1], preset_params("paper"), seed=0).process(frames[:2], [0.0, 0.01])
 
 
 def emulate_timed(frames: np.ndarray, labels: bool = False, threads: int = 1) -> tuple[list, float]:
@@ -69,7 +70,7 @@ def emulate_timed(frames: np.ndarray, labels: bool = False, threads: int = 1) ->
     with `labels`, each chunk is (events, labels); `threads`: the emulator's."""
     n_frames, height, width = frames.shape
     times = np.arange(n_frames) / 100.0
-    emu = EventEmulator(width, height, PRESETS["paper"], seed=1, labels=labels, threads=threads)
+    emu = EventEmulator(width, height, preset_params("paper"), seed=1, labels=labels, threads=threads)
     process = emu.process_with_labels if labels else emu.process
     start = time.perf_counter()
     chunks = [process(frames[k : k + 10], times[k : k + 10]) for k in range(0, n_frames, 10)]
@@ -81,7 +82,7 @@ def labels_cost(n_frames: int, repeats: int) -> None:
     print(f"# labels cost, paper preset, 1 thread, 1024 x 1024 texture, {n_frames} frames, on {platform.node()}")
     frames = moving_texture(1024, 1024, n_frames)
     load_kernels(frames)
-    EventEmulator(1024, 1024, PRESETS["paper"], labels=True).process_with_labels(frames[:2], [0.0, 0.01])
+    EventEmulator(1024, 1024, preset_params("paper"), labels=True).process_with_labels(frames[:2], [0.0, 0.01])
     times = {False: [], True: []}
     for _ in range(repeats):
         for labels in (False, True):

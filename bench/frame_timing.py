@@ -66,8 +66,9 @@ from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.geometry.camera import Camera  # noqa: E402
 from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
 from traj2events.renderer.draw import Frame, TerrainRenderer  # noqa: E402
-from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
+from traj2events.stages.events import preset_params  # noqa: E402
 from traj2events.stages.render import RenderSettings, render_between  # noqa: E402
 from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
 from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
@@ -128,7 +129,7 @@ class Stream:
     """One variant's emulator, fed frame by frame, with its costs and worst interval."""
 
     def __init__(self, width: int, height: int):
-        self.emulator = EventEmulator(width, height, PRESETS["clean"], seed=1)
+        self.emulator = EventEmulator(width, height, preset_params("clean"), seed=1)
         self.events, self.frames, self.emulate_s = [], 0, 0.0
         self.last_log = None
         self.worst = (0.0, 0.0)  # (measured max |dL|, predicted) of the worst interval

@@ -31,9 +31,10 @@ from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.geometry.motion_field import depth_flow  # noqa: E402
 from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.camera_poses import camera_poses  # noqa: E402
+from traj2events.stages.events import preset_params  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 
 GRAD_TEXTURE = 0.02  # |grad ln L| per px counted as texture
@@ -56,7 +57,7 @@ def last_second(trajectory: Path, settings: RenderSettings, mount_m: float, pad_
     log_l = np.log(np.maximum(np.stack(radiance), 1e-6))
     gy, gx = np.gradient(log_l, axis=(1, 2))
     textured = (np.hypot(gx, gy) > GRAD_TEXTURE).mean(axis=(1, 2))
-    emulator = EventEmulator(camera.width, camera.height, PRESETS["clean"], seed=1)
+    emulator = EventEmulator(camera.width, camera.height, preset_params("clean"), seed=1)
     dn = radiance_to_dn(np.stack(radiance), s.display_white_w_m2_sr)
     events = emulator.process(dn, tr.t[frames])
     on_edge = edge_share = 0.0

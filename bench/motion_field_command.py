@@ -55,7 +55,7 @@ def run_command(src: Path, trajectory: Path, size: int, every: int, frames: Path
     command += [
         "--height",
         str(size),
-        "--every",
+        "--every-n-frames",
         str(every),
         "-o",
         str(output / "mf.h5"),
@@ -135,7 +135,7 @@ def main() -> None:
                 env = {**os.environ, "PYTHONPATH": str(src), "OMP_NUM_THREADS": "1"}
                 subprocess.run(
                     [sys.executable, "-m", "traj2events", "motion-field", str(trajectory), "--width", str(args.size),
-                     "--height", str(args.size), "--every", str(args.every), "--frames", str(frames),
+                     "--height", str(args.size), "--every-n-frames", str(args.every), "--frames", str(frames),
                      "-o", str(out / "mf.h5"), "--flo-dir", str(out / "flo")],
                     env=env, check=True, capture_output=True,
                 )  # fmt: skip

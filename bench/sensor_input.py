@@ -35,9 +35,10 @@ from traj2events.formats.events import SIGNAL  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.geometry.motion_field import depth_flow  # noqa: E402
 from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.sensor.photocurrent import SensorParams, sensor_dn  # noqa: E402
+from traj2events.stages.events import preset_params  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
 from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
@@ -63,7 +64,7 @@ def render_clip(renderer, camera, states, t0: float, t1: float, fps: float):
 
 def emulate(frames: np.ndarray, times: np.ndarray, preset: str, edges: np.ndarray) -> dict:
     k, h, w = frames.shape
-    emulator = EventEmulator(w, h, PRESETS[preset], seed=1, labels=True)
+    emulator = EventEmulator(w, h, preset_params(preset), seed=1, labels=True)
     start = time.perf_counter()
     events, labels = emulator.process_with_labels(frames, times)
     seconds = time.perf_counter() - start

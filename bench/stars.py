@@ -29,8 +29,9 @@ from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
 from traj2events.scene.stars import star_radiance  # noqa: E402
-from traj2events.sensor.emulator import PRESETS, EventEmulator  # noqa: E402
+from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.photocurrent import SensorParams, sensor_dn  # noqa: E402
+from traj2events.stages.events import preset_params  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 
 
@@ -91,7 +92,7 @@ def main() -> None:
     print("|---|---|---|---|")
     for name, runs in seconds.items():
         radiance = np.stack([f.radiance for f in out[name]])
-        emulator = EventEmulator(camera.width, camera.height, PRESETS["clean"], seed=1)
+        emulator = EventEmulator(camera.width, camera.height, preset_params("clean"), seed=1)
         events = emulator.process(sensor_dn(radiance, sensor), tr.t[frames])
         interval = np.clip(np.searchsorted(tr.t[frames] * 1e6, events["t"], side="right") - 1, 0, len(frames) - 2)
         on_sky = int(sky_both[interval, events["y"], events["x"]].sum())

@@ -45,6 +45,8 @@ from traj2events.config import load_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory, write_trajectory  # noqa: E402
 from traj2events.plan import dataset_plan  # noqa: E402
 from traj2events.renderer.context import resolve_backend  # noqa: E402
+from traj2events.settings.camera import motion_field_settings  # noqa: E402
+from traj2events.settings.events import events_settings  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
 from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
@@ -82,22 +84,18 @@ def traj2events_cli() -> list[str]:
 
 def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_every: int) -> dict[str, list[str]]:
     cli = traj2events_cli()
-    camera, events = config["camera"], config["events"]
     settings = RenderSettings.from_config(config, scenario).to_json()
+    motion_field = {**motion_field_settings(config), "every_n_frames": field_every}
     frames = folder / "frames.h5"
     return {
         "render": [*cli, "render", str(clip), "--settings", settings, "--frames", str(frames),
                    "--video", str(folder / "video.mkv"),
                    *(["--preview", str(folder / "preview.mp4")] if config["render"]["preview"] else [])],
-        "motion field": [*cli, "motion-field", str(clip), "--width", str(camera["width"]),
-                         "--height", str(camera["height"]), "--fov-deg", str(camera["fov_deg"]),
-                         "--mount-height-m", str(camera["mount_height_m"]),
-                         "--every", str(field_every), "--frames", str(frames),
-                         "-o", str(folder / "motion_field.h5"), "--flo-dir", str(folder / "flow")],
+        "motion field": [*cli, "motion-field", str(clip), "--settings", json.dumps(motion_field),
+                         "--frames", str(frames), "-o", str(folder / "motion_field.h5"),
+                         "--flo-dir", str(folder / "flow")],
         "events": [*cli, "events", str(frames), "-o", str(folder / "events.h5"), "--seed", "1",
-                   "--preset", events["preset"], "--input-scale", events["input"],
-                   "--sensor", json.dumps(events["sensor"]), "--labels" if events["labels"] else "--no-labels",
-                   "--threads", "1"],  # as the workflow's rule
+                   "--settings", json.dumps(events_settings(config)), "--threads", "1"],  # as the workflow's rule
     }  # fmt: skip
 
 

@@ -10,7 +10,7 @@ import yaml
 
 from conftest import ROOT
 from traj2events.config import SCHEMA_PATH, ConfigError, load_config, load_yaml, resolve_config, validate_config
-from traj2events.defaults import default_config, merge_config
+from traj2events.defaults import default_config, merge_config, with_preset
 from traj2events.trajectory.scenarios import ScenarioSettings
 
 
@@ -21,7 +21,7 @@ def schema():
 
 @pytest.fixture()
 def config():
-    return default_config()
+    return with_preset(default_config())
 
 
 @pytest.mark.parametrize("name", ["config.yaml", "smoke.yaml", "paper.yaml"])
@@ -162,7 +162,7 @@ def test_overlays_hold_only_what_differs_from_the_defaults():
     assert config["camera"]["width"] == 32 and config["camera"]["fov_deg"] == default_config()["camera"]["fov_deg"]
     assert config["ocp"]["n_nodes"] == 30 and config["ocp"]["tol"] == default_config()["ocp"]["tol"]
     assert len(yaml.safe_dump(smoke)) < len(yaml.safe_dump(config)) / 5
-    assert load_config(ROOT / "config" / "config.yaml") == default_config()
+    assert load_config(ROOT / "config" / "config.yaml") == with_preset(default_config())
 
 
 def test_merge_replaces_values_and_merges_mappings():
@@ -186,7 +186,7 @@ def test_a_new_scenario_must_be_complete():
 
 @pytest.mark.parametrize("name", ["logs", "figures"])
 def test_reserved_scenario_names_are_refused(name):
-    config = default_config()
+    config = with_preset(default_config())
     config["scenarios"][name] = config["scenarios"]["descent"]
     with pytest.raises(ConfigError, match=rf"scenarios.{name}.*reserved"):
         validate_config(config)
@@ -214,48 +214,6 @@ def test_dataclass_defaults_come_from_the_defaults_file():
         assert {k: (list(v) if isinstance(v, tuple) else v) for k, v in defaults.items()} == values, cls
 
 
-def test_cli_defaults_come_from_the_defaults_file():
-    from traj2events.cli import build_parser
-
-    d = default_config()
-    from traj2events.cli import _camera_settings
-
-    args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f"])
-    camera = _camera_settings(args)
-    assert (camera["width"], camera["fov_deg"], camera["moon_radius_m"], args.every) == (
-        d["camera"]["width"],
-        d["camera"]["fov_deg"],
-        d["motion_field"]["moon_radius_m"],
-        d["motion_field"]["every_n_frames"],
-    )
-    args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f", "--settings",
-                                      '{"width": 64, "height": 48}', "--height", "32"])  # fmt: skip
-    assert (_camera_settings(args)["width"], _camera_settings(args)["height"]) == (64, 32)
-    from traj2events.cli import _events_settings
-
-    args = build_parser().parse_args(["events", "in.mkv", "-o", "e.h5"])
-    settings = _events_settings(args)
-    assert (settings["preset"], settings["refractory_mode"], settings["sensor"], args.window_ms) == (
-        d["events"]["preset"],
-        d["events"]["refractory_mode"],
-        d["events"]["sensor"],
-        d["events"]["window_ms"],
-    )
-    # --settings (what the workflow passes) sets them, an option given overrides it
-    args = build_parser().parse_args(
-        ["events", "in.mkv", "-o", "e.h5", "--settings", '{"preset": "clean", "labels": false}', "--no-labels",
-         "--refractory-s", "0.01", "--sensor", '{"f_number": 4}']
-    )  # fmt: skip
-    settings = _events_settings(args)
-    assert (settings["preset"], settings["labels"], settings["refractory_s"]) == ("clean", False, 0.01)
-    assert settings["sensor"] == {**d["events"]["sensor"], "f_number": 4}
-    args = build_parser().parse_args(["events", "in.mkv", "-o", "e.h5", "--settings", '{"preset": "clean"}',
-                                      "--preset", "paper"])  # fmt: skip
-    assert _events_settings(args)["preset"] == "paper"
-    with pytest.raises(ValueError, match="--settings: unknown keys"):
-        _events_settings(build_parser().parse_args(["events", "i", "-o", "e", "--settings", '{"presets": "x"}']))
-
-
 def test_non_utf8_and_non_mapping_configs_are_named(tmp_path):
     latin = tmp_path / "latin.yaml"
     latin.write_bytes("seed: 1 # caf\xe9\n".encode("latin-1"))
@@ -281,7 +239,14 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"scenarios": {"descent": {"tf_guess_s": 5000.0}}}, ["scenarios.descent.tf_guess_s", "[ocp.tf_min_s"]),
     ({"ocp": {"refine_n_nodes": 40}}, ["ocp.refine_n_nodes", "more than ocp.n_nodes"]),
     ({"terrain": {"crater_diameter_min_m": 50.0, "crater_diameter_max_m": 10.0}}, ["terrain.crater_diameter_min_m"]),
-    ({"events": {"hot_pixel_fraction": 0.01}}, ["events.hot_pixel_hz", "> 0"]),
+    ({"events": {"pixel": {"hot_pixel_fraction": 0.01}}}, ["events.pixel.hot_pixel_hz", "> 0"]),
+    (
+        {"events": {"hot_pixel_fraction": 0.01}},
+        ["events.hot_pixel_fraction", "is now 'events.pixel.hot_pixel_fraction'"],
+    ),
+    ({"events": {"preset": "imx"}}, ["events.preset", "expected one of ['clean', 'paper']", "'imx'"]),
+    ({"events": {"pixel": {"theta_on": 0.001}}}, ["events.pixel.theta_on", ">= 0.01"]),
+    ({"events": {"pixel": {"theta": 0.2}}}, ["unknown key 'events.pixel.theta'"]),
     ({"scenarios": {"descent": {"altitude_m": [-10.0, 100.0]}}}, ["scenarios.descent.altitude_m", "above the ground"]),
     ({"scenarios": {"descent": None}}, ["scenarios.descent", "expected object"]),
     ({"vehicle": {"thrust_main_N": 10000.0}}, ["vehicle.thrust_main_N", "weight"]),
@@ -342,7 +307,7 @@ def test_config_readme_lists_every_key_with_its_default():
             elif path[:1] != ["scenarios"]:
                 yield ".".join([*path, key]), value
 
-    config = default_config()
+    config = with_preset(default_config())  # the pixel keys with the default preset's values
     for key, value in leaves({k: v for k, v in config.items() if k != "scenarios"}, []):
         assert f"| `{key}` | `{shown(value)}` |" in text, key
     for name, scenario in config["scenarios"].items():

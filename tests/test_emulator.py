@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from traj2events.sensor.emulator import PRESETS, EmulatorParams, EventEmulator
+from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.laws import log_intensity_8bit, lowpass_gain
+from traj2events.stages.events import preset_params
 
-CLEAN = PRESETS["clean"]
+CLEAN = preset_params("clean")
 FPS = 100.0
 
 
@@ -211,7 +212,7 @@ def test_linear_radiance_input_keeps_the_model_in_dn():
     frames = video(np.log(radiance), 1, 2)
     dn = radiance_to_dn(frames, 40.0)
     assert dn.max() > 255
-    ev = run(dn, PRESETS["paper"], seed=3)
+    ev = run(dn, preset_params("paper"), seed=3)
     assert len(ev) > 0 and np.all(np.isfinite(ev["t"].astype(float)))
     clean = run(dn, CLEAN)
     assert len(clean) == 2 * int(np.floor(2.0 * 0.5 / 0.25 + 1e-9))
@@ -231,20 +232,20 @@ def test_stream_invariants_and_chunking_does_not_change_a_byte():
     rng = np.random.default_rng(7)
     frames = rng.uniform(0, 255, size=(40, 12, 16)).round()
     times = np.arange(40) / FPS
-    whole = EventEmulator(16, 12, PRESETS["paper"], seed=8).process(frames, times)
+    whole = EventEmulator(16, 12, preset_params("paper"), seed=8).process(frames, times)
     assert (np.diff(whole["t"]) >= 0).all()
     assert whole["x"].max() < 16 and whole["y"].max() < 12 and set(np.unique(whole["p"])) <= {0, 1}
-    emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
+    emu = EventEmulator(16, 12, preset_params("paper"), seed=8)
     parts = [emu.process(frames[a:b], times[a:b]) for a, b in ((0, 1), (1, 7), (7, 8), (8, 40))]
     assert np.concatenate(parts).tobytes() == whole.tobytes()
     # One frame interval at a time: the same events, each interval's within its own times.
-    emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
+    emu = EventEmulator(16, 12, preset_params("paper"), seed=8)
     intervals = [events for a, b in ((0, 7), (7, 40)) for events, _ in emu.intervals(frames[a:b], times[a:b])]
     assert len(intervals) == 39 and np.concatenate(intervals).tobytes() == whole.tobytes()
     for k, events in enumerate(intervals):
         assert ((events["t"] >= round(times[k] * 1e6)) & (events["t"] <= round(times[k + 1] * 1e6))).all()
     # As columns: the same values, each a contiguous array of the structured field's type.
-    emu = EventEmulator(16, 12, PRESETS["paper"], seed=8)
+    emu = EventEmulator(16, 12, preset_params("paper"), seed=8)
     columns = [c for c, _ in emu.intervals(frames, times, columns=True)]
     for name in ("x", "y", "t", "p"):
         joined = np.concatenate([c[name] for c in columns])
@@ -259,7 +260,7 @@ def test_bad_input_is_named():
     with pytest.raises(ValueError, match="increasing"):
         emu.process(np.zeros((2, 4, 4)), [0.0, 0.0])
     with pytest.raises(ValueError, match="sigma"):
-        EmulatorParams(sigma=-1)
+        replace(CLEAN, sigma=-1)
 
 
 def test_stress_black_saturated_and_extreme_time_steps():
@@ -267,7 +268,7 @@ def test_stress_black_saturated_and_extreme_time_steps():
     for level in (0.0, 255.0):
         frames = np.full((20, 4, 4), level)
         assert len(run(frames, CLEAN)) == 0
-        ev = run(frames, PRESETS["paper"], seed=2)
+        ev = run(frames, preset_params("paper"), seed=2)
         assert np.all(np.diff(ev["t"]) >= 0)
     # A 10 s gap and a 1 us gap: the ramp's events land inside their intervals, in order.
     times = np.array([0.0, 10.0, 10.000001, 10.01])
@@ -283,7 +284,7 @@ def test_non_finite_or_negative_intensity_is_refused(bad):
     frames = np.full((3, 2, 2), 50.0)
     frames[2, 1, 0] = bad
     with pytest.raises(ValueError, match="frame 2 of this chunk"):
-        run(frames, PRESETS["paper"])
+        run(frames, preset_params("paper"))
 
 
 # --- event labels: the cause of each event, checked against scenes whose cause is known ---
@@ -305,9 +306,9 @@ def test_label_names_are_the_documented_codes():
 @pytest.mark.parametrize(
     "params",
     [
-        PRESETS["paper"],
-        replace(PRESETS["paper"], refractory_s=0.02, hot_pixel_fraction=0.05, hot_pixel_hz=30.0),
-        replace(PRESETS["paper"], refractory_s=0.02, refractory_mode="defer", leak_hz=2.0),
+        preset_params("paper"),
+        replace(preset_params("paper"), refractory_s=0.02, hot_pixel_fraction=0.05, hot_pixel_hz=30.0),
+        replace(preset_params("paper"), refractory_s=0.02, refractory_mode="defer", leak_hz=2.0),
     ],
 )
 def test_labels_never_change_the_events_and_survive_chunking(params):
@@ -337,7 +338,7 @@ def test_a_static_scene_with_only_leak_gives_only_leak_events_at_the_leak_rate()
 def test_a_moving_scene_without_noise_gives_only_signal():
     t = np.arange(201) / FPS
     frames = video(np.log(50.0) + 3.0 * np.sin(2 * np.pi * t), 3, 4)
-    params = replace(PRESETS["paper"], leak_hz=0.0, shot_noise_hz=0.0)
+    params = replace(preset_params("paper"), leak_hz=0.0, shot_noise_hz=0.0)
     events, labels = run_labelled(frames, params)
     assert len(events) > 50 and (labels == SIGNAL).all()
 
@@ -390,7 +391,7 @@ def test_input_scale_on_float32_frames_is_the_float64_product_byte_for_byte():
         (radiance, scale, [12]),
         (radiance, scale, [5, 7]),
     ):
-        emulator = EventEmulator(24, 20, PRESETS["paper"], seed=3, labels=True, input_scale=input_scale)
+        emulator = EventEmulator(24, 20, preset_params("paper"), seed=3, labels=True, input_scale=input_scale)
         start, parts = 0, []
         for n in chunks:
             parts.append(emulator.process_with_labels(frames[start : start + n], times[start : start + n]))
@@ -401,7 +402,7 @@ def test_input_scale_on_float32_frames_is_the_float64_product_byte_for_byte():
     for events, labels in outputs[1:]:
         assert events.tobytes() == reference[0].tobytes() and labels.tobytes() == reference[1].tobytes()
     with pytest.raises(ValueError, match="input_scale: expected a finite value > 0"):
-        EventEmulator(4, 4, input_scale=0.0)
+        EventEmulator(4, 4, CLEAN, input_scale=0.0)
 
 
 @pytest.mark.parametrize("width, height", [(1024, 1024), (346, 260), (1, 7), (640, 1)])
@@ -512,7 +513,7 @@ def test_pixel_ranges_cover_the_frame_in_order_each_big_enough():
     ]
     assert pixel_ranges(1 << 20, 2) == [(0, 1 << 19), (1 << 19, 1 << 20)]
     with pytest.raises(ValueError, match="threads"):
-        EventEmulator(16, 12, threads=0)
+        EventEmulator(16, 12, CLEAN, threads=0)
 
 
 @pytest.mark.parametrize("input_kind", ["8-bit", "float32 radiance"])
@@ -528,7 +529,7 @@ def test_threads_give_the_same_events_and_labels(input_kind):
     times = np.arange(6) / FPS
     outputs = []
     for threads in (1, 2, 3):
-        emu = EventEmulator(512, 384, PRESETS["paper"], seed=3, labels=True, input_scale=scale, threads=threads)
+        emu = EventEmulator(512, 384, preset_params("paper"), seed=3, labels=True, input_scale=scale, threads=threads)
         events, labels = emu.process_with_labels(frames, times)
         outputs.append((events.tobytes(), labels.tobytes()))
     assert len(outputs[0][0]) > 13 * 100_000  # > 100 k events

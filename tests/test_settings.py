@@ -9,8 +9,10 @@ import pytest
 
 from conftest import ROOT
 from traj2events.config import load_config
-from traj2events.settings.camera import camera_settings
-from traj2events.settings.events import events_settings
+from traj2events.settings import pick
+from traj2events.settings.camera import CAMERA, MOTION_FIELD
+from traj2events.settings.events import EVENTS, EVENTS_PICTURE
+from traj2events.settings.poses import POSES
 from traj2events.settings.render import FrameTiming, render_settings
 from traj2events.settings.solve import solve_settings
 
@@ -33,21 +35,23 @@ def test_the_stages_read_back_what_the_workflow_passes(path):
 
 
 @pytest.mark.parametrize("path", CONFIGS)
-def test_the_events_command_reads_back_the_workflows_events_settings(path):
-    from traj2events.cli import _events_settings, build_parser
+def test_each_command_reads_back_the_settings_the_workflow_passes(path):
+    """Every --settings the workflow passes gives the command those settings, none left to
+    the command's defaults (the paper config changes the camera, the smoke one the fps)."""
+    from traj2events.cli import build_parser
+    from traj2events.options import settings_from
 
-    settings = events_settings(load_config(ROOT / path))
-    args = build_parser().parse_args(["events", "in.h5", "-o", "e.h5", "--settings", json.dumps(settings)])
-    assert _events_settings(args) == settings
-
-
-def test_the_motion_field_command_reads_back_the_workflows_camera():
-    from traj2events.cli import _camera_settings, build_parser
-
-    settings = camera_settings(load_config(ROOT / "config/paper.yaml"))
-    args = build_parser().parse_args(["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f",
-                                      "--settings", json.dumps(settings)])  # fmt: skip
-    assert _camera_settings(args) == settings and settings["width"] == 1024
+    config = load_config(ROOT / path)
+    for argv, keys in (
+        (["events", "in.h5", "-o", "e.h5"], EVENTS),
+        (["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f"], MOTION_FIELD),
+        (["picture", "motion-field", "t.h5", "-o", "m.png"], CAMERA),
+        (["picture", "events", "e.h5", "-o", "e.png"], EVENTS_PICTURE),
+        (["upsample", "--solutions", "s.h5", "--id", "0", "-o", "t.h5"], POSES),
+    ):
+        settings = pick(config, keys)
+        args = build_parser().parse_args([*argv, "--settings", json.dumps(settings)])
+        assert settings_from(args, keys) == settings
 
 
 def test_only_adaptive_renders_depend_on_the_sensor():

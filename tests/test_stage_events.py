@@ -7,14 +7,14 @@ import pytest
 from PIL import Image
 
 from traj2events.formats.events import read_events
-from traj2events.stages.events import emulate, emulator_params, frame_source
+from traj2events.stages.events import emulate, frame_source, preset_params
 from traj2events.stages.pictures import events_picture
 from traj2events.video import VideoWriter
 
 
 def emulate_file(path, output, preset="clean", fps=None, chunk=64, seed=0):
     """(frames, events, t_last) of emulating `path` into `output`."""
-    return emulate(frame_source(path, chunk, fps), emulator_params(preset), seed, output, preset, str(path))
+    return emulate(frame_source(path, chunk, fps), preset_params(preset), seed, output, preset, str(path))
 
 
 def ramp_frames(n=30, h=12, w=16):
@@ -126,21 +126,21 @@ def test_frames_h5_through_the_sensor_is_the_display_path_at_the_sensor_s_scale(
         f["radiance"] = frames
         f.attrs["display_white_w_m2_sr"] = 40.0
     through_sensor = frame_source(tmp_path / "frames.h5", sensor=sensor)
-    emulate(through_sensor, emulator_params("clean"), 0, tmp_path / "s.h5", "clean", "frames.h5")
+    emulate(through_sensor, preset_params("clean"), 0, tmp_path / "s.h5", "clean", "frames.h5")
     same_scale = frame_source(tmp_path / "frames.h5", white=255.0 / dn_per_radiance)
-    emulate(same_scale, emulator_params("clean"), 0, tmp_path / "d.h5", "clean", "frames.h5")
+    emulate(same_scale, preset_params("clean"), 0, tmp_path / "d.h5", "clean", "frames.h5")
     (s, s_attrs), (d, _) = read_events(tmp_path / "s.h5"), read_events(tmp_path / "d.h5")
     assert len(s) > 50 and s.tobytes() == d.tobytes()
     assert s_attrs["sensor_f_number"] == sensor.f_number and "photocurrent" in s_attrs["input_kind"]
     for bad, message in (
-        (["--white", "40"], "--white: only with --input-scale display"),
-        (["--sensor", '{"quantum_efficiency": 2}'], "events.sensor.quantum_efficiency: expected in (0, 1]"),
+        (["--white", "40"], "white: only with the display input scale"),
+        (["--quantum-efficiency", "2"], "--quantum-efficiency: config key 'events.sensor.quantum_efficiency'"),
     ):
         assert main(["events", str(tmp_path / "frames.h5"), "-o", str(tmp_path / "x.h5"), *bad]) == 2
         assert message in capsys.readouterr().err
     assert not (tmp_path / "x.h5").exists()
     assert main(["events", str(tmp_path / "frames.h5"), "-o", str(tmp_path / "c.h5"), "--preset", "clean",
-                 "--no-labels", "--sensor", f'{{"f_number": {sensor.f_number}}}']) == 0  # fmt: skip
+                 "--no-labels", "--f-number", str(sensor.f_number)]) == 0  # fmt: skip
     assert read_events(tmp_path / "c.h5")[0].tobytes() == s.tobytes()
 
 
@@ -156,7 +156,7 @@ def test_reading_ahead_gives_the_same_bytes(tmp_path):
     for name in ("in.mkv", "frames.h5"):
         for ahead in (False, True):
             source = frame_source(tmp_path / name, chunk=3, white=40.0 if name == "frames.h5" else None, ahead=ahead)
-            emulate(source, emulator_params("paper"), 3, tmp_path / f"{name}.{ahead}.h5", "paper", name)
+            emulate(source, preset_params("paper"), 3, tmp_path / f"{name}.{ahead}.h5", "paper", name)
         plain, _ = read_events(tmp_path / f"{name}.False.h5")
         ahead_events, _ = read_events(tmp_path / f"{name}.True.h5")
         assert len(plain) > 100 and plain.tobytes() == ahead_events.tobytes()
@@ -188,7 +188,7 @@ def test_a_video_s_decoder_takes_one_of_the_threads(tmp_path, monkeypatch):
     monkeypatch.setattr(video_module, "decode_command", recording_command)
     for threads in (1, 2, 3):
         source = frame_source(tmp_path / "in.mkv", ahead=threads > 1)
-        emulate(source, emulator_params("clean"), 0, tmp_path / f"{threads}.h5", "clean", "in.mkv", threads=threads)
+        emulate(source, preset_params("clean"), 0, tmp_path / f"{threads}.h5", "clean", "in.mkv", threads=threads)
     assert made == [1, 1, 2]
     assert decoders == [1, 1, 1]  # ffmpeg's decoder: one thread, not one per CPU (its default)
 
@@ -199,5 +199,5 @@ def test_an_error_from_a_plain_iterator_source_is_the_one_raised(tmp_path):
     frames = np.full((3, 12, 16), np.nan, np.float32)  # refused by the emulator
     source = FrameSource(16, 12, "test", iter([(frames, np.arange(3) / 50.0)]))  # no close(), unlike a generator
     with pytest.raises(ValueError, match="NaN"):
-        emulate(source, emulator_params("clean"), 0, tmp_path / "e.h5", "clean", "test")
+        emulate(source, preset_params("clean"), 0, tmp_path / "e.h5", "clean", "test")
     assert not (tmp_path / "e.h5").exists()

@@ -14,7 +14,7 @@ from traj2events.geometry.camera import Camera
 from traj2events.stages import pictures
 from traj2events.stages.base_solution import BaseSolveError, base_solution
 from traj2events.stages.camera_poses import camera_poses
-from traj2events.stages.events import emulate, emulator_params, export_events, frame_source
+from traj2events.stages.events import emulate, export_events, frame_source, preset_params
 from traj2events.stages.index import dataset_index
 from traj2events.stages.motion_field import motion_field
 from traj2events.stages.render import RenderSettings, render_trajectory
@@ -179,7 +179,7 @@ def test_motion_field_memory_does_not_grow_with_the_number_of_fields(built, conf
 
 def test_events_exports_and_pictures(built, config):
     source = frame_source(built / "frames.h5", chunk=4)
-    params = emulator_params("paper", refractory_s=None)
+    params = preset_params("paper")
     n_frames, n_events, t_last = emulate(source, params, 3, built / "events.h5", "paper", "frames.h5")
     events, attrs = read_events(built / "events.h5")
     assert len(events) == n_events > 0 and attrs["seed"] == 3 and attrs["input"] == "frames.h5"
@@ -281,7 +281,7 @@ def test_every_command_refuses_a_wrong_kind_of_file_in_one_line(built, tmp_path,
 
     from traj2events.cli import main
 
-    emulate(frame_source(built / "frames.h5"), emulator_params("clean"), 0, tmp_path / "events.h5", "clean", "f")
+    emulate(frame_source(built / "frames.h5"), preset_params("clean"), 0, tmp_path / "events.h5", "clean", "f")
     pictures.frames_picture(built / "trajectory.h5", built / "video.mkv", tmp_path / "frames.png")
     for name in ("trajectory.h5", "frames.h5", "solutions.h5", "samples.csv", "video.mkv"):
         shutil.copy(built / name, tmp_path / name)
@@ -315,7 +315,7 @@ def test_kept_files_describe_themselves(built, config):
         np.testing.assert_allclose(f.attrs["camera_matrix_px"], camera.matrix)
         assert f.attrs["distortion"] == "none"
     if not (built / "events.h5").exists():
-        emulate(frame_source(built / "frames.h5"), emulator_params("clean"), 0, built / "events.h5", "clean", "f")
+        emulate(frame_source(built / "frames.h5"), preset_params("clean"), 0, built / "events.h5", "clean", "f")
     _, attrs = read_events(built / "events.h5")
     np.testing.assert_allclose(attrs["camera_matrix_px"], camera.matrix)
     sun = config["scenarios"]["descent"]["sun"]
@@ -342,5 +342,5 @@ def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path)
         assert np.array_equal(f["radiance"][np.flatnonzero(poses)], fixed["radiance"][()])
         assert json.loads(f.attrs["timing"]) == timing
     assert len(read_video(tmp_path / "v.mkv")) == len(tr.t)  # the video keeps the fixed rate
-    n_frames, _, _ = emulate(frame_source(tmp_path / "f.h5"), emulator_params("clean"), 1, tmp_path / "e.h5", "c", "f")
+    n_frames, _, _ = emulate(frame_source(tmp_path / "f.h5"), preset_params("clean"), 1, tmp_path / "e.h5", "c", "f")
     assert n_frames == len(t)  # the emulator takes every frame, in time order

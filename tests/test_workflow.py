@@ -307,7 +307,7 @@ def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
     assert edited_source("cli.py", 'help="frames read at a time', 'help="frames read together') == {}
     assert (
         edited_source(
-            "sensor/emulator.py", '"""The pixel model\'s parameters;', '"""The parameters of the pixel model;'
+            "sensor/emulator.py", '"""The pixel model\'s parameters:', '"""The parameters of the pixel model;'
         )
         == {}
     )
@@ -357,6 +357,9 @@ def test_picture_setting_reruns_pictures_only(built, tmp_path):
 def test_emulator_setting_reruns_events_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("events", {}).update(preset="clean"))
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+    shutil.copytree(built, tmp_path / "wf2")
+    jobs = edit_config(tmp_path / "wf2", lambda c: c.setdefault("events", {}).update(pixel={"refractory_s": 1e-3}))
     assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
 
 

@@ -10,27 +10,31 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")  # one process per core is faster 
 
 import argparse
 import gc
-import json
 import sys
 from pathlib import Path
 
 from . import __version__
 from .defaults import section
 from .memory import keep_freed_memory
-
-
-def _inline_or_file(value: str) -> str:
-    """An option's text, given inline or as @file."""
-    return Path(value[1:]).read_text() if value.startswith("@") else value
+from .options import add_settings, settings_from
+from .settings.camera import CAMERA, MOTION_FIELD
+from .settings.events import EVENTS, EVENTS_PICTURE
+from .settings.poses import POSES
 
 
 def _settings(kind, value: str):
     """--settings (JSON inline, or @file) as a `kind` settings object."""
-    text = _inline_or_file(value)
+    text = Path(value[1:]).read_text() if value.startswith("@") else value
     try:
         return kind.from_json(text)
     except (ValueError, TypeError, KeyError, AttributeError) as exc:
         raise ValueError(f"--settings: expected the JSON of {kind.__name__} (the workflow writes it): {exc}") from None
+
+
+def _camera(settings: dict):
+    from .geometry.camera import Camera
+
+    return Camera(settings["width"], settings["height"], settings["fov_deg"], settings["mount_height_m"])
 
 
 def cmd_check_config(args) -> int:
@@ -65,9 +69,8 @@ def cmd_sample(args) -> int:
 def cmd_upsample(args) -> int:
     from .stages.camera_poses import camera_poses
 
-    if not args.fps > 0:
-        raise ValueError(f"upsample: --fps: expected > 0, got {args.fps}")
-    camera_poses(args.solutions, args.id, args.fps, args.method, args.output)
+    s = settings_from(args, POSES)
+    camera_poses(args.solutions, args.id, s["fps"], s["method"], args.output)
     return 0
 
 
@@ -75,112 +78,37 @@ def cmd_render(args) -> int:
     from .stages.render import RenderSettings, render_trajectory
 
     keep_freed_memory()
-    render_trajectory(
-        args.trajectory,
-        _settings(RenderSettings, args.settings),
-        args.frames,
-        args.video,
-        args.preview,
-        args.backend,
-        args.tile_cache,
-    )
+    settings = _settings(RenderSettings, args.settings)
+    render_trajectory(args.trajectory, settings, args.frames, args.video, args.preview, args.backend, args.tile_cache)
     return 0
 
 
 def cmd_motion_field(args) -> int:
     from .stages.motion_field import motion_field
 
+    s = settings_from(args, MOTION_FIELD)
     motion_field(
-        args.trajectory,
-        _camera(c := _camera_settings(args)),
-        c["moon_radius_m"],
-        args.every,
-        args.output,
-        args.flo_dir,
-        args.frames,
+        args.trajectory, _camera(s), s["moon_radius_m"], s["every_n_frames"], args.output, args.flo_dir, args.frames
     )
     return 0
 
 
-def _json_option(option: str, value: str) -> dict:
-    """A JSON object given inline or as @file."""
-    text = _inline_or_file(value)
-    try:
-        given = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{option}: expected a JSON object: {exc}") from None
-    if not isinstance(given, dict):
-        raise ValueError(f"{option}: expected a JSON object, got {text!r}")
-    return given
-
-
-def _layered(defaults: dict, settings: str | None, options: dict) -> dict:
-    """Settings in layers: the defaults, then --settings (JSON or @file), then each option given."""
-    layered = dict(defaults)
-    if settings:
-        given = _json_option("--settings", settings)
-        unknown = sorted(set(given) - set(layered))
-        if unknown:
-            raise ValueError(f"--settings: unknown keys {unknown}; expected {sorted(layered)}")
-        layered.update(given)
-    layered.update({k: v for k, v in options.items() if v is not None})
-    return layered
-
-
-def _events_settings(args) -> dict:
-    """events settings: defaults.yaml's, then --settings, then each option given."""
-    from .settings.events import events_settings
-
-    options = {"preset": args.preset, "refractory_s": args.refractory_s, "refractory_mode": args.refractory_mode,
-               "hot_pixel_fraction": args.hot_pixel_fraction, "hot_pixel_hz": args.hot_pixel_hz,
-               "labels": args.labels, "input": args.input_scale}  # fmt: skip
-    settings = _layered(events_settings({"events": section("events")}), args.settings, options)
-    if args.sensor:
-        settings["sensor"] = {**settings["sensor"], **_json_option("--sensor", args.sensor)}
-    return settings
-
-
-def _positive(option: str, value: float | None) -> None:
-    if value is not None and not value > 0:
-        raise ValueError(f"{option}: expected a value > 0, got {value}")
-
-
 def cmd_events(args) -> int:
-    from .sensor.photocurrent import SensorParams
-    from .stages.events import emulator_params, events_command
+    from .stages.events import events_command
 
-    for option, value in (("--fps", args.fps), ("--white", args.white), ("--window-ms", args.window_ms)):
-        _positive(option, value)
-    if args.seed < 0:
-        raise ValueError(f"--seed: expected a value >= 0, got {args.seed}")
-    if args.threads is not None and args.threads < 1:
-        raise ValueError(f"--threads: expected a value >= 1, got {args.threads}")
-    e = _events_settings(args)
-    if args.white is not None and e["input"] != "display":
-        raise ValueError("--white: only with --input-scale display (the sensor scale needs no white)")
-    overrides = ("refractory_s", "refractory_mode", "hot_pixel_fraction", "hot_pixel_hz")
-    params = emulator_params(e["preset"], **{k: e[k] for k in overrides})
     keep_freed_memory()
-    source, t_last_s = events_command(
+    events_command(
         args.input,
         args.output,
-        params,
-        e["preset"],
+        settings_from(args, EVENTS),
         args.seed,
         fps=args.fps,
         white=args.white,
-        sensor=SensorParams.from_config(e["sensor"]) if e["input"] == "sensor" else None,
         chunk=args.chunk,
         threads=len(os.sched_getaffinity(0)) if args.threads is None else args.threads,
-        labels=e["labels"],
         exports={"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4},
         trajectory=args.trajectory,
     )
-    if args.frames_png:
-        from .stages.pictures import events_picture
-
-        title = args.title or str(args.output)
-        events_picture(args.output, t_last_s, source.width, source.height, args.window_ms, title, args.frames_png)
     return 0
 
 
@@ -190,16 +118,11 @@ def cmd_picture(args) -> int:
     if args.kind == "frames":
         pictures.frames_picture(args.trajectory, args.video, args.output)
     elif args.kind == "motion-field":
-        pictures.motion_field_picture(
-            args.trajectory,
-            _camera(c := _camera_settings(args)),
-            c["moon_radius_m"],
-            args.output,
-            args.video,
-        )
+        s = settings_from(args, CAMERA)
+        pictures.motion_field_picture(args.trajectory, _camera(s), s["moon_radius_m"], args.output, args.video)
     elif args.kind == "events":
-        _positive("--window-ms", args.window_ms)
-        pictures.trajectory_events_picture(args.events, args.trajectory, args.window_ms, args.output)
+        s = settings_from(args, EVENTS_PICTURE)
+        pictures.trajectory_events_picture(args.events, args.trajectory, s["window_ms"], args.output)
     else:
         pictures.dataset_picture(args.solutions, args.output)
     return 0
@@ -219,44 +142,7 @@ def cmd_summary(args) -> int:
     return 0
 
 
-def _add_camera(p: argparse.ArgumentParser) -> None:
-    camera, field = section("camera"), section("motion_field")
-    p.add_argument(
-        "--settings",
-        help="the camera and sphere as JSON (or @file): width, height, fov_deg, mount_height_m, moon_radius_m "
-        "(the workflow passes the config's; the options below override them)",
-    )
-    p.add_argument("--width", type=int, help=f"image width, px (default {camera['width']})")
-    p.add_argument("--height", type=int, help=f"image height, px (default {camera['height']})")
-    p.add_argument("--fov-deg", type=float, help=f"horizontal field of view, deg (default {camera['fov_deg']})")
-    p.add_argument(
-        "--mount-height-m",
-        type=float,
-        help=f"camera height above the trajectory point along -z_b, m (default {camera['mount_height_m']})",
-    )
-    p.add_argument(
-        "--moon-radius-m",
-        type=float,
-        help=f"radius of the sphere through the landing site, m (default {field['moon_radius_m']})",
-    )
-
-
-def _camera_settings(args) -> dict:
-    """camera settings: defaults.yaml's, then --settings, then each option given."""
-    from .settings.camera import camera_settings
-
-    defaults = camera_settings({"camera": section("camera"), "motion_field": section("motion_field")})
-    return _layered(defaults, args.settings, {k: getattr(args, k) for k in defaults})
-
-
-def _camera(settings: dict):
-    from .geometry.camera import Camera
-
-    return Camera(settings["width"], settings["height"], settings["fov_deg"], settings["mount_height_m"])
-
-
 def build_parser() -> argparse.ArgumentParser:
-    events, field = section("events"), section("motion_field")
     parser = argparse.ArgumentParser(
         prog="traj2events",
         description="Synthetic event-camera datasets from mass-optimal lunar landings. "
@@ -266,12 +152,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"traj2events {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser(
-        "check-config", help="validate config files (overlays on the defaults) and print the planned size"
-    )
-    p.add_argument(
-        "config", nargs="+", help="config YAML files, merged in order on the defaults, e.g. config/smoke.yaml"
-    )
+    p = sub.add_parser("check-config", help="validate config files (overlays on the defaults), print the planned size")
+    p.add_argument("config", nargs="+", help="YAML overlays, merged in order on the defaults, e.g. config/smoke.yaml")
     p.set_defaults(func=cmd_check_config)
 
     settings_help = "scenario settings as JSON (or @file): vehicle, ocp, scenario, seed"
@@ -288,12 +170,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
     p.add_argument("--settings", required=True, help=settings_help)
-    p.add_argument(
-        "--base",
-        required=True,
-        help="base.h5 from `traj2events base` (one recording a failed solve gives a solutions.h5 and "
-        "samples.csv without samples, which say so)",
-    )
+    p.add_argument("--base", required=True, help="base.h5 from `traj2events base` (one recording a failed solve "
+                   "gives a solutions.h5 and samples.csv without samples, which say so)")  # fmt: skip
     p.add_argument("--output", "-o", required=True, help="solutions.h5: every sample's nodes and status")
     p.add_argument("--table", required=True, help="samples.csv: one row per sample (status, reason, errors)")
     p.add_argument("--jobs", "-j", type=int, default=1, help="worker processes (default 1)")
@@ -302,58 +180,29 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("upsample", help="camera poses at the frame rate for one solved sample")
     p.add_argument("--solutions", required=True, help="solutions.h5 from `traj2events sample`")
     p.add_argument("--id", type=int, required=True, help="sample index")
-    p.add_argument("--fps", type=float, default=section("camera")["fps"], help="frame rate, Hz (default %(default)s)")
-    p.add_argument(
-        "--method",
-        choices=("reintegrate", "spline"),
-        default=section("upsampling")["method"],
-        help="reintegrate the dynamics (exact) or the paper's cubic spline (default %(default)s)",
-    )
+    add_settings(p, POSES, "the frame rate and upsampling")
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
     p.set_defaults(func=cmd_upsample)
 
-    p = sub.add_parser(
-        "render", help="render the lunar surface from every pose of a trajectory (radiance, depth, videos)"
-    )
+    p = sub.add_parser("render", help="render the surface from every pose of a trajectory (radiance, depth, videos)")
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
-    p.add_argument(
-        "--settings",
-        required=True,
-        help="render settings as JSON (or @file): camera, terrain, sun, "
-        "reflectance, lod, display (the workflow builds it from the config)",
-    )
+    p.add_argument("--settings", required=True, help="render settings as JSON (or @file): camera, terrain, sun, "
+                   "reflectance, lod, display (the workflow builds it from the config)")  # fmt: skip
     p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
-    p.add_argument(
-        "--preview",
-        help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless render.preview is false: "
-        "its encoder takes CPU beside the render); default: none",
-    )
-    p.add_argument(
-        "--backend",
-        default=section("render")["backend"],
-        help="OpenGL backend: egl (a GPU, headless), osmesa (the CPU, Mesa llvmpipe) or auto (EGL when a GPU's "
-        "EGL device exists, else OSMesa); default: %(default)s",
-    )
-    p.add_argument(
-        "--tile-cache",
-        metavar="FOLDER",
-        help="share built tiles' terrain heights with other render jobs through this folder (the workflow "
-        "passes render.tile_cache); default: no cache",
-    )
+    p.add_argument("--preview", help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless "
+                   "render.preview is false: its encoder takes CPU beside the render); default: none")  # fmt: skip
+    p.add_argument("--backend", default=section("render")["backend"], help="OpenGL backend: egl (a GPU, headless), "
+                   "osmesa (the CPU, Mesa llvmpipe) or auto (EGL when a GPU's EGL device exists, else OSMesa); "
+                   "default: %(default)s")  # fmt: skip
+    p.add_argument("--tile-cache", metavar="FOLDER", help="share built tiles' terrain heights with other render jobs "
+                   "through this folder (the workflow passes render.tile_cache); default: no cache")  # fmt: skip
     p.set_defaults(func=cmd_render)
 
-    p = sub.add_parser(
-        "motion-field", help="ground-truth motion field of one trajectory (sphere, and terrain-true from frames.h5)"
-    )
+    p = sub.add_parser("motion-field", help="ground-truth motion field of a trajectory (sphere; terrain-true from "
+                       "frames.h5)")  # fmt: skip
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
-    _add_camera(p)
-    p.add_argument(
-        "--every",
-        type=int,
-        default=field["every_n_frames"],
-        help="write every n-th frame's field (default %(default)s)",
-    )
+    add_settings(p, MOTION_FIELD, "the camera, the sphere and which frames")
     p.add_argument("--frames", help="frames.h5 from `traj2events render`: adds the terrain-true field from its depth")
     p.add_argument("--output", "-o", required=True, help="motion_field.h5")
     p.add_argument("--flo-dir", required=True, help="folder for the Middlebury .flo displacements")
@@ -369,77 +218,18 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("input", help="frames.h5, a video file, or a folder of images")
     p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc)")
-    p.add_argument(
-        "--settings",
-        help="the emulator settings as JSON (or @file): preset, refractory_s, refractory_mode, hot_pixel_fraction, "
-        "hot_pixel_hz, labels, input, sensor (the workflow passes the config's; the options below override "
-        "them; default: defaults.yaml's events section)",
-    )
-    p.add_argument(
-        "--preset",
-        choices=("paper", "clean"),
-        help="paper: the paper's Table 2 (thresholds 0.25, sigma 0.03, 5 Hz shot noise, 0.1 Hz leak, "
-        f"3 Hz low-pass); clean: no noise, no low-pass, no mismatch (default {events['preset']})",
-    )
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
-    p.add_argument(
-        "--input-scale",
-        choices=("sensor", "display"),
-        help="frames.h5's radiance as the sensor's photocurrent (--sensor; docs/events.md 'Sensor model') or as "
-        f"255 L / white, the videos' scale (default {events['input']})",
-    )
-    p.add_argument(
-        "--sensor",
-        help="events.sensor keys to change, as JSON (inline or @file), e.g. '{\"f_number\": 4}' (defaults: "
-        + ", ".join(f"{k} {v}" for k, v in events["sensor"].items())
-        + ")",
-    )
-    p.add_argument(
-        "--white",
-        type=float,
-        help="with --input-scale display: radiance at full scale (default: frames.h5's display white)",
-    )
-    p.add_argument("--refractory-s", type=float, help=f"refractory period, s (default {events['refractory_s']})")
-    p.add_argument(
-        "--refractory-mode",
-        choices=("drop", "defer"),
-        help=f"suppressed crossings: dropped (ESIM) or pending (v2e) (default {events['refractory_mode']})",
-    )
-    p.add_argument(
-        "--hot-pixel-fraction", type=float, help=f"fraction of hot pixels (default {events['hot_pixel_fraction']})"
-    )
-    p.add_argument("--hot-pixel-hz", type=float, help=f"rate of the hot pixels, Hz (default {events['hot_pixel_hz']})")
-    p.add_argument(
-        "--labels",
-        action=argparse.BooleanOptionalAction,
-        help="also write each event's cause (events/label: signal, shot_noise, leak, hot_pixel) "
-        f"(default {events['labels']})",
-    )
-    p.add_argument(
-        "--chunk",
-        type=int,
-        help="frames read at a time (default: stages.events.CHUNK_FRAMES, 16; the events do not change)",
-    )
-    p.add_argument(
-        "--threads",
-        type=int,
-        help="CPUs to use: with 2 or more, the next chunk of frames.h5 or of the video is read in a thread "
-        "while this one is emulated (one more chunk in memory), and each frame's pixels are split over "
-        "that many threads (one fewer for a video, whose decoder takes a CPU; at least 65536 pixels each); "
-        "the events do not change (default: the CPUs this process may use). A video's decoder, ffmpeg, "
-        "takes its own threads besides: up to one per CPU the process may use",
-    )
-    p.add_argument("--frames-png", help="PNG: event frames (ON blue, OFF red) at t0, tf/4, tf/2, 3tf/4, tf")
-    p.add_argument(
-        "--window-ms", type=float, default=events["window_ms"], help="event-frame window, ms (default %(default)s)"
-    )
-    p.add_argument("--title", help="title of the event-frame figure")
-    p.add_argument(
-        "--npz",
-        help="also write an ELOPE-style .npz (events, and with --trajectory: timestamps, traj; "
-        "from frames.h5: range_meter)",
-    )
+    p.add_argument("--white", type=float, help="with --input-scale display: radiance at full scale (default: "
+                   "frames.h5's display white)")  # fmt: skip
+    add_settings(p, EVENTS, "the emulator settings", flags={"events.input": "--input-scale"})
+    p.add_argument("--chunk", type=int, help="frames read at a time (default 16; the events do not change)")
+    p.add_argument("--threads", type=int, help="CPUs to use: with 2 or more, the next chunk is read in a thread while "
+                   "this one is emulated, and each frame's pixels are split over the CPUs left (a video's decoder, "
+                   "ffmpeg, takes one; at least 65536 pixels each); the events do not change (default: the CPUs "
+                   "this process may use)")  # fmt: skip
+    p.add_argument("--npz", help="also write an ELOPE-style .npz (events; with --trajectory: timestamps, traj; from "
+                   "frames.h5: range_meter)")  # fmt: skip
     p.add_argument("--trajectory", help="trajectory.h5, for the .npz's timestamps and traj")
     p.add_argument("--evt3", help="also write Prophesee EVT 3.0 .raw (via faery)")
     p.add_argument("--aedat4", help="also write AEDAT4 (via faery)")
@@ -453,13 +243,13 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--output", "-o", required=True, help="PNG")
     q = kinds.add_parser("motion-field", help="motion_field.png: colour wheel and quiver of the sphere's field")
     q.add_argument("trajectory", help="trajectory.h5 (poses)")
-    _add_camera(q)
+    add_settings(q, CAMERA, "the camera and the sphere")
     q.add_argument("--video", help="video.mkv: draw the quivers over its frames")
     q.add_argument("--output", "-o", required=True, help="PNG")
     q = kinds.add_parser("events", help="events.png: event frames (ON blue, OFF red)")
     q.add_argument("events", help="events.h5")
-    q.add_argument("--trajectory", required=True, help="trajectory.h5 (its end time and title)")
-    q.add_argument("--window-ms", type=float, default=events["window_ms"], help="window, ms (default %(default)s)")
+    q.add_argument("--trajectory", help="trajectory.h5: its end time and title (default: events.h5's end, its name)")
+    add_settings(q, EVENTS_PICTURE, "the window")
     q.add_argument("--output", "-o", required=True, help="PNG")
     q = kinds.add_parser("dataset", help="trajectories.png: height and pitch of every scenario")
     q.add_argument("solutions", nargs="+", help="solutions.h5 of each scenario")

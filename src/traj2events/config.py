@@ -1,7 +1,8 @@
 """Configuration: overlays merged on the defaults, then schema validation with messages
 that name the key.
 
-A config file holds only what differs from defaults.yaml (`load_config`). The workflow
+A config file holds only what differs from defaults.yaml (`load_config`); the pixel
+model's values are those of the named preset under the config's events.pixel. The workflow
 validates the merged config against config.schema.yaml (beside this module) before any
 job runs; `validate_config` turns the first problem into one line such as
 ``config key 'ocp.n_nodes': expected integer, got str 'forty'``.
@@ -16,12 +17,15 @@ from typing import Any
 import jsonschema
 import yaml
 
-from .defaults import default_config, merge_config
+from .defaults import default_config, merge_config, with_preset
 
 SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
 # Folders of results/ that are not scenarios: a scenario of that name would mix its
 # outputs with them.
 RESERVED_SCENARIO_NAMES = ("logs", "figures")
+# Keys that moved, so that an older config gets their new place.
+MOVED_KEYS = {f"events.{key}": f"events.pixel.{key}"
+              for key in ("refractory_s", "refractory_mode", "hot_pixel_fraction", "hot_pixel_hz")}  # fmt: skip
 
 
 class ConfigError(ValueError):
@@ -32,8 +36,9 @@ def _key(path) -> str:
     return ".".join(str(p) for p in path) or "<root>"
 
 
-def _describe(error: jsonschema.ValidationError) -> str:
-    where = _key(error.absolute_path)
+def describe(error: jsonschema.ValidationError, prefix: list[str] | tuple = ()) -> str:
+    """One line naming the config key (`prefix`: the key of the value that was validated)."""
+    where = _key([*prefix, *error.absolute_path])
     v, schema_value, got = error.validator, error.validator_value, error.instance
     if v == "required":
         missing = [k for k in schema_value if k not in got]
@@ -43,6 +48,8 @@ def _describe(error: jsonschema.ValidationError) -> str:
         allowed = sorted(error.schema.get("properties", {}))
         extra = sorted(set(got) - set(allowed))
         prefix = "" if where == "<root>" else where + "."
+        if f"{prefix}{extra[0]}" in MOVED_KEYS:
+            return f"config key '{prefix}{extra[0]}' is now '{MOVED_KEYS[prefix + extra[0]]}'"
         return f"unknown key '{prefix}{extra[0]}' (expected one of: {', '.join(allowed)})"
     if v == "type":
         return f"config key '{where}': expected {schema_value}, got {type(got).__name__} {got!r}"
@@ -146,8 +153,9 @@ def _semantic_errors(config: dict) -> list[str]:
                       f"got {ocp['refine_n_nodes']}")  # fmt: skip
     if terrain["crater_diameter_min_m"] > terrain["crater_diameter_max_m"]:
         errors.append("config key 'terrain.crater_diameter_min_m': expected at most terrain.crater_diameter_max_m")
-    if config["events"]["hot_pixel_fraction"] > 0 and not config["events"]["hot_pixel_hz"] > 0:
-        errors.append("config key 'events.hot_pixel_hz': expected > 0 when events.hot_pixel_fraction > 0")
+    pixel = config["events"]["pixel"]
+    if pixel["hot_pixel_fraction"] > 0 and not pixel["hot_pixel_hz"] > 0:
+        errors.append("config key 'events.pixel.hot_pixel_hz': expected > 0 when events.pixel.hot_pixel_fraction > 0")
     band = config["events"]["sensor"]["band_m"]
     if not band[0] < band[1]:
         errors.append(f"config key 'events.sensor.band_m': expected [low, high] with low < high, got {band}")
@@ -198,7 +206,7 @@ def validate_config(config: Any, schema: dict | None = None) -> None:
         validator.iter_errors(config), key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path)))
     )
     if errors:
-        raise ConfigError(_describe(errors[0]))
+        raise ConfigError(describe(errors[0]))
     semantic = _semantic_errors(config)
     if semantic:
         raise ConfigError(semantic[0])
@@ -227,6 +235,12 @@ def resolve_config(overlay: Any) -> dict:
     if overlay is not None and not isinstance(overlay, dict):
         raise ConfigError(f"config: expected a mapping of keys to values, got {type(overlay).__name__}")
     config = merge_config(default_config(), overlay)
+    events = config.get("events")
+    if isinstance(events, dict) and isinstance(events.get("preset"), str) and isinstance(events.get("pixel"), dict):
+        try:
+            config = with_preset(config)
+        except ValueError as exc:  # an unknown preset
+            raise ConfigError(str(exc)) from None
     validate_config(config)
     from .plan import dataset_plan, too_large
 

@@ -1,5 +1,7 @@
 """The default configuration, defaults.yaml beside this module: the one source of every
-default. Config files are overlays on it: `merge_config(defaults, overlay)`."""
+default. Config files are overlays on it: `merge_config(defaults, overlay)`. The pixel
+model's values come from a named preset, a file of presets/ (`events.preset`), under the
+config's own `events.pixel` keys: `with_preset`."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ from pathlib import Path
 import yaml
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.yaml")
+PRESETS_DIR = Path(__file__).with_name("presets")
 
 
 @functools.cache
@@ -18,13 +21,38 @@ def _defaults() -> dict:
 
 
 def default_config() -> dict:
-    """A fresh copy of defaults.yaml (the default dataset)."""
+    """A fresh copy of defaults.yaml (the default dataset), its preset not yet applied."""
     return copy.deepcopy(_defaults())
 
 
 def section(name: str) -> dict:
-    """One top-level section of the defaults, e.g. section("ocp")."""
-    return copy.deepcopy(_defaults()[name])
+    """One top-level section of the defaults with their preset applied, e.g. section("ocp")."""
+    return with_preset(default_config())[name]
+
+
+def preset_names() -> list[str]:
+    """The pixel-model presets: the files of presets/."""
+    return sorted(path.stem for path in PRESETS_DIR.glob("*.yaml"))
+
+
+@functools.cache
+def _preset(name: str) -> dict:
+    return yaml.safe_load((PRESETS_DIR / f"{name}.yaml").read_text())
+
+
+def preset(name: str) -> dict:
+    """Preset `name`'s overlay on the `events` section ({"pixel": {...}})."""
+    if name not in preset_names():
+        raise ValueError(f"config key 'events.preset': expected one of {preset_names()}, got {name!r}")
+    return copy.deepcopy(_preset(name))
+
+
+def with_preset(config: dict) -> dict:
+    """`config` with events.pixel = its preset's values, then the config's own events.pixel
+    keys. The same config again once applied."""
+    events = config["events"]
+    pixel = {**preset(events["preset"])["pixel"], **(events.get("pixel") or {})}
+    return {**config, "events": {**events, "pixel": pixel}}
 
 
 def merge_config(base: dict, overlay: dict | None) -> dict:

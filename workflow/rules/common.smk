@@ -14,7 +14,10 @@ from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
 from traj2events.plan import dataset_plan, job_resources
 from traj2events.settings.camera import camera_settings as camera_settings_of
+from traj2events.settings.camera import motion_field_settings as motion_field_settings_of
+from traj2events.settings.events import events_picture_settings as events_picture_settings_of
 from traj2events.settings.events import events_settings as events_settings_of
+from traj2events.settings.poses import pose_settings as pose_settings_of
 from traj2events.settings.render import render_settings as render_settings_of
 from traj2events.settings.solve import solve_settings
 
@@ -99,9 +102,9 @@ def preview_option(wildcards, output):
     return f"--preview {output.preview}" if config["render"]["preview"] else ""
 
 
-def camera_settings(wildcards):
-    """The camera and sphere of the config, as JSON."""
-    return json.dumps(camera_settings_of(config), sort_keys=True)
+def as_json(settings_of):
+    """A rule's --settings: a settings function of the config (traj2events.settings), as JSON."""
+    return lambda wildcards: json.dumps(settings_of(config), sort_keys=True)
 
 
 EXPORT_FILES = {"npz": "events.npz", "evt3": "events.raw", "aedat4": "events.aedat4"}
@@ -114,11 +117,6 @@ def export_outputs(folder):
 
 def export_flags(wildcards, output):
     return " ".join(f"--{name} {output[name]}" for name in config["events"]["exports"])
-
-
-def events_settings(wildcards):
-    """The emulator settings of the config, as JSON."""
-    return json.dumps(events_settings_of(config), sort_keys=True)
 
 
 def event_seed(wildcards):

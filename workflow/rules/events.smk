@@ -21,7 +21,7 @@ rule events:
         mem_mb=resources_of("events", "mem_mb"),
         runtime=resources_of("events", "runtime"),
     params:
-        settings=events_settings,
+        settings=as_json(events_settings_of),
         seed=event_seed,
         exports=export_flags,
         code=code("events"),

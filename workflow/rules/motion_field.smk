@@ -19,9 +19,8 @@ rule motion_field:
         mem_mb=resources_of("motion_field", "mem_mb"),
         runtime=resources_of("motion_field", "runtime"),
     params:
-        camera=camera_settings,
-        every=config["motion_field"]["every_n_frames"],
+        settings=as_json(motion_field_settings_of),
         code=code("motion_field"),
     shell:
-        "traj2events motion-field {input.trajectory} --frames {input.frames} --settings {params.camera:q} "
-        "--every {params.every} --output {output.field} --flo-dir {output.flo} 2> {log}"
+        "traj2events motion-field {input.trajectory} --frames {input.frames} --settings {params.settings:q} "
+        "--output {output.field} --flo-dir {output.flo} 2> {log}"

@@ -44,10 +44,10 @@ rule motion_field_picture:
     conda:
         ENV
     params:
-        camera=camera_settings,
+        settings=as_json(camera_settings_of),
         code=code("pictures"),
     shell:
-        "traj2events picture motion-field {input.trajectory} --settings {params.camera:q} --video {input.video} "
+        "traj2events picture motion-field {input.trajectory} --settings {params.settings:q} --video {input.video} "
         "--output {output} 2> {log}"
 
 
@@ -69,11 +69,11 @@ rule events_picture:
     conda:
         ENV
     params:
-        window_ms=config["events"]["window_ms"],
+        settings=as_json(events_picture_settings_of),
         code=code("pictures"),
     shell:
         "traj2events picture events {input.events} --trajectory {input.trajectory} "
-        "--window-ms {params.window_ms} --output {output} 2> {log}"
+        "--settings {params.settings:q} --output {output} 2> {log}"
 
 
 rule dataset_picture:

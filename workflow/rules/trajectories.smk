@@ -56,12 +56,11 @@ rule camera_poses:
     conda:
         ENV
     params:
-        fps=config["camera"]["fps"],
-        method=config["upsampling"]["method"],
+        settings=as_json(pose_settings_of),
         code=code("camera_poses"),
     shell:
-        "traj2events upsample --solutions {input} --id {wildcards.id} --fps {params.fps} "
-        "--method {params.method} --output {output} 2> {log}"
+        "traj2events upsample --solutions {input} --id {wildcards.id} --settings {params.settings:q} "
+        "--output {output} 2> {log}"
 
 
 rule dataset_index:

@@ -160,6 +160,12 @@ def read_events_attrs(path: str | os.PathLike) -> dict:
         return Attributes(path, f.attrs)
 
 
+def read_end_us(path: str | os.PathLike) -> int:
+    """The recording's end (absolute us, to the millisecond): its ms_to_idx runs to it."""
+    with open_file(path, "events.h5 (DSEC layout)") as f:
+        return int(f["t_offset"][()]) + 1000 * (len(f["ms_to_idx"]) - 1)
+
+
 def read_events_window(path: str | os.PathLike, t_start_us: int, t_end_us: int) -> np.ndarray:
     """Events with t in [t_start, t_end) (absolute us), read through ms_to_idx: only that slice."""
     return _read_window(path, t_start_us, t_end_us, labels=False)[0]

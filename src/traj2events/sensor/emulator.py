@@ -49,18 +49,19 @@ from .pixel import advance, emit, refractory_mask
 
 @dataclass(frozen=True)
 class EmulatorParams:
-    """The pixel model's parameters; the defaults are the paper's Table 2 (preset "paper")."""
+    """The pixel model's parameters: a config's events.pixel (its values come from a preset,
+    src/traj2events/presets/: `stages.events.preset_params`)."""
 
-    theta_on: float = 0.25
-    theta_off: float = 0.25
-    sigma: float = 0.03  # threshold mismatch (std of the per-pixel thresholds)
-    cutoff_hz: float = 3.0  # photoreceptor bandwidth at full scale (255 DN); 0 disables
-    refractory_s: float = 0.0
-    leak_hz: float = 0.1
-    shot_noise_hz: float = 5.0
-    hot_pixel_fraction: float = 0.0
-    hot_pixel_hz: float = 0.0
-    refractory_mode: str = "drop"  # "drop" (ESIM) or "defer" (v2e): step 5
+    theta_on: float  # ON contrast threshold, ln units
+    theta_off: float
+    sigma: float  # threshold mismatch (std of the per-pixel thresholds)
+    cutoff_hz: float  # photoreceptor bandwidth at full scale (255 DN); 0 disables
+    refractory_s: float
+    leak_hz: float
+    shot_noise_hz: float
+    hot_pixel_fraction: float
+    hot_pixel_hz: float
+    refractory_mode: str  # "drop" (ESIM) or "defer" (v2e): step 5
 
     def __post_init__(self) -> None:
         if self.refractory_mode not in ("drop", "defer"):
@@ -74,14 +75,6 @@ class EmulatorParams:
             raise ValueError("emulator.theta_on/theta_off: expected >= 0.01")
         if self.hot_pixel_fraction > 1:
             raise ValueError(f"emulator.hot_pixel_fraction: expected <= 1, got {self.hot_pixel_fraction}")
-
-
-PRESETS = {
-    # The paper's Table 2.
-    "paper": EmulatorParams(),
-    # No noise, no low-pass, no mismatch: events only where the log intensity crosses.
-    "clean": EmulatorParams(theta_on=0.25, theta_off=0.25, sigma=0.0, cutoff_hz=0.0, leak_hz=0.0, shot_noise_hz=0.0),
-}
 
 
 def _rng(seed: int, *key: int) -> np.random.Generator:
@@ -100,7 +93,7 @@ class EventEmulator:
         self,
         width: int,
         height: int,
-        params: EmulatorParams = PRESETS["paper"],
+        params: EmulatorParams,
         seed: int = 0,
         labels: bool = False,
         input_scale: float = 1.0,

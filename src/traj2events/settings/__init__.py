@@ -5,10 +5,29 @@ without loading the solver or the kernels. One module per stage, so that editing
 stage's settings reruns only that stage (a module's fingerprint covers what it imports):
 
     solve     base and sample solves of a scenario: vehicle, ocp, ranges, seed
+    poses     the camera poses at the frame rate: fps, upsampling method
     render    one scenario's frames: camera, terrain, Sun, reflectance, detail, timing
-    events    the emulation: pixel-model preset and overrides, labels, input, sensor
+    events    the emulation: preset, pixel model, labels, input, sensor; its picture's window
     camera    the camera and the Moon's sphere (motion field, its picture)
 
-Each stage turns its settings into its model's objects (`trajectory.scenarios.ScenarioSettings`,
-`stages.render.RenderSettings`, `sensor.emulator.EmulatorParams`, `geometry.camera.Camera`).
+The simple ones are a map from each setting to its config key (`pick`), which the commands
+also read to offer one option per key (traj2events.options). Each stage turns its settings
+into its model's objects (`trajectory.scenarios.ScenarioSettings`, `stages.render.RenderSettings`,
+`sensor.emulator.EmulatorParams`, `geometry.camera.Camera`).
 """
+
+from __future__ import annotations
+
+import copy
+
+
+def config_value(config: dict, path: str):
+    """The value at a dotted config key, e.g. "events.pixel.theta_on"."""
+    for key in path.split("."):
+        config = config[key]
+    return config
+
+
+def pick(config: dict, keys: dict[str, str]) -> dict:
+    """{setting: the config's value at its dotted key} (copies)."""
+    return {name: copy.deepcopy(config_value(config, path)) for name, path in keys.items()}

@@ -19,13 +19,14 @@ from typing import Generator
 import numpy as np
 
 from .. import __version__
+from ..defaults import preset
 from ..formats.events import MAX_T_US, EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
 from ..progress import log
 from ..read_ahead import read_ahead
-from ..sensor.emulator import PRESETS, EmulatorParams, EventEmulator
+from ..sensor.emulator import EmulatorParams, EventEmulator
 from ..sensor.laws import display_dn_per_radiance
 from ..sensor.photocurrent import SensorParams, dn_per_radiance
 from ..trajectory.state import BODY_RATES
@@ -175,13 +176,9 @@ def frame_source(
     return source
 
 
-def emulator_params(preset: str, **overrides) -> EmulatorParams:
-    """A preset's parameters with the given (non-None) values replaced."""
-    from dataclasses import replace
-
-    if preset not in PRESETS:
-        raise ValueError(f"events: preset: expected one of {sorted(PRESETS)}, got {preset!r}")
-    return replace(PRESETS[preset], **{k: v for k, v in overrides.items() if v is not None})
+def preset_params(name: str, **changes) -> EmulatorParams:
+    """A preset's pixel model (src/traj2events/presets/) with some values changed."""
+    return EmulatorParams(**{**preset(name)["pixel"], **changes})
 
 
 def emulate(
@@ -291,33 +288,50 @@ def export_events(
 def events_command(
     input: str | os.PathLike,
     output: str | os.PathLike,
-    params: EmulatorParams,
-    preset: str,
+    settings: dict,
     seed: int,
     *,
     fps: float | None = None,
     white: float | None = None,
-    sensor: SensorParams | None = None,
     chunk: int | None = None,
     threads: int = 1,
-    labels: bool = False,
     exports: dict[str, str | None] | None = None,
     trajectory: str | None = None,
-) -> tuple[FrameSource, float]:
-    """The events stage as the command runs it: `input` (frames.h5 through `sensor`, or on
-    the display scale without one; a video; a folder of images) emulated into events.h5,
-    then the exports (`exports`: npz, evt3, aedat4 paths or None; the .npz takes
-    `trajectory`'s states and frames.h5's range meter). Returns the source (its size) and
-    the last frame's time (s): what the event-frame picture needs."""
+) -> None:
+    """The events stage as the command runs it: `input` (frames.h5 through the sensor, or on
+    the display scale; a video; a folder of images) emulated into events.h5 with the pixel
+    model, labels, input scale and sensor of `settings` (settings.events), then the exports
+    (`exports`: npz, evt3, aedat4 paths or None; the .npz takes `trajectory`'s states and
+    frames.h5's range meter). The event-frame picture is its own command (`picture events`),
+    so that a figure's change reruns no emulation."""
+    for option, value in (("fps", fps), ("white", white)):
+        if value is not None and not value > 0:
+            raise ValueError(f"events: {option}: expected a value > 0, got {value}")
+    if seed < 0:
+        raise ValueError(f"events: seed: expected a value >= 0, got {seed}")
+    if not threads >= 1:
+        raise ValueError(f"events: threads: expected a value >= 1, got {threads}")
+    if white is not None and settings["input"] != "display":
+        raise ValueError("events: white: only with the display input scale (the sensor scale needs no white)")
     if trajectory:
         read_trajectory(trajectory)  # refused now, not after the emulation
+    params = EmulatorParams(**settings["pixel"])
+    sensor = SensorParams.from_config(settings["sensor"]) if settings["input"] == "sensor" else None
     chunk = CHUNK_FRAMES if chunk is None else chunk
     source = frame_source(input, chunk, fps, white, sensor, ahead=threads > 1)
-    log(f"{input}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset}, seed {seed})")
-    _, _, t_last_s = emulate(
-        source, params, seed, output, preset, str(input), progress_every=chunk * 10, labels=labels, threads=threads
+    preset_name = settings["preset"]
+    log(f"{input}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset_name}, seed {seed})")
+    emulate(
+        source,
+        params,
+        seed,
+        output,
+        preset_name,
+        str(input),
+        progress_every=chunk * 10,
+        labels=settings["labels"],
+        threads=threads,
     )
     frames = str(input) if Path(input).suffix == ".h5" else None
     e = exports or {}
     export_events(output, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)
-    return source, t_last_s

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..figures import dataset_figure, event_frame, event_mosaic, frame_mosaic, motion_field_mosaic
 from ..formats.atomic import atomic_output
-from ..formats.events import read_events_attrs, read_events_window
+from ..formats.events import read_end_us, read_events_attrs, read_events_window
 from ..formats.trajectory import read_solution_set, read_trajectory
 from ..geometry.camera import Camera
 from ..geometry.motion_field import sphere_flow
@@ -106,13 +106,19 @@ def events_picture(
 
 
 def trajectory_events_picture(
-    events: str | os.PathLike, trajectory: str | os.PathLike, window_ms: float, output: str | os.PathLike
+    events: str | os.PathLike, trajectory: str | os.PathLike | None, window_ms: float, output: str | os.PathLike
 ) -> None:
-    """events.png of one trajectory (its size from its events.h5, its end from its poses)."""
-    tr = read_trajectory(trajectory)
+    """events.png of one recording: its size from its events.h5, its end and title from its
+    poses (`trajectory`), or without them from events.h5 (to the millisecond; the file's
+    name as the title)."""
     attrs = read_events_attrs(events)
     width, height = int(attrs["width"]), int(attrs["height"])
-    events_picture(events, float(tr.t[-1]), width, height, window_ms, _title(tr), output)
+    if trajectory is None:
+        end_s, title = read_end_us(events) * 1e-6, str(events)
+    else:
+        tr = read_trajectory(trajectory)
+        end_s, title = float(tr.t[-1]), _title(tr)
+    events_picture(events, end_s, width, height, window_ms, title, output)
 
 
 def dataset_picture(solutions: list[str | os.PathLike], output: str | os.PathLike) -> None:

@@ -1,0 +1,145 @@
+"""A stage's settings on the command line: `--settings` (the JSON the workflow passes, or
+@file), then one option per config key that changes that key alone. The options, their
+types and their help come from the config's schema and defaults, so a key is described
+once (config.schema.yaml) and every command offers it the same way.
+
+    add_settings(parser, EVENTS)           # --settings, --preset, --theta-on, ..., --f-number
+    settings = settings_from(args, EVENTS)  # defaults < --settings < --preset < each option
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+from pathlib import Path
+
+import jsonschema
+
+from .config import SCHEMA_PATH, ConfigError, describe, load_yaml
+from .defaults import default_config, preset, preset_names, with_preset
+from .settings import config_value, pick
+
+_PREFIX = "setting:"  # argparse dest of an option that changes one setting
+
+
+@functools.cache
+def _schema() -> dict:
+    return load_yaml(SCHEMA_PATH)
+
+
+def _node(path: str) -> dict:
+    """The schema of a dotted config key."""
+    node = _schema()
+    for key in path.split("."):
+        node = node["properties"][key]
+    return node
+
+
+def _defaults(keys: dict[str, str]) -> dict:
+    return pick(with_preset(default_config()), keys)
+
+
+def _leaves(keys: dict[str, str]) -> list[tuple[tuple[str, ...], str]]:
+    """(setting path, config key) of each option: a setting that is a mapping of numbers
+    (events.pixel, events.sensor) gives one option per key."""
+    leaves = []
+    for name, path in keys.items():
+        node = _node(path)
+        if node.get("type") == "object":
+            leaves += [((name, key), f"{path}.{key}") for key in node["properties"]]
+        else:
+            leaves.append(((name,), path))
+    return leaves
+
+
+def _config_key(keys: dict[str, str], setting: str) -> str:
+    """ "pixel.theta_on" -> "events.pixel.theta_on"."""
+    name, _, rest = setting.partition(".")
+    return f"{keys[name]}.{rest}" if rest else keys[name]
+
+
+def add_settings(
+    parser: argparse.ArgumentParser, keys: dict[str, str], what: str, flags: dict[str, str] | None = None
+) -> None:
+    """--settings and one option per key of `keys` ({setting: config key}); `flags` renames
+    an option ({config key: flag})."""
+    defaults = _defaults(keys)
+    parser.add_argument(
+        "--settings",
+        metavar="JSON",
+        help=f"{what} as JSON (or @file) with keys {', '.join(keys)}: the workflow passes the config's; "
+        "default: defaults.yaml's. The options below change one key each",
+    )
+    group = parser.add_argument_group("settings (each changes one config key; default: defaults.yaml's)")
+    given_by = {}  # config key: its option
+    for setting, path in _leaves(keys):
+        node, default = _node(path), config_value(defaults, ".".join(setting))
+        option = dict(dest=_PREFIX + ".".join(setting), default=None, help=f"{node.get('description', '')} [{path}, "
+                      f"default {default}]")  # fmt: skip
+        if setting == ("preset",):
+            option.update(choices=preset_names(), help=f"{node['description']}; sets every events.pixel key "
+                          f"[{path}, default {default}]")  # fmt: skip
+        elif "enum" in node:
+            option.update(choices=node["enum"])
+        elif node.get("type") == "boolean":
+            option.update(action=argparse.BooleanOptionalAction)
+        elif node.get("type") == "array":
+            option.update(nargs=len(default), type=float, metavar="V")
+        else:
+            option.update(type={"integer": int, "number": float}.get(node.get("type"), str), metavar="VALUE")
+        flag = (flags or {}).get(path, "--" + setting[-1].replace("_", "-"))
+        group.add_argument(flag, **option)
+        given_by[path] = flag
+    parser.set_defaults(settings_flags=given_by)
+
+
+def _json_object(option: str, value: str) -> dict:
+    text = Path(value[1:]).read_text() if value.startswith("@") else value
+    try:
+        given = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{option}: expected a JSON object: {exc}") from None
+    if not isinstance(given, dict):
+        raise ValueError(f"{option}: expected a JSON object, got {text!r}")
+    return given
+
+
+def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
+    """The settings in layers: defaults.yaml's, then --settings (its preset's pixel values
+    under its pixel keys, as in a config), then --preset (its pixel values), then each
+    option given; each key checked against the schema."""
+    settings = _defaults(keys)
+    if args.settings:
+        given = _json_object("--settings", args.settings)
+        for name, value in given.items():
+            if name not in settings:
+                raise ValueError(f"--settings: unknown key {name!r}; expected one of {sorted(settings)}")
+            if isinstance(settings[name], dict) and isinstance(value, dict):
+                unknown = sorted(set(value) - set(settings[name]))
+                if unknown:
+                    raise ValueError(f"--settings: {name}: unknown keys {unknown}; expected {sorted(settings[name])}")
+                settings[name] = {**settings[name], **value}
+            else:
+                settings[name] = value
+        if "preset" in given and "pixel" in settings:  # as in a config: the preset's values, then pixel's keys
+            settings["pixel"] = {**preset(given["preset"])["pixel"], **given.get("pixel", {})}
+    options = {d[len(_PREFIX) :]: v for d, v in vars(args).items() if d.startswith(_PREFIX) and v is not None}
+    if options.get("preset"):
+        settings["pixel"] = preset(options["preset"])["pixel"]
+    for setting, value in options.items():
+        *parents, leaf = setting.split(".")
+        target = settings
+        for parent in parents:
+            target = target[parent]
+        target[leaf] = list(value) if isinstance(value, list) else value
+    for name, path in keys.items():
+        error = next(iter(jsonschema.Draft202012Validator(_node(path)).iter_errors(settings[name])), None)
+        if error is not None:  # named by the option that gave the value, or --settings
+            key = ".".join([path, *map(str, error.absolute_path)])
+            given = [_config_key(keys, setting) for setting in options]
+            option = next((args.settings_flags[g] for g in given if f"{key}.".startswith(f"{g}.")), "--settings")
+            raise ConfigError(f"{option}: {describe(error, path.split('.'))}")
+    if "preset" in settings:
+        preset(settings["preset"])  # a known name
+    return settings
