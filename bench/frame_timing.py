@@ -66,6 +66,7 @@ from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.geometry.camera import Camera  # noqa: E402
 from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
 from traj2events.renderer.draw import Frame, TerrainRenderer  # noqa: E402
+from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.events import preset_params  # noqa: E402
@@ -294,6 +295,7 @@ def main() -> None:
     parser.add_argument("--window", type=float, default=0.2, help="--flight: window length, s")
     parser.add_argument("--supersample", type=int, default=1, metavar="S", help="frames averaged from S x S samples")
     parser.add_argument("--adaptive", nargs="+", choices=list(ADAPTIVE), help="the adaptive variants to run")
+    parser.add_argument("--texture-filter", choices=TEXTURE_FILTERS, help="render.lod.texture_filter")
     args = parser.parse_args()
     if args.whole:
         whole_trajectories(args.trajectories, args.size, args.fps)
@@ -304,7 +306,8 @@ def main() -> None:
         parser.error(f"--reference-fps must be a multiple of {FIXED_FPS}")
     print(
         f"# frame timing: {args.size}^2, clean preset, reference {args.reference_fps} fps, adaptive from "
-        f"{args.fps} fps, {args.supersample}x{args.supersample} samples per pixel; {platform.node()} "
+        f"{args.fps} fps, {args.supersample}x{args.supersample} samples per pixel, texture filter "
+        f"{args.texture_filter or 'the config default'}; {platform.node()} "
         f"({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}"
     )
     print(
@@ -330,7 +333,9 @@ def main() -> None:
         else:
             clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
         flight: dict[str, list[dict]] = {}
-        with TerrainRenderer(TilesSeenBy(tiles, camera), drawn, sun, reflectance) as drawing:
+        with TerrainRenderer(
+            TilesSeenBy(tiles, camera), drawn, sun, reflectance, texture_filter=args.texture_filter
+        ) as drawing:
             renderer = drawing if args.supersample == 1 else Supersampled(drawing, args.supersample)
             for clip, (t0, t1) in clips.items():
                 rows = run_clip(

@@ -35,6 +35,7 @@ from ..scene.stars import StarField, add_stars
 from ..scene.sun import Sun
 from ..scene.tiles import TileKey, TileSet, border_ring, depth_range
 from .context import gl_context, resolve_backend
+from .footprint import GL_TEXTURE_MAX_ANISOTROPY, MAX_ANISOTROPY, TEXTURE_FILTERS, level_sides, mip_levels
 
 _INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
 _SHADING_BYTES = 512 * 2**20  # cap on the shading texture array (bounds the slots kept)
@@ -78,9 +79,11 @@ class _GLScene:
         vertices_per_tile: int,
         shading_uv: np.ndarray | None = None,
         shading_side: int = 0,
+        texture_filter: str = "point",
     ):
         """`shading_uv`: (vertices_per_tile, 2) where each vertex of a tile sits in its
-        (shading_side x shading_side) shading texture, to shade per pixel; None: per vertex."""
+        (shading_side x shading_side) shading texture, to shade per pixel; None: per vertex.
+        `texture_filter`: how a pixel samples it (TEXTURE_FILTERS)."""
         from OpenGL import GL as gl
 
         self.gl, self.width, self.height = gl, width, height
@@ -106,8 +109,11 @@ class _GLScene:
             gl.glEnableVertexAttribArray(1)
             gl.glVertexAttribPointer(1, 2, gl.GL_FLOAT, gl.GL_FALSE, 8, None)
             self.shading_side, self.shading_texture = shading_side, 0
+            self.texture_filter = texture_filter
+            self.level_sides = level_sides(shading_side) if texture_filter != "point" else [shading_side]
             layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
-            self.slot_limit = max(1, min(layers, _SHADING_BYTES // (8 * shading_side**2)))  # RGBA16F texels
+            layer_bytes = sum(8 * n**2 for n in self.level_sides)  # RGBA16F texels, every level
+            self.slot_limit = max(1, min(layers, _SHADING_BYTES // layer_bytes))
         else:
             self.slot_limit = 2**31 // (vertices_per_tile * 16)  # OpenGL's buffer offsets
         # Per-vertex data: (position - tile origin, lit) and, shaded per vertex, (normal, 0),
@@ -168,22 +174,29 @@ class _GLScene:
     def _allocate_shading(self, slots: int) -> None:
         """A shading texture array of `slots` layers (RGBA16F: normal xyz, lit), keeping
         the layers already filled (copied on the GPU)."""
-        gl, side = self.gl, self.shading_side
+        gl = self.gl
         new = gl.glGenTextures(1)
         gl.glActiveTexture(gl.GL_TEXTURE2)
         gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, new)
-        gl.glTexImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, gl.GL_RGBA16F, side, side, slots, 0, gl.GL_RGBA, gl.GL_FLOAT, None)
+        for level, n in enumerate(self.level_sides):
+            gl.glTexImage3D(gl.GL_TEXTURE_2D_ARRAY, level, gl.GL_RGBA16F, n, n, slots, 0, gl.GL_RGBA, gl.GL_FLOAT, None)
+        mipmapped = len(self.level_sides) > 1
         for name, value in (
-            (gl.GL_TEXTURE_MIN_FILTER, gl.GL_LINEAR),  # one level: bilinear between texels
+            # point: between the texels at the pixel's centre; else also between levels
+            # (trilinear), the level chosen from the pixel's footprint on the texture
+            (gl.GL_TEXTURE_MIN_FILTER, gl.GL_LINEAR_MIPMAP_LINEAR if mipmapped else gl.GL_LINEAR),
             (gl.GL_TEXTURE_MAG_FILTER, gl.GL_LINEAR),
             (gl.GL_TEXTURE_WRAP_S, gl.GL_CLAMP_TO_EDGE),
             (gl.GL_TEXTURE_WRAP_T, gl.GL_CLAMP_TO_EDGE),
-            (gl.GL_TEXTURE_MAX_LEVEL, 0),
+            (gl.GL_TEXTURE_MAX_LEVEL, len(self.level_sides) - 1),
         ):
             gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
+        if self.texture_filter == "anisotropic":  # samples along the footprint's long axis (oblique ground)
+            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_ANISOTROPY, MAX_ANISOTROPY)
         if self.capacity:
-            gl.glCopyImageSubData(self.shading_texture, gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0,
-                                  new, gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, 0, side, side, self.capacity)  # fmt: skip
+            for level, n in enumerate(self.level_sides):
+                gl.glCopyImageSubData(self.shading_texture, gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, 0,
+                                      new, gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, 0, n, n, self.capacity)  # fmt: skip
             gl.glDeleteTextures([self.shading_texture])
         self.shading_texture = new
 
@@ -206,11 +219,13 @@ class _GLScene:
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, buffer)
             gl.glBufferSubData(gl.GL_ARRAY_BUFFER, offset, data.nbytes, data)
         if self.textured:
-            side = self.shading_side
             gl.glActiveTexture(gl.GL_TEXTURE2)
             gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
-            gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, 0, 0, 0, slot, side, side, 1, gl.GL_RGBA, gl.GL_HALF_FLOAT,
-                               np.ascontiguousarray(shading, np.float16))  # fmt: skip
+            levels = mip_levels(shading) if len(self.level_sides) > 1 else [shading]
+            for level, texels in enumerate(levels):
+                n = texels.shape[0]
+                gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, slot, n, n, 1, gl.GL_RGBA, gl.GL_HALF_FLOAT,
+                                   np.ascontiguousarray(texels, np.float16))  # fmt: skip
 
     def uniform(self, name: str, value) -> None:
         gl = self.gl
@@ -367,9 +382,14 @@ class TerrainRenderer:
         max_cached_tiles: int = 4000,
         stars: StarField | None = None,
         backend: str = "auto",
+        texture_filter: str | None = None,
     ):
         """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black
-        sky. `backend`: auto | egl | osmesa (resolve_backend)."""
+        sky. `backend`: auto | egl | osmesa (resolve_backend). `texture_filter`: how a
+        pixel samples the shading texture (TEXTURE_FILTERS; None: the tiles' lod's)."""
+        texture_filter = tiles.lod.texture_filter if texture_filter is None else texture_filter
+        if texture_filter not in TEXTURE_FILTERS:
+            raise ValueError(f"texture_filter: expected one of {TEXTURE_FILTERS}, got {texture_filter!r}")
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
         self.stars = stars
         self.backend = resolve_backend(backend)
@@ -380,7 +400,8 @@ class TerrainRenderer:
         n_vertices = len(tiles.tile((0, 0, 0)).vertices)  # the same for every tile
         self.shading_levels = tiles.lod.shading_levels
         uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
-        self._gl = _GLScene(camera.width, camera.height, tiles.tile((0, 0, 0)).faces, n_vertices, uv, side)
+        faces = tiles.tile((0, 0, 0)).faces
+        self._gl = _GLScene(camera.width, camera.height, faces, n_vertices, uv, side, texture_filter)
         self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
         self._uniforms = {
             "sun_dir": sun.direction,

@@ -66,6 +66,7 @@ class LodSettings:
     pixels_per_cell: float = _LOD["pixels_per_cell"]
     min_spacing_m: float = _LOD["min_spacing_m"]
     shading_levels: int = _LOD["shading_levels"]  # 0: law per vertex; k: per pixel, normals k levels finer
+    texture_filter: str = _LOD["texture_filter"]  # how a pixel samples the shading texture (renderer.draw)
     skirt_cells: float = 2.0  # skirt depth in cells of the tile
     foreshortening: bool = True  # measure a cell by its projected area, not its width
 

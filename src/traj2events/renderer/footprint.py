@@ -1,0 +1,54 @@
+"""A pixel's footprint on the shading texture: the texture's levels averaged over areas
+(mipmaps), so that a pixel seeing many texels takes their mean normal and lit fraction
+instead of the one texel at its centre (point sampling aliases shadow edges and relief).
+
+Level k of a side-n texture has floor(n / 2^k) texels a side, each the area-weighted mean
+of the level k-1 texels under it in the texture's normalised coordinates: that is where the
+GPU samples it, and the sides are odd (cells 2^levels + 1), so halving does not align
+texels and a plain 2 x 2 box would shift each level by up to half a texel.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# How a pixel samples the shading texture (render.lod.texture_filter): `point` at its centre
+# (bilinear between texels); `trilinear` from the levels below, averaged over its footprint;
+# `anisotropic` also along the footprint's long axis, where the ground is seen obliquely.
+TEXTURE_FILTERS = ("point", "trilinear", "anisotropic")
+MAX_ANISOTROPY = 16.0  # samples along the long axis at most (what llvmpipe and GPUs offer)
+GL_TEXTURE_MAX_ANISOTROPY = 0x84FE  # OpenGL 4.6's (ARB/EXT_texture_filter_anisotropic before)
+
+
+def level_sides(side: int) -> list[int]:
+    """The sides of every level, down to 1 texel (OpenGL's chain: floor(side / 2^k))."""
+    sides = [side]
+    while sides[-1] > 1:
+        sides.append(sides[-1] // 2)
+    return sides
+
+
+def area_weights(n_from: int, n_to: int) -> np.ndarray:
+    """(n_to, n_from): row i holds how much of target texel i's interval [i, i+1) / n_to
+    each source texel's [j, j+1) / n_from covers, normalised to sum to 1."""
+    edges_to = np.arange(n_to + 1) / n_to
+    edges_from = np.arange(n_from + 1) / n_from
+    lo = np.maximum(edges_to[:-1, None], edges_from[None, :-1])
+    hi = np.minimum(edges_to[1:, None], edges_from[None, 1:])
+    overlap = np.clip(hi - lo, 0.0, None)
+    return overlap / overlap.sum(axis=1, keepdims=True)
+
+
+def mip_levels(texture: np.ndarray) -> list[np.ndarray]:
+    """Every level of a (side, side, channels) texture, level 0 itself first; each level
+    the area average of the one before (float32 arithmetic, stored in the texture's dtype)."""
+    levels = [np.asarray(texture)]
+    level = np.asarray(texture, np.float32)
+    for n in level_sides(level.shape[0])[1:]:
+        rows = area_weights(level.shape[0], n).astype(np.float32)
+        cols = area_weights(level.shape[1], n).astype(np.float32)
+        m, k, c = level.shape
+        level = (rows @ level.reshape(m, k * c)).reshape(n, k, c)  # along the rows (BLAS),
+        level = (cols @ level.transpose(1, 0, 2).reshape(k, n * c)).reshape(n, n, c).transpose(1, 0, 2)  # columns
+        levels.append(level.astype(texture.dtype))
+    return levels
