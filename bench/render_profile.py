@@ -62,17 +62,17 @@ def timed(log: list[float], function):
 
 # Probes of the textured fragment shader: (committed text, replacement), each taking one
 # part out; together they split a frame's time (docs/performance.md).
-_LAW = "    float rf = reflectance_factor_of_phase(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
+_LAW = "    float per_mu0 = reflectance_per_mu0(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
 _BODY = _LAW.join(
     [
         "    vec4 texel = texture(shading, vec3(frag_uv, frag_layer));\n",
-        "\n    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);",
+        "\n    float radiance = clamp(per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI, 0.0, radiance_max);",
     ]
 )
 PROBED_SHADER = "terrain_textured.frag"
 PROBES = {
-    "no law": (_LAW, "    float rf = texel.x + frag_phase;"),
-    "no law, no phase term": (_LAW, "    float rf = texel.x;"),
+    "no law": (_LAW, "    float per_mu0 = texel.x + frag_phase;"),
+    "no law, no phase term": (_LAW, "    float per_mu0 = texel.x;"),
     "no texture": (_BODY, "    float radiance = frag_phase + frag_uv.x * frag_uv.y + frag_layer;"),
     "constant radiance": (_BODY, "    float radiance = 1.0;"),
 }

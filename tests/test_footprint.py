@@ -4,7 +4,7 @@ GPU samples it; the integral kept; an edge's texel gets the edge's area fraction
 import numpy as np
 import pytest
 
-from traj2events.renderer.footprint import area_weights, level_sides, mip_levels
+from traj2events.renderer.footprint import area_weights, level_sides, mip_levels, sunlit
 
 
 def test_the_levels_are_openGLs_chain():
@@ -45,3 +45,20 @@ def test_a_texel_across_a_shadow_edge_gets_its_lit_area_fraction():
 def test_half_precision_textures_stay_half_precision():
     levels = mip_levels(np.ones((17, 17, 4), np.float16))
     assert all(level.dtype == np.float16 for level in levels) and levels[-1].shape == (1, 1, 4)
+
+
+def test_the_direct_light_is_averaged_where_a_mean_normal_would_lose_it():
+    # Ridges of +-30 deg facets (z down) under a Sun from +x at 7 deg: the facets facing it
+    # get mu0 = sin 30 cos 7 + cos 30 sin 7 = 0.602, the others none. Their mean direct
+    # light is 0.301; the mean normal is level, which the Sun lights at sin 7 = 0.122.
+    sun = np.array([np.cos(np.radians(7.0)), 0.0, -np.sin(np.radians(7.0))])
+    facing, away = (np.array([s * np.sin(np.radians(30.0)), 0.0, -np.cos(np.radians(30.0))]) for s in (1, -1))
+    texture = np.zeros((17, 17, 4), np.float32)
+    texture[:, 0::2, :3], texture[:, 1::2, :3] = facing, away
+    texture[..., 3] = 1.0  # no cast shadow
+    lit = sunlit(texture, sun)
+    assert lit[0, 0, 3] == pytest.approx(0.602, abs=1e-3) and lit[0, 1, 3] == 0.0
+    coarse = mip_levels(lit)[-1][0, 0]
+    assert coarse[3] == pytest.approx(float(facing @ sun) * 9 / 17, rel=1e-5)  # 9 of 17 columns face the Sun
+    mean_normal = coarse[:3] / np.linalg.norm(coarse[:3])
+    assert mean_normal @ sun < 0.5 * coarse[3]  # what averaging normals alone would give

@@ -13,11 +13,10 @@ asynchronously: `render_sequence` draws each frame before handing over the previ
 
 Shading (`render.lod.shading_levels`): 0 evaluates the reflectance law at the vertices of
 the drawn tiles and interpolates the radiance (shaders/terrain.*). k > 0 gives every slot
-a layer of a texture array holding the normals and lit fractions of its tile's
-area k levels finer (TileSet.shading_texture), and evaluates the law per pixel
-from it (shaders/terrain_textured.*): the geometry (silhouettes, depth) is the drawn
-tiles', the shading that of tiles 2^k times finer. On a CPU rasteriser a frame's cost is
-its triangle count, so coarse tiles shaded per pixel are faster for the same shading.
+a layer of a texture array holding the normals and lit fractions of its tile's area k
+levels finer (TileSet.shading_texture), with levels averaged over areas (`footprint`), and
+evaluates the law per pixel from it (shaders/terrain_textured.*): the geometry
+(silhouettes, depth) is the drawn tiles', the shading that of tiles 2^k times finer.
 """
 
 from __future__ import annotations
@@ -34,8 +33,8 @@ from ..scene.reflectance import ReflectanceParams, max_radiance_factor
 from ..scene.stars import StarField, add_stars
 from ..scene.sun import Sun
 from ..scene.tiles import TileKey, TileSet, border_ring, depth_range
+from . import footprint
 from .context import gl_context, resolve_backend
-from .footprint import GL_TEXTURE_MAX_ANISOTROPY, MAX_ANISOTROPY, TEXTURE_FILTERS, level_sides, mip_levels
 
 _INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
 _SHADING_BYTES = 512 * 2**20  # cap on the shading texture array (bounds the slots kept)
@@ -83,7 +82,7 @@ class _GLScene:
     ):
         """`shading_uv`: (vertices_per_tile, 2) where each vertex of a tile sits in its
         (shading_side x shading_side) shading texture, to shade per pixel; None: per vertex.
-        `texture_filter`: how a pixel samples it (TEXTURE_FILTERS)."""
+        `texture_filter`: how a pixel samples it (footprint.TEXTURE_FILTERS)."""
         from OpenGL import GL as gl
 
         self.gl, self.width, self.height = gl, width, height
@@ -110,7 +109,7 @@ class _GLScene:
             gl.glVertexAttribPointer(1, 2, gl.GL_FLOAT, gl.GL_FALSE, 8, None)
             self.shading_side, self.shading_texture = shading_side, 0
             self.texture_filter = texture_filter
-            self.level_sides = level_sides(shading_side) if texture_filter != "point" else [shading_side]
+            self.level_sides = footprint.level_sides(shading_side) if texture_filter != "point" else [shading_side]
             layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
             layer_bytes = sum(8 * n**2 for n in self.level_sides)  # RGBA16F texels, every level
             self.slot_limit = max(1, min(layers, _SHADING_BYTES // layer_bytes))
@@ -191,8 +190,10 @@ class _GLScene:
             (gl.GL_TEXTURE_MAX_LEVEL, len(self.level_sides) - 1),
         ):
             gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
+        if mipmapped:  # the filter as wide as the pixel (footprint.LOD_BIAS)
+            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, gl.GL_TEXTURE_LOD_BIAS, footprint.LOD_BIAS)
         if self.texture_filter == "anisotropic":  # samples along the footprint's long axis (oblique ground)
-            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_ANISOTROPY, MAX_ANISOTROPY)
+            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, footprint.GL_TEXTURE_MAX_ANISOTROPY, footprint.MAX_ANISOTROPY)
         if self.capacity:
             for level, n in enumerate(self.level_sides):
                 gl.glCopyImageSubData(self.shading_texture, gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, 0,
@@ -221,7 +222,7 @@ class _GLScene:
         if self.textured:
             gl.glActiveTexture(gl.GL_TEXTURE2)
             gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
-            levels = mip_levels(shading) if len(self.level_sides) > 1 else [shading]
+            levels = footprint.mip_levels(shading) if len(self.level_sides) > 1 else [shading]
             for level, texels in enumerate(levels):
                 n = texels.shape[0]
                 gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, slot, n, n, 1, gl.GL_RGBA, gl.GL_HALF_FLOAT,
@@ -386,10 +387,10 @@ class TerrainRenderer:
     ):
         """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black
         sky. `backend`: auto | egl | osmesa (resolve_backend). `texture_filter`: how a
-        pixel samples the shading texture (TEXTURE_FILTERS; None: the tiles' lod's)."""
+        pixel samples the shading texture (footprint.TEXTURE_FILTERS; None: the tiles' lod's)."""
         texture_filter = tiles.lod.texture_filter if texture_filter is None else texture_filter
-        if texture_filter not in TEXTURE_FILTERS:
-            raise ValueError(f"texture_filter: expected one of {TEXTURE_FILTERS}, got {texture_filter!r}")
+        if texture_filter not in footprint.TEXTURE_FILTERS:
+            raise ValueError(f"texture_filter: expected one of {footprint.TEXTURE_FILTERS}, got {texture_filter!r}")
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
         self.stars = stars
         self.backend = resolve_backend(backend)
@@ -429,7 +430,7 @@ class TerrainRenderer:
             position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
             normal = shading = None
             if self.shading_levels:
-                shading = self.tiles.shading_texture(key, self.shading_levels)
+                shading = footprint.sunlit(self.tiles.shading_texture(key, self.shading_levels), self.sun.direction)
             else:
                 normal = np.zeros((len(t.vertices), 4), np.float32)
                 normal[:, :3] = t.normals

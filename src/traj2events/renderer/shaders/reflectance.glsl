@@ -41,23 +41,35 @@ float phase_term(float cos_g)
     return clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
 }
 
+// The reflectance factor per unit mu0 = cos(incidence), r_F / mu0, of a surface with unit
+// normal n seen along unit to_camera (toward the camera) under sun_dir, given phase_term
+// of their phase angle; 0 where the surface faces away from the camera. Both laws are
+// mu0 times a factor smooth in mu0 (at mu0 <= 0 taken at 0): a pixel whose texels face the
+// Sun differently takes the mean of lit * mu0 over its footprint times this factor
+// (terrain_textured.frag), the law's linear part averaged exactly.
+float reflectance_per_mu0(vec3 n, vec3 to_camera, float phase)
+{
+    float mu0 = max(dot(n, sun_dir), 0.0);
+    float mu = dot(n, to_camera);
+    float per_mu0 = 0.0;
+    if (mu > 0.0) {
+        if (model == 0) {
+            float multiple = chandrasekhar_h(mu0) * chandrasekhar_h(mu) - 1.0;
+            per_mu0 = 0.25 * w / (mu0 + mu) * (phase + multiple);
+        } else {
+            per_mu0 = albedo * (2.0 * phase / (mu0 + mu) + (1.0 - phase));
+        }
+    }
+    return per_mu0;
+}
+
 // Reflectance factor r_F (radiance = r_F * irradiance / PI) of a surface with unit normal
-// n seen along unit to_camera (toward the camera) under sun_dir, given phase_term of their
-// phase angle; 0 where either is below the surface's horizon.
+// n seen along unit to_camera under sun_dir, given phase_term of their phase angle; 0
+// where either is below the surface's horizon.
 float reflectance_factor_of_phase(vec3 n, vec3 to_camera, float phase)
 {
     float mu0 = dot(n, sun_dir);
-    float mu = dot(n, to_camera);
-    float rf = 0.0;
-    if (mu0 > 0.0 && mu > 0.0) {
-        if (model == 0) {
-            float multiple = chandrasekhar_h(mu0) * chandrasekhar_h(mu) - 1.0;
-            rf = 0.25 * w * mu0 / (mu0 + mu) * (phase + multiple);
-        } else {
-            rf = albedo * (2.0 * phase * mu0 / (mu0 + mu) + (1.0 - phase) * mu0);
-        }
-    }
-    return rf;
+    return mu0 > 0.0 ? mu0 * reflectance_per_mu0(n, to_camera, phase) : 0.0;
 }
 
 float reflectance_factor(vec3 n, vec3 to_camera)

@@ -1,13 +1,13 @@
 #version 330 core
 // traj2events terrain shaded per pixel, fragment stage: the reflectance law at every pixel
-// from the shading texture's normal and lit fraction (bilinear between its texels), times
-// the lit fraction; depth along the boresight (m) as in terrain.frag.
+// from the shading texture's normal and lit fraction times mu0, sampled over the pixel's
+// footprint (render.lod.texture_filter); depth along the boresight (m) as in terrain.frag.
 in vec2 frag_uv;
 flat in float frag_layer;
 in vec3 frag_to_camera_m;
 in float frag_phase;
 
-uniform sampler2DArray shading;  // per slot: unit normal xyz, lit fraction (0..1)
+uniform sampler2DArray shading;  // per slot: normal xyz, lit fraction times mu0 (0..1)
 uniform float radiance_max;      // the law's maximum for this Sun (W m^-2 sr^-1)
 
 out vec4 frag_color;             // (radiance, depth, -, -): only R and G are stored
@@ -16,8 +16,9 @@ out vec4 frag_color;             // (radiance, depth, -, -): only R and G are st
 
 void main()
 {
+    // Over the pixel's footprint: the mean normal, and the mean of lit * mu0 (footprint.py).
     vec4 texel = texture(shading, vec3(frag_uv, frag_layer));
-    float rf = reflectance_factor_of_phase(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);
-    float radiance = clamp(rf * irradiance / PI * clamp(texel.w, 0.0, 1.0), 0.0, radiance_max);
+    float per_mu0 = reflectance_per_mu0(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);
+    float radiance = clamp(per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI, 0.0, radiance_max);
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
 }
