@@ -34,7 +34,7 @@ from pathlib import Path
 from typing import Protocol
 
 import numpy as np
-from numba import njit
+from numba import float64, njit, vectorize
 
 from ..defaults import section
 from .terrain_kernels import (
@@ -119,20 +119,38 @@ def boulder_profile(rho: np.ndarray, radius_m: float) -> np.ndarray:
     return radius_m * np.sqrt(np.clip(1.0 - np.asarray(rho) ** 2, 0.0, None))
 
 
+def _fresh_crater(rho, depth_m, rim_m):
+    if rho < 1.0:
+        return rim_m - depth_m * (1.0 - rho * rho)
+    if rho < EJECTA_EXTENT:
+        tail = 1.0 / EJECTA_EXTENT**3
+        return rim_m * (math.pow(max(rho, 1.0), -3.0) - tail) / (1.0 - tail)
+    return 0.0
+
+
+def _degraded_crater(rho, depth_m):
+    if rho < DEGRADED_EXTENT:
+        return -0.5 * depth_m * (1.0 + math.cos(math.pi * rho / DEGRADED_EXTENT))
+    return 0.0
+
+
+# Each profile written once, as a scalar function: compiled into the tiles' pass
+# (_add_craters_on_grid) and as a numba ufunc for numpy arrays.
+fresh_crater_height = njit(inline="always")(_fresh_crater)
+degraded_crater_height = njit(inline="always")(_degraded_crater)
+_fresh_crater_ufunc = vectorize([float64(float64, float64, float64)], cache=True)(_fresh_crater)
+_degraded_crater_ufunc = vectorize([float64(float64, float64)], cache=True)(_degraded_crater)
+
+
 def fresh_crater_profile(rho: np.ndarray, depth_m: float, rim_m: float) -> np.ndarray:
     """Fresh simple crater: parabolic bowl from the rim crest (rim_m) down to rim_m - depth_m
     at the centre; outside, an ejecta blanket rim_m * rho^-3 tapered to zero at 3 radii."""
-    rho = np.asarray(rho, dtype=float)
-    bowl = rim_m - depth_m * (1.0 - rho**2)
-    tail = 1.0 / EJECTA_EXTENT**3
-    ejecta = rim_m * (np.maximum(rho, 1.0) ** -3 - tail) / (1.0 - tail)
-    return np.where(rho < 1.0, bowl, np.where(rho < EJECTA_EXTENT, ejecta, 0.0))
+    return _fresh_crater_ufunc(np.asarray(rho, dtype=float), float(depth_m), float(rim_m))
 
 
 def degraded_crater_profile(rho: np.ndarray, depth_m: float) -> np.ndarray:
     """Degraded crater: a rimless cosine bowl, slopes relaxed out to 1.3 radii."""
-    rho = np.asarray(rho, dtype=float)
-    return np.where(rho < DEGRADED_EXTENT, -0.5 * depth_m * (1.0 + np.cos(np.pi * rho / DEGRADED_EXTENT)), 0.0)
+    return _degraded_crater_ufunc(np.asarray(rho, dtype=float), float(depth_m))
 
 
 # --- procedural terrain --------------------------------------------------------------------
@@ -332,9 +350,7 @@ class ProceduralTerrain:
 @njit(cache=True, nogil=True)
 def _add_craters_on_grid(x0, dx, nx, y0, dy, ny, flat_x, flat_y, flat_h, cx, cy, diameter, fresh, depth, rim, reach):
     """The loop of `crater_relief_m` over craters on a regular grid, compiled: each crater's
-    profile added on the sub-block it reaches (`points_near`), with the profiles'
-    operations in the order of `fresh_crater_profile` and `degraded_crater_profile`."""
-    tail = 1.0 / EJECTA_EXTENT**3
+    profile added on the sub-block it reaches (`points_near`)."""
     for c in range(cx.size):
         i0 = max(int(np.floor((cx[c] - reach[c] - x0) / dx)), 0)
         i1 = min(int(np.ceil((cx[c] + reach[c] - x0) / dx)) + 1, nx)
@@ -346,16 +362,9 @@ def _add_craters_on_grid(x0, dx, nx, y0, dy, ny, flat_x, flat_y, flat_h, cx, cy,
                 k = i * ny + j
                 rho = np.hypot(flat_x[k] - cx[c], flat_y[k] - cy[c]) / radius
                 if fresh[c]:
-                    if rho < 1.0:
-                        value = rim[c] - depth[c] * (1.0 - rho * rho)
-                    elif rho < EJECTA_EXTENT:
-                        value = rim[c] * (math.pow(max(rho, 1.0), -3.0) - tail) / (1.0 - tail)
-                    else:
-                        value = 0.0
-                elif rho < DEGRADED_EXTENT:
-                    value = -0.5 * depth[c] * (1.0 + np.cos(np.pi * rho / DEGRADED_EXTENT))
+                    value = fresh_crater_height(rho, depth[c], rim[c])
                 else:
-                    value = 0.0
+                    value = degraded_crater_height(rho, depth[c])
                 flat_h[k] += value
 
 
