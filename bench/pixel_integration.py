@@ -13,7 +13,9 @@ samples per pixel averaged in linear radiance. The reference is --reference x --
 point samples per pixel. Per variant: render seconds per frame (wall, one core: llvmpipe
 with LP_NUM_THREADS=1; the best of --repeats rounds, alternated variant by variant), events
 against the reference's, the per-pixel event-count error (sum |n - n_ref| / sum n_ref) and
-the mean |ln I - ln I_ref| of the emulator's input (lin-log, as the pixel sees it).
+the mean |ln I - ln I_ref| of the emulator's input (lin-log, as the pixel sees it). With
+--regions, also each variant's events against the reference's per kind of pixel (`regions`):
+sky and horizon, depth edges, shadow, shadow edges, lit ground.
 """
 
 from __future__ import annotations
@@ -56,19 +58,35 @@ VARIANTS = [
 
 
 def render_window(settings, camera, states, times, texture_filter: str, samples: int):
-    """(frames (n, h, w) float32 radiance, seconds per frame) of one variant."""
+    """(frames (n, h, w) float32 radiance, seconds per frame, the first frame's depth) of one
+    variant."""
     _, tiles, sun, reflectance = settings.build()
     drawn = Camera(camera.width * samples, camera.height * samples, camera.fov_deg, camera.mount_height_m)
     frames = []
     with TerrainRenderer(TilesSeenBy(tiles, camera), drawn, sun, reflectance, texture_filter=texture_filter) as r:
         renderer = r if samples == 1 else Supersampled(r, samples)
         poses = [camera.pose(s) for s in states.states(times)]
-        renderer.render(poses[0])  # tiles built and uploaded before the clock starts
+        depth_m = renderer.render(poses[0]).depth_m  # tiles built and uploaded before the clock starts
         start = time.perf_counter()
         for pose in poses:
             frames.append(renderer.render(pose).radiance.copy())
         seconds = (time.perf_counter() - start) / len(poses)
-    return np.stack(frames), seconds
+    return np.stack(frames), seconds, depth_m
+
+
+def regions(radiance_dn: np.ndarray, depth_m: np.ndarray) -> dict[str, np.ndarray]:
+    """Pixel masks of the reference's first frame: sky and horizon (a sky sample in the
+    pixel), depth edges (depths in its 3 x 3 neighbourhood more than 10 % apart), shadow
+    (under 5 % of the median ground radiance), shadow edges (next to shadow), lit ground."""
+    from scipy.ndimage import maximum_filter, minimum_filter
+
+    ground = depth_m > 0
+    sky = ~ground | (minimum_filter(depth_m, 3) == 0)
+    edge = (maximum_filter(depth_m, 3) > 1.1 * minimum_filter(np.where(ground, depth_m, np.inf), 3)) & ~sky
+    dark = (radiance_dn < 0.05 * np.median(radiance_dn[ground])) & ~sky & ~edge
+    near_dark = maximum_filter(dark, 3) & ~dark & ~sky & ~edge
+    return {"sky and horizon": sky, "depth edges": edge, "shadow": dark, "shadow edges": near_dark,
+            "lit": ~(sky | edge | dark | near_dark)}  # fmt: skip
 
 
 def emulate(frames: np.ndarray, times: np.ndarray, scale: float) -> np.ndarray:
@@ -87,6 +105,7 @@ def main() -> None:
     parser.add_argument("--fps", type=float, default=100.0)
     parser.add_argument("--repeats", type=int, default=2, help="rounds of the timed variants (best kept)")
     parser.add_argument("--variants", nargs="+", help="names of VARIANTS to run (default: all)")
+    parser.add_argument("--regions", action="store_true", help="also each variant's events per kind of pixel")
     args = parser.parse_args()
     variants = [v for v in VARIANTS if not args.variants or v[0] in args.variants]
     print(f"# pixel integration: {args.size}^2, {args.frames} frames at {args.fps:g} fps, clean preset, sensor "
@@ -106,13 +125,13 @@ def main() -> None:
         tf = float(tr.t_nodes[-1])
         for window, t0 in (("mid-flight", tf / 2), ("last second", tf - 1.0)):
             times = t0 + np.arange(args.frames) / args.fps
-            reference, _ = render_window(settings, camera, states, times, "point", args.reference)
+            reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference)
             ref_counts = emulate(reference, times, scale)
             ref_log = log_intensity_8bit(reference * scale)
             results = {}
             for _ in range(args.repeats):  # alternated: every variant once per round
                 for name, texture_filter, samples in variants:
-                    frames, seconds = render_window(settings, camera, states, times, texture_filter, samples)
+                    frames, seconds, _ = render_window(settings, camera, states, times, texture_filter, samples)
                     best = min(seconds, results[name][1]) if name in results else seconds
                     results[name] = (frames, best)
             point_s = results.get(variants[0][0], (None, np.nan))[1]
@@ -125,6 +144,13 @@ def main() -> None:
                       flush=True)  # fmt: skip
             print(f"| {scenario} {window} | reference {args.reference}x{args.reference} | | | {ref_counts.sum()} "
                   "| 1.00x | 0 | 0 |", flush=True)  # fmt: skip
+            if args.regions:  # where each variant's events fall, against the reference's
+                masks = regions(reference[0] * scale, reference_depth)
+                for name, (frames, _) in results.items():
+                    counts = emulate(frames, times, scale)
+                    ratios = {r: counts[m].sum() / max(ref_counts[m].sum(), 1) for r, m in masks.items()}
+                    split = ", ".join(f"{r} ({masks[r].mean():.0%} of pixels) {x:.2f}x" for r, x in ratios.items())
+                    print(f"#   {scenario} {window}, {name}: {split}", flush=True)
 
 
 if __name__ == "__main__":
