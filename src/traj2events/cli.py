@@ -11,12 +11,11 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")  # one process per core is faster 
 import argparse
 import gc
 import sys
-from pathlib import Path
 
 from . import __version__
 from .defaults import section
 from .memory import keep_freed_memory
-from .options import add_settings, settings_from
+from .options import add_settings, inline_or_file, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
 from .settings.events import EVENTS, EVENTS_PICTURE
 from .settings.poses import POSES
@@ -24,9 +23,8 @@ from .settings.poses import POSES
 
 def _settings(kind, value: str):
     """--settings (JSON inline, or @file) as a `kind` settings object."""
-    text = Path(value[1:]).read_text() if value.startswith("@") else value
     try:
-        return kind.from_json(text)
+        return kind.from_json(inline_or_file(value))
     except (ValueError, TypeError, KeyError, AttributeError) as exc:
         raise ValueError(f"--settings: expected the JSON of {kind.__name__} (the workflow writes it): {exc}") from None
 

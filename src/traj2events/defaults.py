@@ -47,12 +47,16 @@ def preset(name: str) -> dict:
     return copy.deepcopy(_preset(name))
 
 
+def preset_pixel(name: str, own: dict | None = None) -> dict:
+    """The pixel model of preset `name` with the keys of `own` (a config's events.pixel) on top."""
+    return {**preset(name)["pixel"], **(own or {})}
+
+
 def with_preset(config: dict) -> dict:
     """`config` with events.pixel = its preset's values, then the config's own events.pixel
     keys. The same config again once applied."""
     events = config["events"]
-    pixel = {**preset(events["preset"])["pixel"], **(events.get("pixel") or {})}
-    return {**config, "events": {**events, "pixel": pixel}}
+    return {**config, "events": {**events, "pixel": preset_pixel(events["preset"], events.get("pixel"))}}
 
 
 def merge_config(base: dict, overlay: dict | None) -> dict:

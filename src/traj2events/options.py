@@ -17,7 +17,7 @@ from pathlib import Path
 import jsonschema
 
 from .config import SCHEMA_PATH, ConfigError, describe, load_yaml
-from .defaults import default_config, preset, preset_names, with_preset
+from .defaults import default_config, preset_names, preset_pixel, with_preset
 from .settings import config_value, pick
 
 _PREFIX = "setting:"  # argparse dest of an option that changes one setting
@@ -94,8 +94,13 @@ def add_settings(
     parser.set_defaults(settings_flags=given_by)
 
 
+def inline_or_file(value: str) -> str:
+    """An option's text, given inline or as @file."""
+    return Path(value[1:]).read_text() if value.startswith("@") else value
+
+
 def _json_object(option: str, value: str) -> dict:
-    text = Path(value[1:]).read_text() if value.startswith("@") else value
+    text = inline_or_file(value)
     try:
         given = json.loads(text)
     except json.JSONDecodeError as exc:
@@ -123,10 +128,10 @@ def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
             else:
                 settings[name] = value
         if "preset" in given and "pixel" in settings:  # as in a config: the preset's values, then pixel's keys
-            settings["pixel"] = {**preset(given["preset"])["pixel"], **given.get("pixel", {})}
+            settings["pixel"] = preset_pixel(given["preset"], given.get("pixel"))
     options = {d[len(_PREFIX) :]: v for d, v in vars(args).items() if d.startswith(_PREFIX) and v is not None}
     if options.get("preset"):
-        settings["pixel"] = preset(options["preset"])["pixel"]
+        settings["pixel"] = preset_pixel(options["preset"])
     for setting, value in options.items():
         *parents, leaf = setting.split(".")
         target = settings
@@ -137,9 +142,7 @@ def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
         error = next(iter(jsonschema.Draft202012Validator(_node(path)).iter_errors(settings[name])), None)
         if error is not None:  # named by the option that gave the value, or --settings
             key = ".".join([path, *map(str, error.absolute_path)])
-            given = [_config_key(keys, setting) for setting in options]
-            option = next((args.settings_flags[g] for g in given if f"{key}.".startswith(f"{g}.")), "--settings")
+            from_options = [_config_key(keys, setting) for setting in options]
+            option = next((args.settings_flags[k] for k in from_options if f"{key}.".startswith(f"{k}.")), "--settings")
             raise ConfigError(f"{option}: {describe(error, path.split('.'))}")
-    if "preset" in settings:
-        preset(settings["preset"])  # a known name
     return settings

@@ -19,7 +19,7 @@ from typing import Generator
 import numpy as np
 
 from .. import __version__
-from ..defaults import preset
+from ..defaults import preset_pixel
 from ..formats.events import MAX_T_US, EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
@@ -178,7 +178,7 @@ def frame_source(
 
 def preset_params(name: str, **changes) -> EmulatorParams:
     """A preset's pixel model (src/traj2events/presets/) with some values changed."""
-    return EmulatorParams(**{**preset(name)["pixel"], **changes})
+    return EmulatorParams(**preset_pixel(name, changes))
 
 
 def emulate(
