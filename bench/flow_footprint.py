@@ -26,7 +26,6 @@ os.environ.setdefault("LP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
-from frame_timing import TilesSeenBy  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
@@ -57,9 +56,9 @@ def main() -> None:
         for fraction in (0.25, 0.5, 0.75):
             k = int(fraction * (len(tr.t) - 1))
             state = tr.state[k]
-            with TerrainRenderer(TilesSeenBy(tiles, camera), camera, sun, reflectance) as r:
+            with TerrainRenderer(tiles, camera, sun, reflectance) as r:
                 centre_depth = r.render(camera.pose(state)).depth_m
-            with TerrainRenderer(TilesSeenBy(tiles, camera), big, sun, reflectance) as r:
+            with TerrainRenderer(tiles, big, sun, reflectance, lod_camera=camera) as r:
                 fine_depth = r.render(big.pose(state)).depth_m
             centre, _ = depth_flow(camera, state, centre_depth.astype(np.float64))
             fine, _ = depth_flow(big, state, fine_depth.astype(np.float64))

@@ -94,19 +94,6 @@ FLIGHT = ("adaptive, log 2", "adaptive, log 1", "adaptive, log 0.5 (ESIM)", "ada
 CLIPS = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "adaptive, log 0.05", "adaptive, 1 px")
 
 
-class TilesSeenBy:
-    """A TileSet whose level of detail is chosen for `camera`, whichever camera draws it."""
-
-    def __init__(self, tiles, camera: Camera):
-        self._tiles, self._camera = tiles, camera
-
-    def select(self, pose, camera: Camera) -> list:
-        return self._tiles.select(pose, self._camera)
-
-    def __getattr__(self, name: str):
-        return getattr(self._tiles, name)
-
-
 class Supersampled:
     """A renderer at `factor` times the camera's size whose frames are block-averaged down:
     radiance as the mean over each pixel's block (area integration), depth as the inverse
@@ -334,7 +321,7 @@ def main() -> None:
             clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
         flight: dict[str, list[dict]] = {}
         with TerrainRenderer(
-            TilesSeenBy(tiles, camera), drawn, sun, reflectance, texture_filter=args.texture_filter
+            tiles, drawn, sun, reflectance, texture_filter=args.texture_filter, lod_camera=camera
         ) as drawing:
             renderer = drawing if args.supersample == 1 else Supersampled(drawing, args.supersample)
             for clip, (t0, t1) in clips.items():

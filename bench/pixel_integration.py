@@ -32,7 +32,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
-from frame_timing import Supersampled, TilesSeenBy  # noqa: E402
+from frame_timing import Supersampled  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
@@ -63,7 +63,7 @@ def render_window(settings, camera, states, times, texture_filter: str, samples:
     _, tiles, sun, reflectance = settings.build()
     drawn = Camera(camera.width * samples, camera.height * samples, camera.fov_deg, camera.mount_height_m)
     frames = []
-    with TerrainRenderer(TilesSeenBy(tiles, camera), drawn, sun, reflectance, texture_filter=texture_filter) as r:
+    with TerrainRenderer(tiles, drawn, sun, reflectance, texture_filter=texture_filter, lod_camera=camera) as r:
         renderer = r if samples == 1 else Supersampled(r, samples)
         poses = [camera.pose(s) for s in states.states(times)]
         depth_m = renderer.render(poses[0]).depth_m  # tiles built and uploaded before the clock starts

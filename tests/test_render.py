@@ -443,19 +443,6 @@ def test_more_tiles_than_the_shading_texture_holds_is_a_clear_error(monkeypatch)
             renderer.render(camera_pose(state(altitude=400.0, pitch=50.0)))
 
 
-class SelectedFor:
-    """Tiles whose level of detail is chosen for `camera`, whichever camera draws them."""
-
-    def __init__(self, tiles, camera):
-        self.tiles, self.camera = tiles, camera
-
-    def select(self, pose, camera):
-        return self.tiles.select(pose, self.camera)
-
-    def __getattr__(self, name):
-        return getattr(self.tiles, name)
-
-
 def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """(rendered, analytic) lit fraction of a nadir camera's middle row over a straight
     shadow edge at x = x_edge_m on flat ground: a 10 m cliff beyond the view casts it, the
@@ -472,8 +459,8 @@ def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1
     lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter)
     images = []
     for terrain in (cliff, flat):
-        tiles = SelectedFor(TileSet(terrain, sun.direction, 1e12, 2e3, lod), camera)
-        with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend="osmesa") as renderer:
+        tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod)
+        with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend="osmesa", lod_camera=camera) as renderer:
             frame = renderer.render(pose)
         images.append(frame.radiance.reshape(64, samples, 64, samples).mean(axis=(1, 3)))
     row = camera.height // 2

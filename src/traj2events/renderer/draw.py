@@ -109,7 +109,7 @@ class _GLScene:
             gl.glVertexAttribPointer(1, 2, gl.GL_FLOAT, gl.GL_FALSE, 8, None)
             self.shading_side, self.shading_texture = shading_side, 0
             self.texture_filter = texture_filter
-            self.level_sides = footprint.level_sides(shading_side) if texture_filter != "point" else [shading_side]
+            self.level_sides = footprint.sampled_levels(texture_filter, shading_side)
             layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
             layer_bytes = sum(8 * n**2 for n in self.level_sides)  # RGBA16F texels, every level
             self.slot_limit = max(1, min(layers, _SHADING_BYTES // layer_bytes))
@@ -384,25 +384,25 @@ class TerrainRenderer:
         stars: StarField | None = None,
         backend: str = "auto",
         texture_filter: str | None = None,
+        lod_camera: Camera | None = None,
     ):
         """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black
         sky. `backend`: auto | egl | osmesa (resolve_backend). `texture_filter`: how a
-        pixel samples the shading texture (footprint.TEXTURE_FILTERS; None: the tiles' lod's)."""
+        pixel samples the shading texture (footprint.TEXTURE_FILTERS; None: the tiles' lod's).
+        `lod_camera`: whose pixels set the level of detail (None: `camera`; a larger `camera`
+        then draws the same tiles with more samples per pixel)."""
         texture_filter = tiles.lod.texture_filter if texture_filter is None else texture_filter
-        if texture_filter not in footprint.TEXTURE_FILTERS:
-            raise ValueError(f"texture_filter: expected one of {footprint.TEXTURE_FILTERS}, got {texture_filter!r}")
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
-        self.stars = stars
+        self.stars, self.lod_camera = stars, lod_camera or camera
         self.backend = resolve_backend(backend)
         self._platform = gl_context(self.backend, camera.width, camera.height)
         from OpenGL import GL as gl
 
         self.gl_renderer = gl.glGetString(gl.GL_RENDERER).decode()
-        n_vertices = len(tiles.tile((0, 0, 0)).vertices)  # the same for every tile
+        root = tiles.tile((0, 0, 0))  # every tile has its number of vertices and its faces
         self.shading_levels = tiles.lod.shading_levels
         uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
-        faces = tiles.tile((0, 0, 0)).faces
-        self._gl = _GLScene(camera.width, camera.height, faces, n_vertices, uv, side, texture_filter)
+        self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter)
         self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
         self._uniforms = {
             "sun_dir": sun.direction,
@@ -456,7 +456,7 @@ class TerrainRenderer:
 
     def _start(self, pose: CameraPose) -> tuple:
         """Selects, uploads and draws `pose`'s tiles; the read-back runs on (`_finish`)."""
-        keys = self.tiles.select(pose, self.camera)
+        keys = self.tiles.select(pose, self.lod_camera)
         self._frame_count += 1
         self._platform.make_current()
         slots = [self._slot(key) for key in keys]

@@ -47,6 +47,13 @@ def level_sides(side: int) -> list[int]:
     return sides
 
 
+def sampled_levels(texture_filter: str, side: int) -> list[int]:
+    """The sides of the levels a pixel samples with `texture_filter`: level 0 alone for `point`."""
+    if texture_filter not in TEXTURE_FILTERS:
+        raise ValueError(f"texture_filter: expected one of {TEXTURE_FILTERS}, got {texture_filter!r}")
+    return [side] if texture_filter == "point" else level_sides(side)
+
+
 def area_weights(n_from: int, n_to: int) -> np.ndarray:
     """(n_to, n_from): row i holds how much of target texel i's interval [i, i+1) / n_to
     each source texel's [j, j+1) / n_from covers, normalised to sum to 1."""
