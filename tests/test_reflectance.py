@@ -5,7 +5,9 @@ import pytest
 
 from traj2events.scene.reflectance import (
     ReflectanceParams,
+    bihemispherical_albedo,
     chandrasekhar_h,
+    hemispherical_albedo,
     hapke_radiance_factor,
     lunar_lambert_radiance_factor,
 )
@@ -66,3 +68,22 @@ def test_hapke_phase_function_is_normalised(b, c):
     # (1/4 pi) integral of P over the sphere = (1/2) integral of P(g) sin g dg over [0, pi] = 1.
     g = np.linspace(0.0, np.pi, 200_001)
     assert np.trapezoid(hapke_phase(b, c, np.cos(g)) * np.sin(g), g) / 2 == pytest.approx(1.0, rel=1e-6)
+
+
+def test_hemispherical_albedo_of_lambert_and_lommel_seeliger_laws():
+    # Lambert, I/F = A mu0: A at every incidence. Lommel-Seeliger, I/F = mu0 / (mu0 + mu):
+    # 2 (1 - mu0 ln((1 + mu0) / mu0)) (the integral of mu / (mu0 + mu) over the hemisphere).
+    mu0 = np.array([0.05, 0.3, 0.7, 1.0])
+    assert hemispherical_albedo(lambda a, b, c: 0.3 * a + 0 * b, mu0) == pytest.approx(0.3, rel=1e-10)
+    expected = 2 * (1 - mu0 * np.log((1 + mu0) / mu0))
+    assert hemispherical_albedo(lambda a, b, c: a / (a + b), mu0) == pytest.approx(expected, rel=1e-6)
+
+
+def test_bihemispherical_albedo_is_the_lunar_order_and_grows_with_w():
+    # The Moon's bolometric Bond albedo is ~0.11-0.12; the default Hapke w = 0.21 is a
+    # darker surface. Energy: below 1, and more scattering gives more albedo.
+    hapke = [bihemispherical_albedo(ReflectanceParams(single_scattering_albedo=w)) for w in (0.1, 0.21, 0.5, 0.9)]
+    assert np.all(np.diff(hapke) > 0) and 0 < hapke[0] and hapke[-1] < 1
+    assert 0.04 < hapke[1] < 0.12
+    lambert = bihemispherical_albedo(ReflectanceParams(model="lunar-lambert", albedo=0.12))
+    assert 0.10 < lambert < 0.2

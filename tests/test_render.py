@@ -12,7 +12,7 @@ from traj2events.geometry.camera import Camera, CameraPose, camera_pose
 from traj2events.renderer import draw as render_module
 from traj2events.renderer.context import check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
 from traj2events.renderer.draw import TerrainRenderer
-from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.scene.reflectance import ReflectanceParams, angles, bihemispherical_albedo, radiance_factor
 from traj2events.scene.sun import Sun
 from traj2events.scene.terrain import (
     GridTerrain,
@@ -40,9 +40,17 @@ def state(x=0.0, y=0.0, altitude=1000.0, roll=0.0, pitch=0.0, yaw=0.0):
 
 
 def render(
-    terrain, camera, pose, radius=R_MOON, half_extent=140e3, sun=SUN, reflectance=ReflectanceParams(), lod=LodSettings()
+    terrain,
+    camera,
+    pose,
+    radius=R_MOON,
+    half_extent=140e3,
+    sun=SUN,
+    reflectance=ReflectanceParams(),
+    lod=LodSettings(),
+    scattered_azimuths=16,
 ):
-    tiles = TileSet(terrain, sun.direction, radius, half_extent, lod)
+    tiles = TileSet(terrain, sun.direction, radius, half_extent, lod, scattered_azimuths=scattered_azimuths)
     with TerrainRenderer(tiles, camera, sun, reflectance, backend="osmesa") as renderer:
         return renderer.render(pose), tiles
 
@@ -301,14 +309,14 @@ def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
     assert np.array_equal(again.radiance, first.radiance)
 
 
-@pytest.mark.parametrize(
-    "lod",
-    [
-        LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0, shading_levels=0),
-        LodSettings(min_spacing_m=0.25, pixels_per_cell=4.0, shading_levels=2),
-    ],
-    ids=["vertex", "pixel"],
-)
+# Shaded per vertex and per pixel, fine enough for a 100 m bowl seen from 200 m.
+BOWL_SHADINGS = [
+    LodSettings(min_spacing_m=0.25, pixels_per_cell=1.0, shading_levels=0),
+    LodSettings(min_spacing_m=0.25, pixels_per_cell=4.0, shading_levels=2),
+]
+
+
+@pytest.mark.parametrize("lod", BOWL_SHADINGS, ids=["vertex", "pixel"])
 def test_rendered_crater_shadow_has_the_analytic_length(lod):
     # Parabolic bowl (radius 50 m, depth 20 m), Sun from +x at 10 deg: the rim's shadow
     # covers the floor from the rim at x = +50 m for 2R - R^2 tan(e) / d = 78 m.
@@ -332,11 +340,44 @@ def test_rendered_crater_shadow_has_the_analytic_length(lod):
     row = 128  # through the centre (y ~ 0)
     x_s, _ = camera.pixel_coordinates()
     ground_x = x_s[0] * frame.depth_m[row] / camera.focal_px  # camera X = inertial x at zero attitude
-    dark = (frame.radiance[row] < 1e-6) & (np.abs(ground_x) < radius)
+    plain = np.median(frame.radiance[row][np.abs(ground_x) > radius + 5])
+    # In the shadow only light the crater's lit wall scatters: ~1 % of the plain's.
+    dark = (frame.radiance[row] < 0.05 * plain) & (np.abs(ground_x) < radius)
     length = ground_x[dark].max() - ground_x[dark].min()
     expected = 2 * radius - radius**2 * np.tan(np.radians(elevation)) / depth
     assert length == pytest.approx(expected, abs=2.0)  # a few cells and pixels
     assert ground_x[dark].max() == pytest.approx(radius, abs=2.0)  # it starts at the Sun-side rim
+
+
+@pytest.mark.parametrize("lod", BOWL_SHADINGS, ids=["vertex", "pixel"])
+def test_a_spherical_bowls_shadow_is_lit_by_its_wall_as_radiosity_says(lod):
+    # Inside a sphere every point receives A E sin(e) a^2 / (4 R_s^2) from the lit part of
+    # the cavity (scattering.py); a shadowed point returns A of it, Lambertian: radiance
+    # A^2 E sin(e) a^2 / (4 pi R_s^2). Without scattered light the shadow is black.
+    spacing, a, depth, elevation = 0.5, 50.0, 20.0, 20.0
+    sphere = (a * a + depth * depth) / (2 * depth)
+    x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
+    xx, yy = np.meshgrid(x, x, indexing="ij")
+    rho2 = xx**2 + yy**2
+    h = np.where(rho2 < a * a, sphere - np.sqrt(np.maximum(sphere**2 - rho2, 0.0)) - depth, 0.0)
+    bowl = GridTerrain(h, spacing, (x[0], x[0]))
+    sun, camera = Sun(1.496e11, 0.0, elevation), Camera(128, 128, 45.0)
+    pose = camera_pose(state(altitude=200.0))  # nadir: columns along +x, rows along +y
+    reflectance = ReflectanceParams()
+    frames = {
+        k: render(bowl, camera, pose, radius=1e12, half_extent=2e3, sun=sun, lod=lod, scattered_azimuths=k)[0]
+        for k in (0, 16)
+    }
+    x_s, y_s = camera.pixel_coordinates()
+    ground_x = x_s * frames[16].depth_m / camera.focal_px
+    ground_y = y_s * frames[16].depth_m / camera.focal_px
+    # The shadow falls on the floor's Sun side (x > 0): well inside it, away from its edge.
+    shadow = (np.hypot(ground_x - 25.0, ground_y) < 8.0) & (frames[0].radiance == 0)
+    assert shadow.sum() > 50
+    albedo = bihemispherical_albedo(reflectance)
+    expected = albedo**2 * sun.irradiance_w_m2 * np.sin(np.radians(elevation)) * a**2 / (4 * np.pi * sphere**2)
+    assert np.median(frames[16].radiance[shadow]) == pytest.approx(expected, rel=0.12)
+    assert np.max(frames[0].radiance[shadow]) == 0.0
 
 
 def test_rendered_regolith_backscatters():
@@ -399,7 +440,7 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
 @pytest.mark.parametrize("w, r0", [(0.36, 1.0 / 9.0), (0.75, 1.0 / 3.0), (0.0, 0.0), (1.0, 1.0)])
 def test_hapke_r0_for_the_shaders_is_the_published_formula(w, r0):
     """r0 = (1 - g) / (1 + g), g = sqrt(1 - w): g = 0.8 and 0.5 by hand, and the limits."""
-    from traj2events.renderer.draw import hapke_r0_float32
+    from traj2events.renderer.law_uniforms import hapke_r0_float32
 
     assert hapke_r0_float32(w) == pytest.approx(r0, rel=1e-6, abs=1e-7)
 

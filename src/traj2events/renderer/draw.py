@@ -29,12 +29,13 @@ from importlib import resources
 import numpy as np
 
 from ..geometry.camera import Camera, CameraPose, opengl_camera_to_world
-from ..scene.reflectance import ReflectanceParams, max_radiance_factor
+from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField, add_stars
 from ..scene.sun import Sun
 from ..scene.tiles import TileKey, TileSet, border_ring, depth_range
 from . import footprint
 from .context import gl_context, resolve_backend
+from .law_uniforms import law_uniforms
 
 _INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
 _SHADING_BYTES = 512 * 2**20  # cap on the shading texture array (bounds the slots kept)
@@ -115,8 +116,9 @@ class _GLScene:
             self.slot_limit = max(1, min(layers, _SHADING_BYTES // layer_bytes))
         else:
             self.slot_limit = 2**31 // (vertices_per_tile * 16)  # OpenGL's buffer offsets
-        # Per-vertex data: (position - tile origin, lit) and, shaded per vertex, (normal, 0),
-        # one texel each (shaded per pixel, the normals come from the shading texture).
+        # Per-vertex data: (position - tile origin, lit) and, shaded per vertex, (normal,
+        # scattered light), one texel each (shaded per pixel, the normals and lit fractions
+        # come from the shading texture and the first array's w is the scattered light).
         self.capacity = 0
         n_arrays = 1 if self.textured else 2
         self.vertex_buffers = [gl.glGenBuffers(1) for _ in range(n_arrays)]
@@ -361,15 +363,6 @@ def shading_coordinates(cells: int, levels: int) -> tuple[np.ndarray, int]:
     return uv.astype(np.float32), side
 
 
-def hapke_r0_float32(w: float) -> float:
-    """Hapke's r0 = (1 - sqrt(1 - w)) / (1 + sqrt(1 - w)) in float32, operation by operation
-    as GLSL computes it: the shaders' `hapke_r0` uniform, with the bits they would get
-    computing it themselves at every pixel (once per frame instead: 2-4 % of a braking
-    frame on llvmpipe)."""
-    gamma = np.sqrt(np.float32(1.0) - np.float32(w))
-    return float((np.float32(1.0) - gamma) / (np.float32(1.0) + gamma))
-
-
 class TerrainRenderer:
     """Renders a TileSet from camera poses. One OpenGL context; tiles are uploaded once
     and kept while they are in use (at most `max_cached_tiles` beyond one frame's)."""
@@ -404,19 +397,7 @@ class TerrainRenderer:
         uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
         self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter)
         self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
-        self._uniforms = {
-            "sun_dir": sun.direction,
-            "irradiance": float(sun.irradiance_w_m2),
-            "model": 0 if reflectance.model == "hapke" else 1,
-            "w": float(reflectance.single_scattering_albedo),
-            "hapke_r0": hapke_r0_float32(reflectance.single_scattering_albedo),
-            "b": float(reflectance.phase_b),
-            "c": float(reflectance.phase_c),
-            "b0": float(reflectance.opposition_b0),
-            "hw": float(reflectance.opposition_h),
-            "albedo": float(reflectance.albedo),
-            "radiance_max": float(max_radiance_factor(reflectance) * sun.irradiance_w_m2 / np.pi),
-        }
+        self._uniforms = law_uniforms(reflectance, sun)
         self._slots: dict[TileKey, int] = {}
         self._free: list[int] = []
         self._last_used: dict[TileKey, int] = {}
@@ -429,11 +410,12 @@ class TerrainRenderer:
             position_lit = np.empty((len(t.vertices), 4), np.float32)
             position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
             normal = shading = None
-            if self.shading_levels:
+            if self.shading_levels:  # lit comes from the texture: the slot carries the scattered light
                 shading = footprint.sunlit(self.tiles.shading_texture(key, self.shading_levels), self.sun.direction)
+                position_lit[:, 3] = self.tiles.scattered(key)
             else:
-                normal = np.zeros((len(t.vertices), 4), np.float32)
-                normal[:, :3] = t.normals
+                normal = np.empty((len(t.vertices), 4), np.float32)
+                normal[:, :3], normal[:, 3] = t.normals, self.tiles.scattered(key)
             self._gl.upload(slot, position_lit, normal, shading)
             self._slots[key] = slot
         return self._slots[key]

@@ -120,3 +120,26 @@ def max_radiance_factor(p: ReflectanceParams, n: int = 61) -> float:
     i, e, a = np.meshgrid(angle, angle, azimuth, indexing="ij")
     cos_g = np.cos(i) * np.cos(e) + np.sin(i) * np.sin(e) * np.cos(a)
     return 1.05 * float(np.max(radiance_factor(np.cos(i), np.cos(e), cos_g, p)))
+
+
+def hemispherical_albedo(law, mu0: np.ndarray, n: int = 48) -> np.ndarray:
+    """Directional-hemispherical albedo A(mu0) = (1 / (pi mu0)) integral of I/F mu dOmega
+    over the emission hemisphere: the share of the light arriving at incidence mu0 that
+    leaves the surface; `law(mu0, mu, cos_g)` gives I/F (Gauss-Legendre in mu and azimuth).
+    Lambert's I/F = A mu0 gives A."""
+    nodes, weights = np.polynomial.legendre.leggauss(n)
+    mu, w_mu = 0.5 * (nodes + 1), 0.5 * weights  # on (0, 1)
+    phi, w_phi = np.pi * (nodes + 1), np.pi * weights  # on (0, 2 pi)
+    mu0 = np.asarray(mu0, float)[..., None, None]
+    cos_g = mu0 * mu[:, None] + np.sqrt(1 - mu0**2) * np.sqrt(1 - mu[:, None] ** 2) * np.cos(phi)[None, :]
+    integrand = law(mu0, mu[:, None], cos_g) * mu[:, None] * w_mu[:, None] * w_phi[None, :]
+    return integrand.sum(axis=(-2, -1)) / (np.pi * mu0[..., 0, 0])
+
+
+def bihemispherical_albedo(p: ReflectanceParams, n: int = 48) -> float:
+    """A = 2 integral of A(mu0) mu0 dmu0 (the surface's albedo under light from every
+    direction): the albedo of the one-bounce scattering into shadows (scattering.py)."""
+    nodes, weights = np.polynomial.legendre.leggauss(n)
+    mu0 = 0.5 * (nodes + 1)
+    albedo = hemispherical_albedo(lambda a, b, c: radiance_factor(a, b, c, p), mu0, n)
+    return float(np.sum(2 * albedo * mu0 * 0.5 * weights))

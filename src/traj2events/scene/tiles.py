@@ -18,6 +18,9 @@ Building a tile is mostly evaluating the terrain's heights on its grid: with a t
 TileSet with the same terrain, quadtree and Sun side, in this process or another. A drawn
 tile's shading texture (its area evaluated `levels` levels finer) is stored there too, whole.
 
+Light scattered into shadows (scattering.py): per tile vertex, a horizon march over the
+tile's grid and its ancestors' (coarser, wider) grids of heights and sunlit fractions.
+
 Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
 grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights
 beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
@@ -37,6 +40,7 @@ from ..defaults import section
 from ..formats.tile_cache import TileCache
 from ..geometry.camera import Camera, CameraPose
 from .illumination import ShadowField, no_obstruction, shadow_field
+from .scattering import height_normals, scattered_sunlight
 from .terrain import Terrain, surface_points
 
 TileKey = tuple[int, int, int]  # (level, i, j); i along x, j along y, 0..2^level - 1
@@ -54,9 +58,13 @@ class Tile:
     faces: np.ndarray  # (m, 3) int
     shadow: ShadowField = field(repr=False)
     heights_m: np.ndarray = field(repr=False)  # (cells + 1, cells + 1), the tile's own grid
+    sunlit: np.ndarray = field(repr=False)  # (cells + 1, cells + 1): lit fraction times mu0 on that grid
+    scattered: np.ndarray | None = field(default=None, repr=False)  # (n,) S of scattering.py: TileSet.scattered
 
 
 _LOD = section("render")["lod"]
+_SCATTERED_AZIMUTHS = section("render")["scattered_light"]["azimuths"]
+_SCATTERED_STRIDE = 2  # grid points per marched one (bench/scattered_light.py)
 
 
 @dataclass(frozen=True)
@@ -85,14 +93,18 @@ class TileSet:
         half_extent_m: float,
         lod: LodSettings = LodSettings(),
         cache_dir: str | None = None,
+        scattered_azimuths: int = _SCATTERED_AZIMUTHS,
     ):
         """`cache_dir`: a folder for the tile cache (heights shared with other TileSets
-        and jobs; formats/tile_cache.py), or None: every tile's terrain is evaluated here."""
+        and jobs; formats/tile_cache.py), or None: every tile's terrain is evaluated here.
+        `scattered_azimuths`: directions of the march for light scattered into shadows
+        (render.scattered_light.azimuths; 0: none, shadows are black)."""
         self.terrain = terrain
         self.sun_dir = np.asarray(sun_dir, float)
         self.radius_m = radius_m
         self.half_extent_m = half_extent_m
         self.lod = lod
+        self.scattered_azimuths = scattered_azimuths
         self._cache: dict[TileKey, Tile] = {}
         self.faces = _grid_faces(lod.cells + 1)
         self.cache_dir = cache_dir
@@ -223,12 +235,73 @@ class TileSet:
         verts = points[core].reshape(-1, 3)
         norms = normals[inner].reshape(-1, 3)
         lit = shadow.lit[core].reshape(-1)
+        sunlit = (lit * np.maximum(norms @ self.sun_dir, 0.0)).reshape(n + 1, n + 1)
         verts, norms, lit, faces = _add_skirts(
             verts, norms, lit, self.faces, n + 1, self.lod.skirt_cells * spacing, self.radius_m
         )
         centre = verts[: (n + 1) ** 2].mean(axis=0)
         radius = float(np.max(np.linalg.norm(verts - centre, axis=1)))
-        return Tile(key, spacing, centre, radius, verts - centre, norms, lit, faces, shadow, h[core])
+        return Tile(key, spacing, centre, radius, verts - centre, norms, lit, faces, shadow, h[core], sunlit)
+
+    def scattered(self, key: TileKey) -> np.ndarray:
+        """S (scattering.py) at the tile's vertices (its skirts take their grid vertex's),
+        zeros without scattered light. Marched over the tile's own grid, then over the 3 x 3
+        tiles around each ancestor (a tile at its parent's edge sees past it), from every
+        `_SCATTERED_STRIDE`-th grid point, linear between: the scattered light varies over
+        the size of what casts it, and finer tiles take over as it grows on screen."""
+        tile = self.tile(key)
+        n = self.lod.cells + 1
+        if tile.scattered is not None:
+            return tile.scattered
+        if not self.scattered_azimuths:
+            tile.scattered = np.zeros(len(tile.vertices))
+            return tile.scattered
+        with self._timed():
+            level, i, j = key
+            grids = [(tile.heights_m, tile.sunlit, self._origin(key))]
+            grids += [self._neighbourhood((level - up, i >> up, j >> up)) for up in range(1, level + 1)]
+            size = max(len(g[0]) for g in grids), max(g[0].shape[1] for g in grids)
+            heights, sunlit = np.zeros((2, len(grids)) + size)
+            for k, (h, lit, _) in enumerate(grids):
+                heights[k, : h.shape[0], : h.shape[1]], sunlit[k, : h.shape[0], : h.shape[1]] = h, lit
+            every = slice(None, None, _SCATTERED_STRIDE)
+            at = np.arange(n)[every] * tile.spacing_m
+            origin = self._origin(key)
+            a, b = np.meshgrid(at + origin[0], at + origin[1], indexing="ij")
+            s = scattered_sunlight(
+                heights,
+                sunlit,
+                np.array([g[2] for g in grids]),
+                np.array([self.tile_spacing_m(level - up) for up in range(level + 1)]),
+                np.stack([a, b, tile.heights_m[every, every]], axis=-1).reshape(-1, 3),
+                self._local_normals(tile)[every, every].reshape(-1, 3),
+                self.radius_m,
+                self.scattered_azimuths,
+                sizes=np.array([g[0].shape for g in grids]),
+            )
+            s = _resample_linear(s.reshape(len(at), len(at), 1), n).reshape(-1)
+            tile.scattered = np.concatenate([s, s[border_ring(n)]])
+        return tile.scattered
+
+    def _neighbourhood(self, key: TileKey) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
+        """(heights, lit mu0, origin) on one grid over the tile `key` and the tiles around it
+        at its level (those inside the quadtree)."""
+        level, i, j = key
+        last, n = 2**level - 1, self.lod.cells
+        rows, cols = range(max(i - 1, 0), min(i + 1, last) + 1), range(max(j - 1, 0), min(j + 1, last) + 1)
+        heights = np.empty((len(rows) * n + 1, len(cols) * n + 1))
+        sunlit = np.empty_like(heights)
+        for a, row in enumerate(rows):
+            for b, col in enumerate(cols):
+                t = self.tile((level, row, col))
+                heights[a * n : a * n + n + 1, b * n : b * n + n + 1] = t.heights_m
+                sunlit[a * n : a * n + n + 1, b * n : b * n + n + 1] = t.sunlit
+        return heights, sunlit, self._origin((level, rows[0], cols[0]))
+
+    def _local_normals(self, tile: Tile) -> np.ndarray:
+        """(cells + 1, cells + 1, 3) unit normals (x, y, up) of the tile's heights."""
+        h = np.pad(tile.heights_m, 1, mode="reflect", reflect_type="odd")  # continues the edge slopes
+        return height_normals(h, tile.spacing_m)
 
     def shading_texture(self, key: TileKey, levels: int) -> np.ndarray:
         """(side, side, 4) float16 (the renderer's texel format), side = cells 2^levels + 1:

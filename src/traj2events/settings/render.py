@@ -57,6 +57,7 @@ def render_settings(config: dict, name: str) -> dict:
         "sun": dict(sc["sun"]),
         "reflectance": dict(r["reflectance"]),
         "lod": dict(r["lod"]),
+        "scattered_light": dict(r["scattered_light"]),
         "half_extent_m": float(reach + horizon),
         "display_white_w_m2_sr": float(r["display_white_w_m2_sr"]),
         "display_gamma": float(r["display_gamma"]),

@@ -50,6 +50,7 @@ class RenderSettings:
     sun: dict
     reflectance: dict
     lod: dict
+    scattered_light: dict
     half_extent_m: float
     display_white_w_m2_sr: float
     display_gamma: float
@@ -84,7 +85,8 @@ class RenderSettings:
         terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
         sun = Sun(**self.sun)
         lod = LodSettings(**self.lod)
-        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache)
+        azimuths = int(self.scattered_light["azimuths"])
+        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache, azimuths)
         return (
             Camera(self.width, self.height, self.fov_deg, self.mount_height_m),
             tiles,
@@ -113,6 +115,7 @@ class RenderSettings:
             "reflectance": self.reflectance,
             "terrain": self.terrain,
             "lod": self.lod,
+            "scattered_light": self.scattered_light,
             "terrain_half_extent_m": self.half_extent_m,
             "display_white_w_m2_sr": self.display_white_w_m2_sr,
             "display_gamma": self.display_gamma,
@@ -244,6 +247,7 @@ FRAME_ATTR_ORDER = (
     "reflectance",
     "terrain",
     "lod",
+    "scattered_light",
     "terrain_half_extent_m",
     "display_white_w_m2_sr",
     "display_gamma",

@@ -10,6 +10,7 @@ uniform float c;
 uniform float b0;
 uniform float hw;            // opposition width h
 uniform float albedo;        // Lunar-Lambert
+uniform float bounce_albedo; // the law's bihemispherical albedo (reflectance.bihemispherical_albedo)
 
 const float PI = 3.14159265358979;
 
@@ -75,4 +76,12 @@ float reflectance_factor_of_phase(vec3 n, vec3 to_camera, float phase)
 float reflectance_factor(vec3 n, vec3 to_camera)
 {
     return reflectance_factor_of_phase(n, to_camera, phase_term(dot(sun_dir, to_camera)));
+}
+
+// Reflectance factor of the sunlight the terrain scattered onto a point (scattering.py: S
+// per unit of the Sun's irradiance and of the albedo): A S E_sun arrives, a Lambertian
+// surface of albedo A returns A of it.
+float scattered_factor(float scattered)
+{
+    return bounce_albedo * bounce_albedo * scattered;
 }

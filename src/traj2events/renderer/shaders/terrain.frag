@@ -1,8 +1,10 @@
 #version 330 core
-// traj2events terrain, fragment stage: radiance (W m^-2 sr^-1) times the lit fraction,
-// and depth along the boresight (m), into a two-channel float32 buffer.
+// traj2events terrain, fragment stage: radiance (W m^-2 sr^-1) times the lit fraction plus
+// the light scattered into shadows, and depth along the boresight (m), into a two-channel
+// float32 buffer.
 in float frag_radiance;
 in float frag_lit;
+in float frag_scattered;  // light scattered into shadows by the terrain (W m^-2 sr^-1)
 
 uniform float radiance_max;  // the law's maximum for this Sun (W m^-2 sr^-1)
 
@@ -12,7 +14,7 @@ void main()
 {
     // Interpolation at a pixel centre a hair outside a sliver triangle extrapolates; keep
     // the result within what the law can give (vertex values are in [0, radiance_max]).
-    float radiance = clamp(frag_radiance * frag_lit, 0.0, radiance_max);
+    float radiance = clamp(frag_radiance * frag_lit + frag_scattered, 0.0, radiance_max);
     // Depth along the boresight is clip w (P's last row is (0, 0, -1, 0)); gl_FragCoord.w
     // holds its perspective-correct 1/w, so no per-vertex position has to be interpolated.
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);

@@ -1,11 +1,13 @@
 #version 330 core
 // traj2events terrain shaded per pixel, fragment stage: the reflectance law at every pixel
 // from the shading texture's normal and lit fraction times mu0, sampled over the pixel's
-// footprint (render.lod.texture_filter); depth along the boresight (m) as in terrain.frag.
+// footprint (render.lod.texture_filter), plus the light the terrain scattered there;
+// depth along the boresight (m) as in terrain.frag.
 in vec2 frag_uv;
 flat in float frag_layer;
 in vec3 frag_to_camera_m;
 in float frag_phase;
+in float frag_scattered;
 
 uniform sampler2DArray shading;  // per slot: normal xyz, lit fraction times mu0 (0..1)
 uniform float radiance_max;      // the law's maximum for this Sun (W m^-2 sr^-1)
@@ -19,6 +21,7 @@ void main()
     // Over the pixel's footprint: the mean normal, and the mean of lit * mu0 (footprint.py).
     vec4 texel = texture(shading, vec3(frag_uv, frag_layer));
     float per_mu0 = reflectance_per_mu0(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);
-    float radiance = clamp(per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI, 0.0, radiance_max);
+    float direct = per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI;
+    float radiance = clamp(direct + frag_scattered, 0.0, radiance_max);
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
 }

@@ -1,0 +1,38 @@
+"""The reflectance laws' parameters as the shaders take them (shaders/reflectance.glsl)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..scene.reflectance import ReflectanceParams, bihemispherical_albedo, max_radiance_factor
+from ..scene.sun import Sun
+
+
+def hapke_r0_float32(w: float) -> float:
+    """Hapke's r0 = (1 - sqrt(1 - w)) / (1 + sqrt(1 - w)) in float32, operation by operation
+    as GLSL computes it: the shaders' `hapke_r0` uniform, with the bits they would get
+    computing it themselves at every pixel (once per frame instead: 2-4 % of a braking
+    frame on llvmpipe)."""
+    gamma = np.sqrt(np.float32(1.0) - np.float32(w))
+    return float((np.float32(1.0) - gamma) / (np.float32(1.0) + gamma))
+
+
+def law_uniforms(reflectance: ReflectanceParams, sun: Sun) -> dict:
+    """The uniforms of reflectance.glsl, and `radiance_max`: the law's largest direct light
+    plus the most scattered light there can be (scattering.py: S <= 1), W m^-2 sr^-1."""
+    bounce_albedo = bihemispherical_albedo(reflectance)
+    most = max_radiance_factor(reflectance) + bounce_albedo**2
+    return {
+        "sun_dir": sun.direction,
+        "irradiance": float(sun.irradiance_w_m2),
+        "model": 0 if reflectance.model == "hapke" else 1,
+        "w": float(reflectance.single_scattering_albedo),
+        "hapke_r0": hapke_r0_float32(reflectance.single_scattering_albedo),
+        "b": float(reflectance.phase_b),
+        "c": float(reflectance.phase_c),
+        "b0": float(reflectance.opposition_b0),
+        "hw": float(reflectance.opposition_h),
+        "albedo": float(reflectance.albedo),
+        "bounce_albedo": bounce_albedo,
+        "radiance_max": float(most * sun.irradiance_w_m2 / np.pi),
+    }
