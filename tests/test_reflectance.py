@@ -7,8 +7,8 @@ from traj2events.scene.reflectance import (
     ReflectanceParams,
     bihemispherical_albedo,
     chandrasekhar_h,
-    hemispherical_albedo,
     hapke_radiance_factor,
+    hemispherical_albedo,
     lunar_lambert_radiance_factor,
 )
 
