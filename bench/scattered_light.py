@@ -9,7 +9,8 @@
    mean and largest relative error), a long lit wall's against its view factor.
 2. For each trajectory given, windows of --frames frames at --fps (mid-flight from t_f / 2,
    the last second), rendered at --size^2 with the default settings, scattered light off
-   (azimuths 0: black shadows) and on (the default), alternated --repeats times: seconds
+   (azimuths 0: black shadows), on (the default), and on with earthshine from an Earth 60 deg
+   up opposite the Sun's azimuth, alternated --repeats times: seconds
    building the window's tiles from scratch (no tile cache) and drawing a frame (the best
    round), the shadow pixels' median radiance (pixels black without scattered light)
    against the lit pixels' median, and the events of the window through the sensor model
@@ -88,7 +89,7 @@ def analytic_table() -> None:
 def render_window(settings: RenderSettings, states, times):
     """(frames (n, h, w) radiance, seconds building the tiles, seconds per frame drawn)."""
     camera, tiles, sun, reflectance = settings.build()
-    with TerrainRenderer(tiles, camera, sun, reflectance) as renderer:
+    with TerrainRenderer(tiles, camera, sun, reflectance, earth=settings.earth_light()) as renderer:
         poses = [camera.pose(s) for s in states.states(times)]
         for pose in poses:  # every tile of the window built (timed apart) and uploaded
             renderer.render(pose)
@@ -114,7 +115,12 @@ def windows_table(paths: list[Path], size: int, n_frames: int, fps: float, repea
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
         base = RenderSettings.from_config(config, scenario)
-        variants = {"off": dataclasses.replace(base, scattered_light={"azimuths": 0}), "on (16 azimuths)": base}
+        earth = {"azimuth_deg": base.sun["azimuth_deg"] + 180.0, "elevation_deg": 60.0}
+        variants = {
+            "off": dataclasses.replace(base, scattered_light={"azimuths": 0}),
+            "on (16 azimuths)": base,
+            "on, and earthshine": dataclasses.replace(base, earth=earth),
+        }
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
         for window, t0 in (("mid-flight", tf / 2), ("last second", tf - 1.0)):

@@ -12,6 +12,7 @@ from traj2events.geometry.camera import Camera, CameraPose, camera_pose
 from traj2events.renderer import draw as render_module
 from traj2events.renderer.context import check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
 from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.earthshine import Earth
 from traj2events.scene.reflectance import ReflectanceParams, angles, bihemispherical_albedo, radiance_factor
 from traj2events.scene.sun import Sun
 from traj2events.scene.terrain import (
@@ -378,6 +379,29 @@ def test_a_spherical_bowls_shadow_is_lit_by_its_wall_as_radiosity_says(lod):
     expected = albedo**2 * sun.irradiance_w_m2 * np.sin(np.radians(elevation)) * a**2 / (4 * np.pi * sphere**2)
     assert np.median(frames[16].radiance[shadow]) == pytest.approx(expected, rel=0.12)
     assert np.max(frames[0].radiance[shadow]) == 0.0
+
+
+@pytest.mark.parametrize("shading_levels", [0, 1], ids=["vertex", "pixel"])
+def test_earthshine_on_a_flat_plane_is_the_lambert_sphere_value(shading_levels):
+    # Sun at 10 deg from +x, Earth at 40 deg from -x: phase angle alpha with
+    # cos(alpha) = cos(10) cos(40) - sin(10) sin(40) (alpha = 50 deg). Earthshine on a
+    # horizontal plane: p E_sun (R_E / d)^2 Phi(alpha) sin(40), Phi the Lambert sphere's
+    # (sin a + (pi - a) cos a) / pi; returned as A / pi of it (no terrain in the way).
+    flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
+    sun, earth = Sun(1.496e11, 0.0, 10.0), Earth(180.0, 40.0)
+    camera = Camera(16, 16, 10.0)
+    pose = camera_pose(state(altitude=100.0))
+    lod = LodSettings(shading_levels=shading_levels)
+    tiles = TileSet(flat, sun.direction, 1e12, 5e3, lod, scattered_azimuths=0)
+    frames = []
+    for source in (None, earth):
+        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), backend="osmesa", earth=source) as renderer:
+            frames.append(renderer.render(pose).radiance)
+    alpha = np.radians(50.0)
+    phase = (np.sin(alpha) + (np.pi - alpha) * np.cos(alpha)) / np.pi
+    irradiance = 0.367 * sun.irradiance_w_m2 * (6.371e6 / 3.844e8) ** 2 * phase * np.sin(np.radians(40.0))
+    expected = bihemispherical_albedo(ReflectanceParams()) * irradiance / np.pi
+    assert frames[1] - frames[0] == pytest.approx(np.full((16, 16), expected), rel=2e-3)
 
 
 def test_rendered_regolith_backscatters():

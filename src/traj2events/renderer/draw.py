@@ -29,6 +29,7 @@ from importlib import resources
 import numpy as np
 
 from ..geometry.camera import Camera, CameraPose, opengl_camera_to_world
+from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField, add_stars
 from ..scene.sun import Sun
@@ -378,12 +379,14 @@ class TerrainRenderer:
         backend: str = "auto",
         texture_filter: str | None = None,
         lod_camera: Camera | None = None,
+        earth: Earth | None = None,
     ):
         """`stars`: added to the sky pixels of every frame (stars.add_stars); None: a black
         sky. `backend`: auto | egl | osmesa (resolve_backend). `texture_filter`: how a
         pixel samples the shading texture (footprint.TEXTURE_FILTERS; None: the tiles' lod's).
         `lod_camera`: whose pixels set the level of detail (None: `camera`; a larger `camera`
-        then draws the same tiles with more samples per pixel)."""
+        then draws the same tiles with more samples per pixel). `earth`: earthshine's source
+        (earthshine.py; None: none)."""
         texture_filter = tiles.lod.texture_filter if texture_filter is None else texture_filter
         self.tiles, self.camera, self.sun, self.reflectance = tiles, camera, sun, reflectance
         self.stars, self.lod_camera = stars, lod_camera or camera
@@ -397,7 +400,7 @@ class TerrainRenderer:
         uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
         self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter)
         self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
-        self._uniforms = law_uniforms(reflectance, sun)
+        self._uniforms = law_uniforms(reflectance, sun, earth)
         self._slots: dict[TileKey, int] = {}
         self._free: list[int] = []
         self._last_used: dict[TileKey, int] = {}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams, bihemispherical_albedo, max_radiance_factor
 from ..scene.sun import Sun
 
@@ -17,11 +18,13 @@ def hapke_r0_float32(w: float) -> float:
     return float((np.float32(1.0) - gamma) / (np.float32(1.0) + gamma))
 
 
-def law_uniforms(reflectance: ReflectanceParams, sun: Sun) -> dict:
-    """The uniforms of reflectance.glsl, and `radiance_max`: the law's largest direct light
-    plus the most scattered light there can be (scattering.py: S <= 1), W m^-2 sr^-1."""
+def law_uniforms(reflectance: ReflectanceParams, sun: Sun, earth: Earth | None = None) -> dict:
+    """The uniforms of reflectance.glsl (`earth` None: no earthshine), and `radiance_max`:
+    the law's largest direct light plus the most scattered light there can be
+    (scattering.py: S <= 1) and earthshine, W m^-2 sr^-1."""
     bounce_albedo = bihemispherical_albedo(reflectance)
-    most = max_radiance_factor(reflectance) + bounce_albedo**2
+    earthshine = earth.irradiance_w_m2(sun.irradiance_w_m2, sun.direction) if earth else 0.0
+    most = max_radiance_factor(reflectance) + bounce_albedo**2 + bounce_albedo * earthshine / sun.irradiance_w_m2
     return {
         "sun_dir": sun.direction,
         "irradiance": float(sun.irradiance_w_m2),
@@ -34,5 +37,7 @@ def law_uniforms(reflectance: ReflectanceParams, sun: Sun) -> dict:
         "hw": float(reflectance.opposition_h),
         "albedo": float(reflectance.albedo),
         "bounce_albedo": bounce_albedo,
+        "earth_dir": earth.direction if earth else np.array([0.0, 0.0, -1.0]),
+        "earth_irradiance": earthshine,
         "radiance_max": float(most * sun.irradiance_w_m2 / np.pi),
     }

@@ -55,6 +55,7 @@ def render_settings(config: dict, name: str) -> dict:
         "moon_radius_m": radius,
         "terrain": dict(config["terrain"]),
         "sun": dict(sc["sun"]),
+        "earth": dict(sc["earth"]) if sc.get("earth") else None,
         "reflectance": dict(r["reflectance"]),
         "lod": dict(r["lod"]),
         "scattered_light": dict(r["scattered_light"]),

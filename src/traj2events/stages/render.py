@@ -22,6 +22,7 @@ from ..geometry.camera import Camera
 from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
 from ..renderer.draw import TerrainRenderer
+from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField
 from ..scene.sun import Sun
@@ -48,6 +49,7 @@ class RenderSettings:
     moon_radius_m: float
     terrain: dict
     sun: dict
+    earth: dict | None  # earthshine's source (None: none)
     reflectance: dict
     lod: dict
     scattered_light: dict
@@ -94,6 +96,10 @@ class RenderSettings:
             ReflectanceParams(**self.reflectance),
         )
 
+    def earth_light(self) -> Earth | None:
+        """Earthshine's source (scenarios.<name>.earth), or None."""
+        return Earth(**self.earth) if self.earth else None
+
     def star_field(self) -> StarField | None:
         """The sky's stars (render.stars), or None where they are off."""
         if not self.stars["enabled"]:
@@ -112,6 +118,7 @@ class RenderSettings:
             "sun_azimuth_deg": sun.azimuth_deg,
             "sun_elevation_deg": sun.elevation_deg,
             "sun_irradiance_w_m2": sun.irradiance_w_m2,
+            "earth": json.dumps(self.earth, sort_keys=True),  # "null": no earthshine
             "reflectance": self.reflectance,
             "terrain": self.terrain,
             "lod": self.lod,
@@ -189,7 +196,9 @@ def render_trajectory(
     start = time.perf_counter()
     triangles = reused = added = 0
     with (
-        TerrainRenderer(tiles, camera, sun, reflectance, stars=s.star_field(), backend=backend) as renderer,
+        TerrainRenderer(
+            tiles, camera, sun, reflectance, stars=s.star_field(), backend=backend, earth=s.earth_light()
+        ) as renderer,
         FramesWriter(frames, s.height, s.width, attrs) as out,
         VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
         VideoWriter(preview, s.width, s.height, fps, "h264") if preview else contextlib.nullcontext() as shown_preview,
@@ -244,6 +253,7 @@ FRAME_ATTR_ORDER = (
     "sun_azimuth_deg",
     "sun_elevation_deg",
     "sun_irradiance_w_m2",
+    "earth",
     "reflectance",
     "terrain",
     "lod",

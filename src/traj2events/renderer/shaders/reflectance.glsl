@@ -11,6 +11,8 @@ uniform float b0;
 uniform float hw;            // opposition width h
 uniform float albedo;        // Lunar-Lambert
 uniform float bounce_albedo; // the law's bihemispherical albedo (reflectance.bihemispherical_albedo)
+uniform vec3 earth_dir;      // unit, toward the Earth (world)
+uniform float earth_irradiance;  // W/m^2 of earthshine on a surface facing the Earth (0: none)
 
 const float PI = 3.14159265358979;
 
@@ -84,4 +86,11 @@ float reflectance_factor(vec3 n, vec3 to_camera)
 float scattered_factor(float scattered)
 {
     return bounce_albedo * bounce_albedo * scattered;
+}
+
+// Earthshine off a surface with unit normal n (earthshine.py): Lambertian with the bounce
+// albedo, not shadowed by the terrain (W m^-2 sr^-1).
+float earthshine_radiance(vec3 n)
+{
+    return bounce_albedo * earth_irradiance * max(dot(n, earth_dir), 0.0) / PI;
 }

@@ -4,7 +4,7 @@
 // float32 buffer.
 in float frag_radiance;
 in float frag_lit;
-in float frag_scattered;  // light scattered into shadows by the terrain (W m^-2 sr^-1)
+in float frag_scattered;  // light scattered by the terrain, and earthshine (W m^-2 sr^-1)
 
 uniform float radiance_max;  // the law's maximum for this Sun (W m^-2 sr^-1)
 

@@ -14,7 +14,7 @@ uniform mat4 P;
 
 out float frag_radiance;
 out float frag_lit;
-out float frag_scattered;
+out float frag_scattered;  // scattered light and earthshine (W m^-2 sr^-1)
 
 #include "reflectance.glsl"
 
@@ -28,7 +28,7 @@ void main()
     vec3 n = normalize(normal_scattered.xyz);
     vec3 to_camera = -normalize(offset);
     frag_radiance = reflectance_factor(n, to_camera) * irradiance / PI;
-    frag_scattered = scattered_factor(normal_scattered.w) * irradiance / PI;
+    frag_scattered = scattered_factor(normal_scattered.w) * irradiance / PI + earthshine_radiance(n);
     frag_lit = clamp(position_lit.w, 0.0, 1.0);  // from the horizon march
     gl_Position = P * V * vec4(offset, 1.0);
 }

@@ -1,8 +1,8 @@
 #version 330 core
 // traj2events terrain shaded per pixel, fragment stage: the reflectance law at every pixel
 // from the shading texture's normal and lit fraction times mu0, sampled over the pixel's
-// footprint (render.lod.texture_filter), plus the light the terrain scattered there;
-// depth along the boresight (m) as in terrain.frag.
+// footprint (render.lod.texture_filter), plus the light the terrain scattered there and
+// earthshine;// depth along the boresight (m) as in terrain.frag.
 in vec2 frag_uv;
 flat in float frag_layer;
 in vec3 frag_to_camera_m;
@@ -22,6 +22,7 @@ void main()
     vec4 texel = texture(shading, vec3(frag_uv, frag_layer));
     float per_mu0 = reflectance_per_mu0(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);
     float direct = per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI;
-    float radiance = clamp(direct + frag_scattered, 0.0, radiance_max);
+    float earthshine = earthshine_radiance(normalize(texel.xyz));
+    float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
 }
