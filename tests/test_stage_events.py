@@ -35,7 +35,8 @@ def test_events_command_on_a_video_a_folder_and_frames_h5(tmp_path):
     emulate_file(tmp_path / "in.mkv", tmp_path / "v.h5")
     emulate_file(folder, tmp_path / "i.h5", fps=50.0, chunk=7)
     from_video, attrs = read_events(tmp_path / "v.h5")
-    from_images, _ = read_events(tmp_path / "i.h5")
+    from_images, image_attrs = read_events(tmp_path / "i.h5")
+    assert attrs["fps"] == 50.0 and image_attrs["fps"] == 50.0  # the input's rate, as frames.h5 gives it
     assert len(from_video) > 100 and from_video.tobytes() == from_images.tobytes()  # same frames, same events
     assert (from_video["p"] == 1).all()  # brightening only
     assert attrs["emulator_theta_on"] == 0.25 and attrs["preset"] == "clean"

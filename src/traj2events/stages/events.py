@@ -63,8 +63,8 @@ VIDEO_DECODER_CPUS = 1
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
 SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_convention", "camera_mount_height_m",
                "camera_position", "fps", "timing", "stars", "sun_range_m",
-               "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "reflectance", "terrain",
-               "moon_radius_m", "scenario", "id")  # fmt: skip
+               "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "earth", "reflectance", "terrain",
+               "scattered_light", "moon_radius_m", "scenario", "id")  # fmt: skip
 
 
 def check_recording_length(path: Path, last_time_s: float | None) -> None:
@@ -96,7 +96,7 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
                 raise ValueError(f"events INPUT: images in {path} differ in size (expected {width} x {height})")
             yield np.stack(batch), times[start : start + chunk]
 
-    return FrameSource(width, height, "images (8-bit)", images())
+    return FrameSource(width, height, "images (8-bit)", images(), {"fps": float(fps)})
 
 
 def frames_source(
@@ -146,7 +146,8 @@ def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
             yield frames, (k + np.arange(len(frames))) / fps
             k += len(frames)
 
-    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), decoder_cpus=VIDEO_DECODER_CPUS)
+    scene = {"fps": float(fps)}  # events.h5 says its input's rate, as from frames.h5
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), scene, decoder_cpus=VIDEO_DECODER_CPUS)
 
 
 def frame_source(
