@@ -5,6 +5,7 @@ import h5py
 import numpy as np
 import pytest
 from PIL import Image
+from scipy.special import erf
 
 from traj2events.formats.events import read_events
 from traj2events.stages.events import emulate, frame_source, preset_params
@@ -202,3 +203,41 @@ def test_an_error_from_a_plain_iterator_source_is_the_one_raised(tmp_path):
     with pytest.raises(ValueError, match="NaN"):
         emulate(source, preset_params("clean"), 0, tmp_path / "e.h5", "clean", "test")
     assert not (tmp_path / "e.h5").exists()
+
+
+def test_a_lens_blur_spreads_a_step_edges_events_over_its_width(tmp_path):
+    # A step of 100x radiance appears at column 16 of a 32-wide frames.h5. Through a pinhole
+    # only the bright side's pixels fire (ln 100 / 0.25 = 18 events each). A Gaussian lens
+    # blur of one pixel pitch sends the share (1 - erf((k - 1/2) / sqrt(2))) / 2 of the step
+    # into the k-th dark column: 1 + 99 of that times the light, ln of it / 0.25 events
+    # (13, 8, 1, 0 for k = 1..4). events.h5 records the lens. A video cannot go through it
+    # (8-bit display values, not radiance).
+    from traj2events.config import default_config
+    from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+    from traj2events.stages.events import events_command
+
+    sensor = dict(default_config()["events"]["sensor"])
+    low = 100.0 / dn_per_radiance(SensorParams.from_config(sensor))  # 100 DN: well above the knee
+    radiance = np.full((6, 8, 32), low, np.float32)
+    radiance[1:, :, 16:] *= 100.0
+    with h5py.File(tmp_path / "frames.h5", "w") as f:
+        f["t"] = np.arange(6) / 100.0
+        f["radiance"] = radiance
+        f.attrs["focal_px"] = 40.0
+    columns = {}
+    for name, blur_um in (("pinhole", 0.0), ("lens", sensor["pixel_pitch_m"] * 1e6)):
+        settings = {"preset": "clean", "pixel": dict(preset_params("clean").__dict__), "input": "sensor",
+                    "sensor": {**sensor, "lens_blur_um": blur_um}, "labels": False}  # fmt: skip
+        events_command(tmp_path / "frames.h5", tmp_path / f"{name}.h5", settings, 0)
+        events, attrs = read_events(tmp_path / f"{name}.h5")
+        columns[name] = np.bincount(events["x"], minlength=32) / 8  # events per pixel, per column
+        assert attrs["sensor_lens_blur_um"] == blur_um
+    assert columns["pinhole"][:16].sum() == 0 and columns["pinhole"][16:].min() >= 18  # ln(100) / 0.25
+    share = (1 - erf((np.arange(1, 5) - 0.5) / np.sqrt(2))) / 2
+    expected = np.floor(np.log(1 + 99 * share) / 0.25)
+    assert columns["lens"][15:11:-1] == pytest.approx(expected, abs=1) and columns["lens"][:12].sum() == 0
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in ramp_frames():
+            video.write(f)
+    with pytest.raises(ValueError, match="acts on linear radiance"):
+        frame_source(tmp_path / "in.mkv", sensor=SensorParams.from_config({**sensor, "vignetting": True}))

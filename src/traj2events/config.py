@@ -156,7 +156,12 @@ def _semantic_errors(config: dict) -> list[str]:
     pixel = config["events"]["pixel"]
     if pixel["hot_pixel_fraction"] > 0 and not pixel["hot_pixel_hz"] > 0:
         errors.append("config key 'events.pixel.hot_pixel_hz': expected > 0 when events.pixel.hot_pixel_fraction > 0")
-    band = config["events"]["sensor"]["band_m"]
+    sensor = config["events"]["sensor"]
+    optics = [k for k in ("psf_diffraction", "lens_blur_um", "vignetting") if sensor[k]]
+    if optics and config["events"]["input"] != "sensor":
+        errors.append(f"config key 'events.sensor.{optics[0]}': the lens acts on the sensor's input only: "
+                      f"expected events.input: sensor, got {config['events']['input']}")  # fmt: skip
+    band = sensor["band_m"]
     if not band[0] < band[1]:
         errors.append(f"config key 'events.sensor.band_m': expected [low, high] with low < high, got {band}")
     timing = config["render"]["timing"]

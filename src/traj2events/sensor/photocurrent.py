@@ -8,7 +8,8 @@ emulator's input in units tied to that photocurrent (docs/events.md "Sensor mode
 L_band is the rendered radiance's share inside the sensor's band: the renderer's radiance
 is of the whole solar spectrum (1361 W/m^2 at 1 AU), the Sun is taken as a 5772 K black
 body and the regolith as grey, so the share and the mean photon energy come from Planck's
-law over the band. Off-axis fall-off (cos^4) is left out: a lens is usually corrected for it.
+law over the band. The lens's point-spread function and cos^4 fall-off, when on, act on
+the radiance before this (optics.py).
 
 The emulator's input is the photocurrent in units of the dark current times the 20 DN
 knee of its lin-log law, x = 20 I_ph / I_dark: the log response ln(I_ph + I_dark) of a
@@ -43,8 +44,18 @@ class SensorParams:
     quantum_efficiency: float  # electrons per photon over the pixel's whole area (fill factor included)
     band_m: tuple[float, float]  # the sensor's spectral band, m
     dark_current_a: float
+    # The lens before the pixels (optics.py): off, the paper's pinhole.
+    psf_diffraction: bool = False  # the Airy pattern of the f-number over the band
+    lens_blur_um: float = 0.0  # a Gaussian blur's standard deviation at the focal plane, um
+    vignetting: bool = False  # cos^4 of the field angle
+
+    @property
+    def has_optics(self) -> bool:
+        return self.psf_diffraction or self.lens_blur_um > 0 or self.vignetting
 
     def __post_init__(self) -> None:
+        if not self.lens_blur_um >= 0:
+            raise ValueError(f"events.sensor.lens_blur_um: expected >= 0, got {self.lens_blur_um}")
         for key in ("f_number", "pixel_pitch_m", "dark_current_a"):
             if not getattr(self, key) > 0:
                 raise ValueError(f"events.sensor.{key}: expected > 0, got {getattr(self, key)}")

@@ -28,6 +28,7 @@ from ..progress import log
 from ..read_ahead import read_ahead
 from ..sensor.emulator import EmulatorParams, EventEmulator
 from ..sensor.laws import display_dn_per_radiance
+from ..sensor.optics import psf_kernel, through_lens, vignetting
 from ..sensor.photocurrent import SensorParams, dn_per_radiance
 from ..trajectory.state import BODY_RATES
 from ..video import iter_video, video_info
@@ -125,11 +126,22 @@ def frames_source(
         scale = display_dn_per_radiance(white)
         kind = f"linear radiance (white {white:g} W m^-2 sr^-1)"
 
+    lens = _lens(sensor, frames.attrs, width, height) if sensor is not None and sensor.has_optics else None
+
     def radiance():  # float32 as stored: the emulator scales it per pixel (no float64 copy)
         with frames:
-            yield from frames.radiance_chunks(chunk, buffers)
+            for chunk_frames, times in frames.radiance_chunks(chunk, buffers):
+                yield (chunk_frames if lens is None else through_lens(chunk_frames, *lens)), times
 
     return FrameSource(width, height, kind, radiance(), scene, scale)
+
+
+def _lens(sensor: SensorParams, attrs, width: int, height: int) -> tuple[np.ndarray, np.ndarray | None]:
+    """(PSF kernel, vignetting or None) of the sensor's lens on frames.h5's camera."""
+    kernel = psf_kernel(sensor.pixel_pitch_m, sensor.f_number, sensor.band_m, sensor.psf_diffraction,
+                        sensor.lens_blur_um)  # fmt: skip
+    falloff = vignetting(width, height, float(attrs["focal_px"])) if sensor.vignetting else None
+    return kernel, falloff
 
 
 def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
@@ -166,9 +178,13 @@ def frame_source(
         raise FileNotFoundError(f"events INPUT: {path} does not exist")
     if chunk < 1:
         raise ValueError(f"events: chunk: expected >= 1 frames, got {chunk}")
+    radiance = path.suffix.lower() in (".h5", ".hdf5")
+    if sensor is not None and sensor.has_optics and not radiance:
+        raise ValueError(f"events: the lens (events.sensor psf_diffraction, lens_blur_um, vignetting) acts on linear "
+                         f"radiance: frames.h5, not {path}")  # fmt: skip
     if path.is_dir():
         return image_folder_source(path, fps, chunk)
-    if path.suffix.lower() in (".h5", ".hdf5"):
+    if radiance:
         source = frames_source(path, white, chunk, sensor, READ_AHEAD_BUFFERS if ahead else 1)
     else:
         source = video_source(path, fps, chunk)
