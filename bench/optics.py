@@ -58,8 +58,8 @@ def clip(source: Path, n: int, folder: Path) -> Path:
     return out
 
 
-def run(frames: Path, output: Path, sensor: dict, src: Path) -> float:
-    settings = {"sensor": sensor}
+def run(frames: Path, output: Path, settings: dict, src: Path) -> float:
+    """Seconds of one whole `traj2events events` command with these `--settings`."""
     command = [sys.executable, "-m", "traj2events", "events", str(frames), "--output", str(output),
                "--preset", "paper", "--no-labels", "--threads", "1", "--settings", json.dumps(settings)]  # fmt: skip
     env = dict(os.environ, PYTHONPATH=str(src), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
@@ -89,10 +89,10 @@ def main() -> None:
         seconds = {name: [] for name in variants}
         events = {}
         for name, (lens, src) in variants.items():  # once untimed: caches warm
-            run(frames, Path(tmp) / "warm.h5", lens, src)
+            run(frames, Path(tmp) / "warm.h5", {"sensor": lens}, src)
         for _ in range(args.repeats):
             for name, (lens, src) in variants.items():
-                seconds[name].append(run(frames, Path(tmp) / "out.h5", lens, src))
+                seconds[name].append(run(frames, Path(tmp) / "out.h5", {"sensor": lens}, src))
                 events[name] = len(read_events(Path(tmp) / "out.h5")[0])
         base_s, base_n = statistics.median(seconds["A no lens"]), events["A no lens"]
         print("| variant | kernel | s (median) | vs A | events | vs A |")

@@ -227,7 +227,8 @@ def test_a_lens_blur_spreads_a_step_edges_events_over_its_width(tmp_path):
     columns = {}
     for name, blur_um in (("pinhole", 0.0), ("lens", sensor["pixel_pitch_m"] * 1e6)):
         settings = {"preset": "clean", "pixel": dict(preset_params("clean").__dict__), "input": "sensor",
-                    "sensor": {**sensor, "lens_blur_um": blur_um}, "labels": False}  # fmt: skip
+                    "sensor": {**sensor, "lens_blur_um": blur_um}, "labels": False,
+                    "readout": default_config()["events"]["readout"]}  # fmt: skip
         events_command(tmp_path / "frames.h5", tmp_path / f"{name}.h5", settings, 0)
         events, attrs = read_events(tmp_path / f"{name}.h5")
         columns[name] = np.bincount(events["x"], minlength=32) / 8  # events per pixel, per column
@@ -241,3 +242,30 @@ def test_a_lens_blur_spreads_a_step_edges_events_over_its_width(tmp_path):
             video.write(f)
     with pytest.raises(ValueError, match="acts on linear radiance"):
         frame_source(tmp_path / "in.mkv", sensor=SensorParams.from_config({**sensor, "vignetting": True}))
+
+
+def test_the_readout_delays_and_drops_in_the_events_command(tmp_path):
+    # The ramp through an 8-bit video, clean preset: with latency, jitter and a rate
+    # controller, events.h5 stays sorted, holds what was kept, and counts what was dropped
+    # per cause; kept and dropped add up to the events without a readout.
+    from traj2events.config import default_config
+    from traj2events.stages.events import events_command
+
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in ramp_frames():
+            video.write(f)
+    events = dict(default_config()["events"], input="display", preset="clean", labels=True)
+    events["pixel"] = dict(preset_params("clean").__dict__)
+    counts = {}
+    for name, readout in (("off", {}), ("on", {"latency_s": 1e-4, "jitter_s": 3e-5, "max_event_rate_hz": 2e4,
+                                                "mode": "drop"})):  # fmt: skip
+        settings = {**events, "readout": {**events["readout"], **readout}}
+        events_command(tmp_path / "in.mkv", tmp_path / f"{name}.h5", settings, 3)
+        out, attrs = read_events(tmp_path / f"{name}.h5")
+        counts[name] = len(out)
+        assert np.all(np.diff(out["t"]) >= 0)
+    assert attrs["readout_mode"] == "drop" and attrs["readout_dropped"] > 0
+    assert counts["on"] + attrs["readout_dropped"] == counts["off"]
+    assert attrs["readout_dropped"] == sum(
+        attrs[f"readout_dropped_{k}"] for k in ("signal", "shot_noise", "leak", "hot_pixel")
+    )

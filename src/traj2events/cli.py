@@ -17,7 +17,7 @@ from .defaults import section
 from .memory import keep_freed_memory
 from .options import add_settings, inline_or_file, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
-from .settings.events import EVENTS, EVENTS_PICTURE
+from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE
 from .settings.poses import POSES
 
 
@@ -220,7 +220,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
     p.add_argument("--white", type=float, help="with --input-scale display: radiance at full scale (default: "
                    "frames.h5's display white)")  # fmt: skip
-    add_settings(p, EVENTS, "the emulator settings", flags={"events.input": "--input-scale"})
+    add_settings(p, EVENTS, "the emulator settings", flags=EVENTS_FLAGS)
     p.add_argument("--chunk", type=int, help="frames read at a time (default 16; the events do not change)")
     p.add_argument("--threads", type=int, help="CPUs to use: with 2 or more, the next chunk is read in a thread while "
                    "this one is emulated, and each frame's pixels are split over the CPUs left (a video's decoder, "

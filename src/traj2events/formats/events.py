@@ -130,6 +130,10 @@ class EventsWriter:
             ds[self._written :] = columns[name][:n]
         self._written += n
 
+    def annotate(self, attrs: dict) -> None:
+        """Attributes known only once every event is in (counts)."""
+        set_attrs(self._file, attrs)
+
     def close(self, duration_us: int, exc=(None, None, None)) -> None:
         if exc[0] is None:
             self._write(self._buffer, self.n - self._written)  # the last, partial chunk

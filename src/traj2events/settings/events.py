@@ -11,13 +11,16 @@ EVENTS = {
     "labels": "events.labels",
     "input": "events.input",
     "sensor": "events.sensor",
+    "readout": "events.readout",
 }
 EVENTS_PICTURE = {"window_ms": "events.window_ms"}
+# The events command's options where a key's own name would say too little.
+EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--readout-mode"}
 
 
 def events_settings(config: dict) -> dict:
     """Everything the emulation depends on (the seed aside, per trajectory): the pixel
-    model (and the preset it came from), labels, the input scale and the sensor."""
+    model (and the preset it came from), labels, the input scale, the sensor and its readout."""
     return pick(config, EVENTS)
 
 

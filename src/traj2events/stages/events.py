@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import __version__
 from ..defaults import preset_pixel
-from ..formats.events import MAX_T_US, EventsWriter, read_events
+from ..formats.events import EVENT_LABELS, MAX_T_US, EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
@@ -30,6 +30,7 @@ from ..sensor.emulator import EmulatorParams, EventEmulator
 from ..sensor.laws import display_dn_per_radiance
 from ..sensor.optics import psf_kernel, through_lens, vignetting
 from ..sensor.photocurrent import SensorParams, dn_per_radiance
+from ..sensor.readout import Readout, ReadoutParams
 from ..trajectory.state import BODY_RATES
 from ..video import iter_video, video_info
 
@@ -208,11 +209,13 @@ def emulate(
     progress_every: int = 640,
     labels: bool = False,
     threads: int = 1,
+    readout: ReadoutParams = ReadoutParams(),
 ) -> tuple[int, int, float]:
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
     `input_name` are recorded in its attributes; with `labels`, each event's cause too;
     `threads`: CPUs to use, the emulator's per-pixel pass split over those the source's
-    decoder leaves). Returns (frames, events, time of the last frame in s)."""
+    decoder leaves; `readout`: latency, jitter and rate limit after the pixels). Returns
+    (frames, events, time of the last frame in s)."""
     emulator = EventEmulator(
         source.width,
         source.height,
@@ -229,15 +232,20 @@ def emulate(
         "input_kind": source.kind,
         **{f"emulator_{k}": v for k, v in asdict(params).items()},
         "labels": labels,
+        **{f"readout_{k}": v for k, v in asdict(readout).items()},
         "traj2events_version": __version__,
         **source.scene,
     }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
     writer = EventsWriter(output, source.width, source.height, attrs, labels=labels)
+    stream = Readout(readout, seed, len(EVENT_LABELS)) if readout.active else None
     try:
         for frames, times in source.chunks:
             # Memory: one interval's events; as columns, which events.h5 stores.
             for events, event_labels in emulator.intervals(frames, times, columns=True):
+                if stream is not None:
+                    events = stream.process(events, event_labels)
+                    event_labels = events.get("label")
                 writer.append(events, event_labels)
                 n_events += len(events["t"])
             n_frames += len(frames)
@@ -250,6 +258,14 @@ def emulate(
             close()
         writer.close(0, (type(exc), exc, exc.__traceback__))
         raise
+    if stream is not None:
+        events = stream.flush()
+        if events is not None:
+            writer.append(events, events.get("label"))
+            n_events += len(events["t"])
+        dropped = dict(zip(EVENT_LABELS, stream.dropped.tolist())) if labels else {}
+        writer.annotate({"readout_dropped": int(stream.dropped.sum()),
+                         **{f"readout_dropped_{k}": v for k, v in dropped.items()}})  # fmt: skip
     writer.close(int(round(t_last * 1e6)))
     elapsed = time.perf_counter() - start
     log(
@@ -348,6 +364,7 @@ def events_command(
         progress_every=chunk * 10,
         labels=settings["labels"],
         threads=threads,
+        readout=ReadoutParams(**settings["readout"]),
     )
     frames = str(input) if Path(input).suffix == ".h5" else None
     e = exports or {}

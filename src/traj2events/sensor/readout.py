@@ -1,0 +1,131 @@
+"""From the pixels to the sensor's output: latency, jitter and the readout's rate limit
+(events.readout; all off by default: events leave when their pixels cross).
+
+    t_out = t_cross + max(0, N(latency, jitter^2))          per event (IEBCS's model)
+A pixel's comparator and handshake take a while, longer and more variable in dim light;
+IEBCS draws each event's delay from a normal law clipped at zero, and so does this.
+
+The readout then passes at most `max_event_rate_hz` events per second:
+  - `delay` (the arbiter, as IEBCS's bottleneck arbiter): events queue in their order of
+    arrival and leave one every 1 / rate: t_k = max(arrival_k, t_{k-1} + 1 / rate), so a
+    burst comes out late, none lost;
+  - `drop` (an event-rate controller, as Prophesee's sensors have, set to this rate): an
+    event is dropped when the events kept in the 1 ms before it, itself included, would
+    exceed rate x 1 ms: no 1 ms window holds more. The dropped ones are counted per cause
+    (events.h5 attributes `readout_dropped_<label>`).
+Times are integer microseconds, as events.h5 stores them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+READOUT_MODES = ("delay", "drop")
+WINDOW_US = 1000  # the drop mode's window
+
+
+@dataclass(frozen=True)
+class ReadoutParams:
+    latency_s: float = 0.0
+    jitter_s: float = 0.0
+    max_event_rate_hz: float = 0.0  # 0: no limit
+    mode: str = "delay"
+
+    def __post_init__(self) -> None:
+        for key in ("latency_s", "jitter_s", "max_event_rate_hz"):
+            if not getattr(self, key) >= 0:
+                raise ValueError(f"events.readout.{key}: expected >= 0, got {getattr(self, key)}")
+        if self.mode not in READOUT_MODES:
+            raise ValueError(f"events.readout.mode: expected one of {READOUT_MODES}, got {self.mode!r}")
+
+    @property
+    def active(self) -> bool:
+        return self.latency_s > 0 or self.jitter_s > 0 or self.max_event_rate_hz > 0
+
+
+@njit(cache=True, nogil=True)
+def _queue(arrival_us, spacing_us, free_us):
+    """Arbiter: each event leaves at max(its arrival, the previous one's + spacing).
+    Returns (times, the time the next one may leave)."""
+    out = np.empty(arrival_us.size, np.int64)
+    for k in range(arrival_us.size):
+        leave = max(float(arrival_us[k]), free_us)
+        out[k] = np.int64(np.floor(leave))
+        free_us = leave + spacing_us
+    return out, free_us
+
+
+@njit(cache=True, nogil=True)
+def _rate_control(arrival_us, ring, head, count, window_us):
+    """Event-rate controller: keep an event when fewer than len(ring) kept events lie in
+    (t - window, t]; `ring` holds the last kept times (`count` of them, oldest at `head`)."""
+    keep = np.zeros(arrival_us.size, np.bool_)
+    size = ring.size
+    for k in range(arrival_us.size):
+        t = arrival_us[k]
+        while count > 0 and ring[head] <= t - window_us:
+            head = (head + 1) % size
+            count -= 1
+        if count < size:
+            ring[(head + count) % size] = t
+            count += 1
+            keep[k] = True
+    return keep, head, count
+
+
+class Readout:
+    """The readout of one recording, interval by interval (events sorted by crossing time,
+    intervals in time order): `process` returns the events sure to leave before any event
+    still to come (those arriving by the latest crossing seen: a later crossing cannot
+    arrive before it), sorted by output time; `flush` the rest at the end."""
+
+    def __init__(self, params: ReadoutParams, seed: int, n_labels: int):
+        self.params = params
+        delays = params.jitter_s or params.latency_s
+        self.rng = np.random.Generator(np.random.PCG64([seed, 0x7EAD0])) if delays else None  # its own stream
+        self.held: dict[str, np.ndarray] | None = None
+        self.free_us = -np.inf
+        per_window = int(np.floor(params.max_event_rate_hz * WINDOW_US * 1e-6))
+        self.ring = np.empty(max(per_window, 1), np.int64)
+        self.head = self.count = 0
+        self.dropped = np.zeros(n_labels, np.int64)  # per cause (all in the first without labels)
+        self.latest_crossing_us = np.iinfo(np.int64).min
+
+    def process(self, events: dict[str, np.ndarray], labels: np.ndarray | None):
+        columns = {name: np.asarray(events[name]) for name in ("x", "y", "t", "p")}
+        if len(columns["t"]):
+            self.latest_crossing_us = max(self.latest_crossing_us, int(columns["t"][-1]))
+        if labels is not None:
+            columns["label"] = np.asarray(labels)
+        if self.rng is not None:
+            delay = self.rng.normal(self.params.latency_s * 1e6, self.params.jitter_s * 1e6, len(columns["t"]))
+            columns["t"] = columns["t"].astype(np.int64) + np.round(np.maximum(delay, 0.0)).astype(np.int64)
+        if self.held is not None:  # the last intervals' events still travelling
+            columns = {name: np.concatenate([self.held[name], columns[name]]) for name in columns}
+        order = np.argsort(columns["t"], kind="stable")
+        columns = {name: values[order] for name, values in columns.items()}
+        leave = int(np.searchsorted(columns["t"], self.latest_crossing_us, side="right"))
+        self.held = {name: values[leave:] for name, values in columns.items()}
+        return self._limit({name: values[:leave] for name, values in columns.items()})
+
+    def flush(self):
+        out, self.held = self.held, None
+        return self._limit(out)
+
+    def _limit(self, columns: dict[str, np.ndarray] | None):
+        if columns is None or not len(columns["t"]):
+            return columns
+        rate = self.params.max_event_rate_hz
+        if rate > 0 and self.params.mode == "delay":
+            columns["t"], self.free_us = _queue(columns["t"].astype(np.int64), 1e6 / rate, self.free_us)
+        elif rate > 0:
+            keep, self.head, self.count = _rate_control(
+                columns["t"].astype(np.int64), self.ring, self.head, self.count, WINDOW_US
+            )
+            causes = columns["label"][~keep] if "label" in columns else np.zeros(int((~keep).sum()), np.int64)
+            self.dropped += np.bincount(causes, minlength=len(self.dropped))
+            columns = {name: values[keep] for name, values in columns.items()}
+        return columns

@@ -1,0 +1,76 @@
+"""The readout after the pixels (sensor/readout.py): latency and jitter against the clipped
+normal law's mean, order kept across intervals, the arbiter's spacing and the rate
+controller's 1 ms bound, nothing lost or made."""
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from traj2events.sensor.readout import Readout, ReadoutParams
+
+
+def stream(n_intervals=50, per_interval=2000, interval_us=1000, seed=0, labels=True):
+    """Intervals of events sorted by crossing time, as the emulator gives them."""
+    rng = np.random.default_rng(seed)
+    for k in range(n_intervals):
+        t = np.sort(rng.integers(k * interval_us, (k + 1) * interval_us, per_interval))
+        x, y = rng.integers(0, 64, len(t)).astype(np.uint16), rng.integers(0, 48, len(t)).astype(np.uint16)
+        events = {"x": x, "y": y, "t": t.astype(np.int64), "p": rng.integers(0, 2, len(t)).astype(np.uint8)}
+        yield events, (rng.integers(0, 4, len(t)).astype(np.uint8) if labels else None)
+
+
+def run(params, intervals, seed=1):
+    readout = Readout(params, seed, 4)
+    parts = [readout.process(e, lab) for e, lab in intervals] + [readout.flush()]
+    out = {k: np.concatenate([p[k] for p in parts if p is not None]) for k in ("x", "y", "t", "p", "label")}
+    return out, readout
+
+
+def test_latency_alone_delays_every_event_by_it():
+    inputs = list(stream(5, 100))
+    out, _ = run(ReadoutParams(latency_s=250e-6), inputs)
+    assert out["t"] == pytest.approx(np.concatenate([e["t"] for e, _ in inputs]) + 250)
+
+
+def test_jittered_delays_follow_the_clipped_normal_law_and_stay_sorted():
+    # max(0, N(mu, sigma^2)): mean mu Phi(mu / sigma) + sigma phi(mu / sigma), zero with
+    # probability Phi(-mu / sigma). Matching events by (x, y, p, label) is ambiguous, so
+    # the law is checked on the sums.
+    mu, sigma = 20.0, 50.0
+    inputs = list(stream(40, 2500))
+    out, _ = run(ReadoutParams(latency_s=mu * 1e-6, jitter_s=sigma * 1e-6), inputs)
+    t_in = np.concatenate([e["t"] for e, _ in inputs])
+    n = len(t_in)
+    assert len(out["t"]) == n and np.all(np.diff(out["t"]) >= 0)
+    expected = mu * stats.norm.cdf(mu / sigma) + sigma * stats.norm.pdf(mu / sigma)
+    spread = sigma / np.sqrt(n)  # the mean delay's sampling error is below this
+    assert (out["t"].sum() - t_in.sum()) / n == pytest.approx(expected, abs=4 * spread + 0.5)  # + rounding
+
+
+def test_the_arbiter_spaces_events_by_one_over_the_rate_and_loses_none():
+    # 2 M events/s arrive; the readout passes 1 M/s: they leave 1 us apart, late, all of them.
+    inputs = list(stream(20, 2000))
+    out, readout = run(ReadoutParams(max_event_rate_hz=1e6, mode="delay"), inputs)
+    assert len(out["t"]) == 40000 and readout.dropped.sum() == 0
+    assert np.all(np.diff(out["t"]) >= 1)  # 1 us apart, at the first event's pace
+    assert out["t"][-1] == pytest.approx(inputs[0][0]["t"][0] + 39999, abs=1)
+
+
+def test_the_rate_controller_keeps_at_most_the_limit_in_any_millisecond():
+    inputs = list(stream(20, 2000, interval_us=1000))  # 2 M events/s
+    out, readout = run(ReadoutParams(max_event_rate_hz=500e3, mode="drop"), inputs)
+    t = out["t"]
+    window_counts = np.searchsorted(t, t + 1000, side="left") - np.arange(len(t))  # events in [t, t + 1 ms)
+    assert window_counts.max() <= 500
+    assert len(t) + readout.dropped.sum() == 40000
+    assert len(t) == pytest.approx(500 * 20, rel=0.02)  # the limit, kept all along
+    labels_in = np.bincount(np.concatenate([lab for _, lab in inputs]), minlength=4)
+    assert np.all(readout.dropped + np.bincount(out["label"], minlength=4) == labels_in)
+
+
+def test_off_does_nothing_and_bad_values_are_named():
+    assert not ReadoutParams().active
+    with pytest.raises(ValueError, match="events.readout.jitter_s"):
+        ReadoutParams(jitter_s=-1.0)
+    with pytest.raises(ValueError, match="events.readout.mode"):
+        ReadoutParams(mode="queue")
