@@ -363,6 +363,15 @@ def test_emulator_setting_reruns_events_only(built, tmp_path):
     assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
 
 
+def test_an_imu_setting_or_a_readout_setting_reruns_its_stage_only(built, tmp_path):
+    shutil.copytree(built, tmp_path / "wf")
+    jobs = edit_config(tmp_path / "wf", lambda c: c.update(imu={"rate_hz": 500.0}))
+    assert jobs == {"imu": 3, "dataset_index": 2}
+    shutil.copytree(built, tmp_path / "wf2")
+    jobs = edit_config(tmp_path / "wf2", lambda c: c.setdefault("events", {}).update(readout={"latency_s": 1e-4}))
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+
+
 def test_turning_the_preview_off_reruns_no_render(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("render", {}).update(preview=False))

@@ -10,6 +10,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")  # one process per core is faster 
 
 import argparse
 import gc
+import importlib
 import sys
 
 from . import __version__
@@ -18,6 +19,7 @@ from .memory import keep_freed_memory
 from .options import add_settings, inline_or_file, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
 from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE
+from .settings.imu import IMU
 from .settings.poses import POSES
 
 
@@ -61,14 +63,6 @@ def cmd_sample(args) -> int:
     if args.jobs < 1:
         raise ValueError(f"sample: --jobs: expected >= 1, got {args.jobs}")
     sample_trajectories(_settings(ScenarioSettings, args.settings), args.base, args.output, args.table, args.jobs)
-    return 0
-
-
-def cmd_upsample(args) -> int:
-    from .stages.camera_poses import camera_poses
-
-    s = settings_from(args, POSES)
-    camera_poses(args.solutions, args.id, s["fps"], s["method"], args.output)
     return 0
 
 
@@ -126,18 +120,15 @@ def cmd_picture(args) -> int:
     return 0
 
 
-def cmd_index(args) -> int:
-    from .stages.index import dataset_index
+def _calls(stage: str, function: str, *arguments):
+    """A command: stages.<stage>.<function>(each argument: an option's name, or a function of the options)."""
 
-    dataset_index(args.trajectories, args.output, args.samples)
-    return 0
+    def command(args) -> int:
+        values = [a(args) if callable(a) else getattr(args, a) for a in arguments]
+        getattr(importlib.import_module(f".stages.{stage}", __package__), function)(*values)
+        return 0
 
-
-def cmd_summary(args) -> int:
-    from .stages.summary import dataset_summary
-
-    dataset_summary(args.solutions, args.tables, args.output)
-    return 0
+    return command
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -180,7 +171,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--id", type=int, required=True, help="sample index")
     add_settings(p, POSES, "the frame rate and upsampling")
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
-    p.set_defaults(func=cmd_upsample)
+    p.set_defaults(
+        func=_calls("camera_poses", "poses_command", "solutions", "id", lambda a: settings_from(a, POSES), "output")
+    )
+
+    p = sub.add_parser("imu", help="imu.h5: the IMU's specific force and body rates, and the altitude, noise-free")
+    p.add_argument("trajectory", help="trajectory.h5 (its nodes are re-integrated at the IMU's rate)")
+    add_settings(p, IMU, "the IMU's rate and the sphere")
+    p.add_argument("--output", "-o", required=True, help="imu.h5")
+    p.set_defaults(func=_calls("imu", "imu_command", "trajectory", "output", lambda a: settings_from(a, IMU)))
 
     p = sub.add_parser("render", help="render the surface from every pose of a trajectory (radiance, depth, videos)")
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
@@ -258,13 +257,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("trajectories", nargs="*", help="trajectory.h5 files (other files are ignored)")
     p.add_argument("--output", "-o", required=True, help="index.csv")
     p.add_argument("--samples", help="the scenario's samples.csv: a scenario with no solved sample is then an error")
-    p.set_defaults(func=cmd_index)
+    p.set_defaults(func=_calls("index", "dataset_index", "trajectories", "output", "samples"))
 
     p = sub.add_parser("summary", help="one CSV row per scenario: counts, failures, final mass, t_f, errors")
     p.add_argument("--solutions", nargs="+", required=True, help="solutions.h5 of each scenario")
     p.add_argument("--tables", nargs="+", required=True, help="samples.csv of each scenario, same order")
     p.add_argument("--output", "-o", required=True, help="summary.csv")
-    p.set_defaults(func=cmd_summary)
+    p.set_defaults(func=_calls("summary", "dataset_summary", "solutions", "tables", "output"))
     return parser
 
 

@@ -28,6 +28,7 @@ import numpy as np
 from .formats.events import read_events_attrs, read_events_window, read_labelled_window
 from .formats.frames import FramesFile
 from .formats.hdf5 import open_file
+from .formats.imu import read_imu
 from .formats.trajectory import read_trajectory
 
 
@@ -43,6 +44,11 @@ class Landing:
         """Camera pose times (K,) s and states (K, 13) at the frame rate."""
         tr = read_trajectory(self.folder / "trajectory.h5")
         return tr.t, tr.state
+
+    def imu(self) -> dict[str, np.ndarray]:
+        """imu.h5's streams: t (n,) s, specific_force_b (n, 3) m/s^2, angular_rate_b (n, 3)
+        rad/s, altitude_m (n,) m (docs/dataset.md)."""
+        return read_imu(self.folder / "imu.h5")[0]
 
     @property
     def camera_matrix(self) -> np.ndarray:

@@ -17,6 +17,7 @@ from traj2events.settings.camera import camera_settings as camera_settings_of
 from traj2events.settings.camera import motion_field_settings as motion_field_settings_of
 from traj2events.settings.events import events_picture_settings as events_picture_settings_of
 from traj2events.settings.events import events_settings as events_settings_of
+from traj2events.settings.imu import imu_settings as imu_settings_of
 from traj2events.settings.poses import pose_settings as pose_settings_of
 from traj2events.settings.render import render_settings as render_settings_of
 from traj2events.settings.solve import solve_settings
@@ -133,6 +134,7 @@ def trajectory_ids(scenario):
 
 PER_TRAJECTORY = [
     "trajectory.h5",
+    "imu.h5",
     "video.mkv",
     *(["preview.mp4"] if config["render"]["preview"] else []),
     "frames.png",

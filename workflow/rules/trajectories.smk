@@ -63,6 +63,24 @@ rule camera_poses:
         "--output {output} 2> {log}"
 
 
+rule imu:
+    input:
+        "results/{scenario}/{id}/trajectory.h5",
+    output:
+        "results/{scenario}/{id}/imu.h5",
+    log:
+        "results/logs/{scenario}/{id}/imu.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/imu.tsv"
+    conda:
+        ENV
+    params:
+        settings=as_json(imu_settings_of),
+        code=code("imu"),
+    shell:
+        "traj2events imu {input} --settings {params.settings:q} --output {output} 2> {log}"
+
+
 rule dataset_index:
     input:
         trajectories=scenario_outputs,

@@ -58,3 +58,8 @@ def camera_poses(
         "traj2events_version": __version__,
     }
     write_trajectory(output, (t, state, control), poses, attrs)
+
+
+def poses_command(solutions: str | os.PathLike, sample_id: int, settings: dict, output: str | os.PathLike) -> None:
+    """The camera_poses stage as the command runs it: settings.poses (fps, method)."""
+    camera_poses(solutions, sample_id, settings["fps"], settings["method"], output)
