@@ -5,17 +5,25 @@ trajectory back, and imu.h5 agrees with the camera poses of the same integration
 import numpy as np
 import pytest
 
+from traj2events.config import default_config
 from traj2events.formats.imu import read_imu
 from traj2events.formats.trajectory import read_trajectory, vehicle_attrs, write_trajectory
 from traj2events.stages.imu import imu_command
 from traj2events.trajectory.dynamics import Dynamics
-from traj2events.trajectory.imu import altitude_above_sphere, angular_rate_body, specific_force_body
+from traj2events.trajectory.imu import (
+    ImuNoise,
+    altitude_above_sphere,
+    angular_rate_body,
+    measured,
+    specific_force_body,
+)
 from traj2events.trajectory.state import BODY_RATES, MASS, POSITION, VELOCITY, rotation_body_to_inertial
 from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls
 from traj2events.trajectory.vehicle import Vehicle
 
 VEHICLE = Vehicle()
 DYNAMICS = Dynamics(VEHICLE)
+SETTINGS = {"rate_hz": 400.0, "moon_radius_m": 1737400.0, "noise": default_config()["imu"]["noise"]}
 
 
 def state(pitch=0.0, mass=None):
@@ -87,12 +95,41 @@ def test_imu_h5_agrees_with_the_camera_poses_of_the_same_integration(tmp_path):
     pose_rows = (t_poses, poses, interpolate_controls(t_nodes, controls, t_poses))
     attrs = {**vehicle_attrs(VEHICLE), "scenario": "test", "id": 3, "fps": 20.0}
     write_trajectory(tmp_path / "trajectory.h5", nodes, pose_rows, attrs)
-    imu_command(tmp_path / "trajectory.h5", tmp_path / "imu.h5", {"rate_hz": 400.0, "moon_radius_m": 1737400.0})
+    imu_command(tmp_path / "trajectory.h5", tmp_path / "imu.h5", SETTINGS, seed=5)
     streams, attrs = read_imu(tmp_path / "imu.h5")
     assert len(streams["t"]) == 8001 and attrs["rate_hz"] == 400.0 and attrs["id"] == 3
     every_20th = streams["angular_rate_b"][::20]  # the pose times
     assert every_20th == pytest.approx(poses[:, BODY_RATES], abs=1e-12)
     assert streams["altitude_m"][::20] == pytest.approx(altitude_above_sphere(poses, 1737400.0), abs=1e-9)
     assert read_trajectory(tmp_path / "trajectory.h5").t[-1] == streams["t"][-1]
+    # The measured streams: the truth plus the biases plus white noise; the same seed, the same bytes.
+    residual = streams["angular_rate_b_measured"] - streams["angular_rate_b"] - streams["gyro_bias_b"]
+    gyro = ImuNoise.from_config(SETTINGS["noise"])
+    assert np.std(residual) == pytest.approx(gyro.gyro_random_walk_rad_sqrt_s * np.sqrt(400.0), rel=0.05)
+    imu_command(tmp_path / "trajectory.h5", tmp_path / "again.h5", SETTINGS, seed=5)
+    assert (tmp_path / "again.h5").read_bytes() == (tmp_path / "imu.h5").read_bytes()
     with pytest.raises(ValueError, match="rate_hz"):
-        imu_command(tmp_path / "trajectory.h5", tmp_path / "bad.h5", {"rate_hz": 0.0, "moon_radius_m": 1737400.0})
+        imu_command(tmp_path / "trajectory.h5", tmp_path / "bad.h5", {**SETTINGS, "rate_hz": 0.0})
+
+
+def test_hg1700_units_and_the_noise_laws():
+    # Datasheet units: 0.125 deg/sqrt(h) = 3.636e-5 rad/sqrt(s); 1 deg/h = 4.848e-6 rad/s;
+    # 0.0198 m/s/sqrt(h) = 3.3e-4 m/s^1.5; 1 mg = 9.80665e-3 m/s^2 (NavToolkit's HG1700 figures).
+    noise = ImuNoise.from_config(default_config()["imu"]["noise"])
+    assert noise.gyro_random_walk_rad_sqrt_s == pytest.approx(3.6361e-5, rel=1e-4)
+    assert noise.gyro_bias_rad_s == pytest.approx(4.8481e-6, rel=1e-4)
+    assert noise.accel_random_walk_m_s_sqrt_s == pytest.approx(3.30e-4, rel=1e-3)
+    assert noise.accel_bias_m_s2 == pytest.approx(9.80665e-3)
+    rng = np.random.default_rng(1)
+    # White noise of density N: the Allan deviation of 1 s averages is N / sqrt(1 s).
+    readings, _ = measured(np.zeros((200_000, 3)), 1e-3, 0.0, 1.0, 1000.0, rng)
+    averages = readings.reshape(200, 1000, 3).mean(axis=1)
+    allan = np.sqrt(0.5 * np.mean(np.diff(averages, axis=0) ** 2))
+    assert allan == pytest.approx(1e-3, rel=0.07)
+    # The bias: N(0, sigma) at turn-on, then wandering by sigma in the walk time.
+    starts, walks = [], []
+    for _ in range(300):
+        _, b = measured(np.zeros((1001, 3)), 0.0, 2.0, 1.0, 1000.0, rng)
+        starts.append(b[0])
+        walks.append(b[-1] - b[0])
+    assert np.std(starts) == pytest.approx(2.0, rel=0.08) and np.std(walks) == pytest.approx(2.0, rel=0.08)

@@ -179,7 +179,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("trajectory", help="trajectory.h5 (its nodes are re-integrated at the IMU's rate)")
     add_settings(p, IMU, "the IMU's rate and the sphere")
     p.add_argument("--output", "-o", required=True, help="imu.h5")
-    p.set_defaults(func=_calls("imu", "imu_command", "trajectory", "output", lambda a: settings_from(a, IMU)))
+    p.add_argument("--seed", type=int, default=0, help="the IMU errors' seed (default 0)")
+    p.set_defaults(func=_calls("imu", "imu_command", "trajectory", "output", lambda a: settings_from(a, IMU), "seed"))
 
     p = sub.add_parser("render", help="render the surface from every pose of a trajectory (radiance, depth, videos)")
     p.add_argument("trajectory", help="trajectory.h5 (poses)")

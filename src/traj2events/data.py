@@ -47,7 +47,8 @@ class Landing:
 
     def imu(self) -> dict[str, np.ndarray]:
         """imu.h5's streams: t (n,) s, specific_force_b (n, 3) m/s^2, angular_rate_b (n, 3)
-        rad/s, altitude_m (n,) m (docs/dataset.md)."""
+        rad/s, their *_measured with an IMU's errors and its biases, altitude_m (n,) m
+        (docs/dataset.md)."""
         return read_imu(self.folder / "imu.h5")[0]
 
     @property

@@ -120,8 +120,9 @@ def export_flags(wildcards, output):
     return " ".join(f"--{name} {output[name]}" for name in config["events"]["exports"])
 
 
-def event_seed(wildcards):
-    """One seed per trajectory, from the dataset's seed (same config, same events)."""
+def trajectory_seed(wildcards):
+    """One seed per trajectory, from the dataset's seed (same config, same events and IMU
+    noise; each stage draws from its own stream of it)."""
     key = f"{config['seed']}/{wildcards.scenario}/{wildcards.id}".encode()
     return int(hashlib.sha256(key).hexdigest()[:8], 16)
 

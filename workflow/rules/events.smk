@@ -22,7 +22,7 @@ rule events:
         runtime=resources_of("events", "runtime"),
     params:
         settings=as_json(events_settings_of),
-        seed=event_seed,
+        seed=trajectory_seed,
         exports=export_flags,
         code=code("events"),
     shell:

@@ -76,9 +76,10 @@ rule imu:
         ENV
     params:
         settings=as_json(imu_settings_of),
+        seed=trajectory_seed,
         code=code("imu"),
     shell:
-        "traj2events imu {input} --settings {params.settings:q} --output {output} 2> {log}"
+        "traj2events imu {input} --settings {params.settings:q} --seed {params.seed} --output {output} 2> {log}"
 
 
 rule dataset_index:

@@ -1,9 +1,10 @@
 """imu.h5: one trajectory's inertial and altitude streams (stages/imu.py).
 
 Datasets, one row per sample: `t` (n,) s, `specific_force_b` (n, 3) m/s^2 and
-`angular_rate_b` (n, 3) rad/s in the body axes (x forward, y right, z down),
-`altitude_m` (n,) m above the sphere through the site. Attributes say the rate, the
-sphere, gravity, the noise (none) and where the IMU sits."""
+`angular_rate_b` (n, 3) rad/s in the body axes (x forward, y right, z down), noise-free;
+the same `*_measured` with the IMU's errors, whose biases are `accel_bias_b` and
+`gyro_bias_b`; `altitude_m` (n,) m above the sphere through the site. Attributes say the
+rate, the sphere, gravity, the noise model and seed, and where the IMU sits."""
 
 from __future__ import annotations
 
@@ -14,7 +15,16 @@ import numpy as np
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, set_attrs, write_dataset
 
-COLUMNS = {"t": 1, "specific_force_b": 3, "angular_rate_b": 3, "altitude_m": 1}
+COLUMNS = {
+    "t": 1,
+    "specific_force_b": 3,
+    "angular_rate_b": 3,
+    "specific_force_b_measured": 3,
+    "angular_rate_b_measured": 3,
+    "accel_bias_b": 3,
+    "gyro_bias_b": 3,
+    "altitude_m": 1,
+}
 
 
 def write_imu(path: str | os.PathLike, streams: dict[str, np.ndarray], attrs: dict) -> None:

@@ -12,13 +12,13 @@ from ..formats.imu import write_imu
 from ..formats.trajectory import read_trajectory
 from ..progress import log
 from ..trajectory.dynamics import Dynamics
-from ..trajectory.imu import altitude_above_sphere, angular_rate_body, specific_force_body
+from ..trajectory.imu import ImuNoise, altitude_above_sphere, angular_rate_body, measured, specific_force_body
 from ..trajectory.upsample import ReintegratedStates, interpolate_controls
 
 
-def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settings: dict) -> None:
-    """imu.h5 of trajectory.h5 at settings["rate_hz"], altitude above the sphere of
-    settings["moon_radius_m"]."""
+def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settings: dict, seed: int = 0) -> None:
+    """imu.h5 of trajectory.h5 at settings["rate_hz"], the readings with settings["noise"]'s
+    errors drawn from `seed`, the altitude above the sphere of settings["moon_radius_m"]."""
     rate = float(settings["rate_hz"])
     if not rate > 0:
         raise ValueError(f"imu: rate_hz: expected > 0, got {rate}")
@@ -27,17 +27,31 @@ def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settin
     t = np.arange(int(np.floor(float(tr.t_nodes[-1]) * rate + 1e-9)) + 1) / rate
     states = ReintegratedStates(dynamics, tr.t_nodes, tr.state_nodes[0], tr.control_nodes).states(t)
     controls = interpolate_controls(tr.t_nodes, tr.control_nodes, t)
+    if seed < 0:
+        raise ValueError(f"imu: seed: expected a value >= 0, got {seed}")
+    noise = ImuNoise.from_config(settings["noise"])
+    rng = np.random.Generator(np.random.PCG64([seed, 0x1A0]))  # its own stream of the trajectory's seed
+    force, rates = specific_force_body(dynamics, states, controls), angular_rate_body(states)
+    force_measured, accel_bias = measured(force, noise.accel_random_walk_m_s_sqrt_s, noise.accel_bias_m_s2,
+                                          noise.bias_walk_time_s, rate, rng)  # fmt: skip
+    rates_measured, gyro_bias = measured(rates, noise.gyro_random_walk_rad_sqrt_s, noise.gyro_bias_rad_s,
+                                         noise.bias_walk_time_s, rate, rng)  # fmt: skip
     streams = {
         "t": t,
-        "specific_force_b": specific_force_body(dynamics, states, controls),
-        "angular_rate_b": angular_rate_body(states),
+        "specific_force_b": force,
+        "angular_rate_b": rates,
+        "specific_force_b_measured": force_measured,
+        "angular_rate_b_measured": rates_measured,
+        "accel_bias_b": accel_bias,
+        "gyro_bias_b": gyro_bias,
         "altitude_m": altitude_above_sphere(states, float(settings["moon_radius_m"])),
     }
     attrs = {
         "rate_hz": rate,
         "moon_radius_m": float(settings["moon_radius_m"]),
         "g_m_s2": tr.vehicle.g_m_s2,
-        "noise": "none",
+        "seed": seed,
+        **{f"noise_{k}": v for k, v in settings["noise"].items()},
         "imu_position": "the centre of mass (the body frame's origin)",
         "body_frame": "x forward, y right, z down (the camera frame)",
         "inertial_frame": "the site frame, as the dynamics take it: the Moon's rotation is not in angular_rate_b",

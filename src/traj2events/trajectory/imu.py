@@ -8,9 +8,14 @@ body's -z, attitude couples that add no net force) and g_i = (0, 0, g) the flat-
 gravity of the same dynamics. Hovering, f_b = (0, 0, -g): the engine's push, up.
 The site frame is taken as inertial, as the dynamics take it: the Moon's rotation
 (2.66e-6 rad/s) is not in omega_b, nor the curvature's change of gravity's direction.
+
+A real IMU adds its errors (ImuNoise, `measured`): a bias, drawn at turn-on and wandering
+as a random walk, and white noise (angle and velocity random walk), per axis.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -39,3 +44,42 @@ def angular_rate_body(states: np.ndarray) -> np.ndarray:
 def altitude_above_sphere(states: np.ndarray, radius_m: float) -> np.ndarray:
     """(n,) height above the sphere through the site (centre at (0, 0, R), z down), m."""
     return np.linalg.norm(np.asarray(states)[:, POSITION] - np.array([0.0, 0.0, radius_m]), axis=1) - radius_m
+
+
+@dataclass(frozen=True)
+class ImuNoise:
+    """An IMU's errors (1 sigma, per axis): white noise of density `*_random_walk` (angle
+    and velocity random walk) and a bias, drawn at turn-on from N(0, `*_bias`) and then
+    wandering as a random walk that reaches that same sigma in `bias_walk_time_s`."""
+
+    gyro_random_walk_rad_sqrt_s: float
+    gyro_bias_rad_s: float
+    accel_random_walk_m_s_sqrt_s: float
+    accel_bias_m_s2: float
+    bias_walk_time_s: float
+
+    @classmethod
+    def from_config(cls, noise: dict) -> ImuNoise:
+        """From imu.noise (datasheet units: deg/sqrt(h), deg/h, m/s/sqrt(h), mg, s)."""
+        deg, hour = np.pi / 180.0, 3600.0
+        return cls(
+            gyro_random_walk_rad_sqrt_s=noise["gyro_arw_deg_sqrt_h"] * deg / np.sqrt(hour),
+            gyro_bias_rad_s=noise["gyro_bias_deg_h"] * deg / hour,
+            accel_random_walk_m_s_sqrt_s=noise["accel_vrw_m_s_sqrt_h"] / np.sqrt(hour),
+            accel_bias_m_s2=noise["accel_bias_mg"] * 1e-3 * STANDARD_GRAVITY_M_S2,
+            bias_walk_time_s=noise["bias_walk_time_s"],
+        )
+
+
+STANDARD_GRAVITY_M_S2 = 9.80665  # a datasheet's "g"
+
+
+def measured(truth: np.ndarray, density: float, bias: float, walk_time_s: float, rate_hz: float, rng) -> tuple:
+    """(readings, biases), each (n, 3): truth + bias + white noise. The white noise's
+    samples have sigma density sqrt(rate) (its Allan deviation at tau is density / sqrt(tau));
+    the bias starts at N(0, bias^2) and steps by N(0, bias^2 / (walk_time rate)) per sample."""
+    n = len(truth)
+    steps = rng.normal(0.0, bias / np.sqrt(walk_time_s * rate_hz), (n, 3))
+    steps[0] = rng.normal(0.0, bias, 3)
+    biases = np.cumsum(steps, axis=0)
+    return truth + biases + rng.normal(0.0, density * np.sqrt(rate_hz), (n, 3)), biases
