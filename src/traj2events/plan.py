@@ -17,6 +17,7 @@ COSTS_PATH = Path(__file__).with_name("costs.yaml")
 COSTS = yaml.safe_load(COSTS_PATH.read_text())
 BYTES_PER_PX = COSTS["bytes_per_px"]  # per pixel per frame (per field written for the motion field)
 EXPORT_BYTES_PER_EVENTS_BYTE = COSTS["export_bytes_per_events_byte"]
+IMU_BYTES_PER_SAMPLE = COSTS["imu_bytes_per_sample"]
 RENDER_S = tuple(COSTS["cpu_s"]["render_per_frame"])  # (per frame, per pixel), encoders included
 PREVIEW_S_PER_PX = COSTS["cpu_s"]["preview_per_px"]  # of RENDER_S: the preview's encoder
 EVENTS_S = tuple(COSTS["cpu_s"]["events_per_frame"])  # (per frame, per pixel): decoding, emulation, writing
@@ -115,6 +116,7 @@ def dataset_plan(config: dict) -> Plan:
         "events.h5": events_bytes_per_px(camera["width"]) * px_frames,
         "motion_field.h5": BYTES_PER_PX["motion_field.h5"] * px_fields,
         "flow/*.flo": BYTES_PER_PX["flow/*.flo"] * px_fields,
+        "imu.h5": IMU_BYTES_PER_SAMPLE * frames / camera["fps"] * config["imu"]["rate_hz"],
     }
     if config["render"]["preview"]:
         disk["preview.mp4"] = BYTES_PER_PX["preview.mp4"] * px_frames
