@@ -38,6 +38,10 @@ def _key(path) -> str:
 
 def describe(error: jsonschema.ValidationError, prefix: list[str] | tuple = ()) -> str:
     """One line naming the config key (`prefix`: the key of the value that was validated)."""
+    if error.validator in ("oneOf", "anyOf") and error.context:
+        # A value or a range, say: what the branch of the value's own type says.
+        typed = [e for e in error.context if e.validator != "type"]
+        return describe(typed[0] if typed else jsonschema.exceptions.best_match(error.context), prefix)
     where = _key([*prefix, *error.absolute_path])
     v, schema_value, got = error.validator, error.validator_value, error.instance
     if v == "required":
@@ -86,8 +90,8 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"config key 'scenarios.{name}': the name '{name}' is reserved for results/{name}/ "
             f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
         )
-    for key in RANGE_KEYS:
-        lo, hi = sc[key]
+    sun = [(f"sun.{k}", sc["sun"][k]) for k in ("azimuth_deg", "elevation_deg") if isinstance(sc["sun"][k], list)]
+    for key, (lo, hi) in [(key, sc[key]) for key in RANGE_KEYS] + sun:
         if lo > hi:
             errors.append(f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}")
     tilt = config["vehicle"]["tilt_max_deg"]
@@ -193,7 +197,7 @@ def _display_errors(config: dict) -> list[str]:
     from .scene.sun import Sun
 
     factor = max_radiance_factor(ReflectanceParams(**config["render"]["reflectance"]), n=21)
-    irradiance = max(Sun(**sc["sun"]).irradiance_w_m2 for sc in config["scenarios"].values())
+    irradiance = max(Sun(sc["sun"]["range_m"], 0.0, 90.0).irradiance_w_m2 for sc in config["scenarios"].values())
     brightest = factor * irradiance / math.pi
     white = config["render"]["display_white_w_m2_sr"]
     if white > 10 * brightest:

@@ -67,8 +67,8 @@ def scenario_settings(wildcards):
 
 
 def render_settings(wildcards):
-    """Everything one scenario's frames depend on, as JSON (camera, terrain, Sun, reflectance, LOD)."""
-    return json.dumps(render_settings_of(config, wildcards.scenario), sort_keys=True)
+    """Everything one trajectory's frames depend on, as JSON (camera, terrain, its Sun, reflectance, LOD)."""
+    return json.dumps(render_settings_of(config, wildcards.scenario, wildcards.id), sort_keys=True)
 
 
 def elevation_grid(wildcards):

@@ -1,7 +1,10 @@
-"""Settings of one scenario's rendering, and of when to render (`render.timing`)."""
+"""Settings of one scenario's rendering (one trajectory's, where its Sun is drawn), and of
+when to render (`render.timing`)."""
 
 from __future__ import annotations
 
+import hashlib
+import random
 from dataclasses import dataclass
 
 from ..geometry.camera import horizon_distance_m
@@ -34,8 +37,25 @@ class FrameTiming:
             raise ValueError("render.timing: adaptive needs max_log_change or max_displacement_px (both are null)")
 
 
-def render_settings(config: dict, name: str) -> dict:
-    """Everything one scenario's frames depend on: camera, sphere, terrain, Sun,
+def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> dict:
+    """The Sun of one trajectory of scenario `name` (scenarios.<name>.sun): an azimuth or
+    elevation given as [low, high] is drawn uniformly for each trajectory from the dataset's
+    seed, the scenario and `trajectory_id` (the same config, the same Suns); without an id,
+    the range's middle."""
+    sun = dict(config["scenarios"][name]["sun"])
+    ranges = [k for k in ("azimuth_deg", "elevation_deg") if isinstance(sun[k], list)]
+    if ranges and trajectory_id is None:
+        return {**sun, **{k: 0.5 * (sun[k][0] + sun[k][1]) for k in ranges}}
+    if ranges:
+        key = f"{config['seed']}/{name}/{trajectory_id}/sun".encode()
+        rng = random.Random(int(hashlib.sha256(key).hexdigest()[:16], 16))
+        sun.update({k: rng.uniform(*sun[k]) for k in ranges})
+    return sun
+
+
+def render_settings(config: dict, name: str, trajectory_id: str | None = None) -> dict:
+    """Everything one scenario's frames depend on (the Sun: `trajectory_id`'s, where the
+    config gives it as a range; scenario_sun): camera, sphere, terrain, Sun,
     reflectance, level of detail and its extent, display mapping, frame timing, stars, and
     with adaptive timing the emulator's input (its scale sets the predicted log change)."""
     sc = config["scenarios"][name]
@@ -54,7 +74,7 @@ def render_settings(config: dict, name: str) -> dict:
         "mount_height_m": float(camera["mount_height_m"]),
         "moon_radius_m": radius,
         "terrain": dict(config["terrain"]),
-        "sun": dict(sc["sun"]),
+        "sun": scenario_sun(config, name, trajectory_id),
         "earth": dict(sc["earth"]) if sc.get("earth") else None,
         "reflectance": dict(r["reflectance"]),
         "lod": dict(r["lod"]),
