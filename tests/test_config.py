@@ -239,6 +239,14 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"scenarios": {"descent": {"tf_guess_s": 5000.0}}}, ["scenarios.descent.tf_guess_s", "[ocp.tf_min_s"]),
     ({"ocp": {"refine_n_nodes": 40}}, ["ocp.refine_n_nodes", "more than ocp.n_nodes"]),
     ({"terrain": {"crater_diameter_min_m": 50.0, "crater_diameter_max_m": 10.0}}, ["terrain.crater_diameter_min_m"]),
+    # Physically impossible values, refused by the bound they break.
+    ({"scenarios": {"descent": {"n_trajectories": 2.0}}}, ["scenarios.descent.n_trajectories", "integer"]),
+    ({"events": {"sensor": {"dark_current_a": 1.0}}}, ["events.sensor.dark_current_a", "<= 1e-10"]),
+    ({"events": {"sensor": {"pixel_pitch_m": 1.0}}}, ["events.sensor.pixel_pitch_m", "<= 0.0001"]),
+    ({"events": {"sensor": {"band_m": [1e-9, 2e-9]}}}, ["events.sensor.band_m.0", ">= 2e-07"]),
+    ({"terrain": {"boulder_diameter_min_m": 9.0}}, ["terrain.boulder_diameter_min_m", "boulder_diameter_max_m"]),
+    ({"terrain": {"boulder_density_k": 0.2}}, ["terrain.boulder_density_k", "cover 83%"]),
+    ({"events": {"window_ms": 1e5}}, ["events.window_ms", "shortest flight"]),
     ({"events": {"pixel": {"hot_pixel_fraction": 0.01}}}, ["events.pixel.hot_pixel_hz", "> 0"]),
     (
         {"events": {"hot_pixel_fraction": 0.01}},

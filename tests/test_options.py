@@ -77,7 +77,7 @@ def test_the_workflows_pixel_values_pass_unchanged():
         ),
         (["--settings", "[1]"], "--settings: expected a JSON object"),
         (["--theta-off", "0"], "--theta-off: config key 'events.pixel.theta_off': expected a value >= 0.01, got 0.0"),
-        (["--band-m", "1", "-1"], "--band-m: config key 'events.sensor.band_m.1': expected a value > 0"),
+        (["--band-m", "1e-6", "-1"], "--band-m: config key 'events.sensor.band_m.1': expected a value >= 2e-07"),
         (["--quantum-efficiency", "2"], "--quantum-efficiency: config key 'events.sensor.quantum_efficiency'"),
     ],
 )

@@ -155,8 +155,18 @@ def _semantic_errors(config: dict) -> list[str]:
     if ocp["refine_n_nodes"] and ocp["refine_n_nodes"] <= ocp["n_nodes"]:
         errors.append(f"config key 'ocp.refine_n_nodes': expected 0 or more than ocp.n_nodes = {ocp['n_nodes']}, "
                       f"got {ocp['refine_n_nodes']}")  # fmt: skip
-    if terrain["crater_diameter_min_m"] > terrain["crater_diameter_max_m"]:
-        errors.append("config key 'terrain.crater_diameter_min_m': expected at most terrain.crater_diameter_max_m")
+    for kind in ("crater", "boulder"):
+        if terrain[f"{kind}_diameter_min_m"] > terrain[f"{kind}_diameter_max_m"]:
+            errors.append(f"config key 'terrain.{kind}_diameter_min_m': expected at most terrain.{kind}_diameter_max_m")
+    covered = _boulder_cover(terrain)
+    if covered > 0.5:
+        errors.append(f"config key 'terrain.boulder_density_k': boulders would cover {covered:.0%} of the ground "
+                      f"(pi/4 of D^2 summed over N(>D) = K D^-slope from the smallest to the largest); "
+                      f"expected at most 50 %, got K = {terrain['boulder_density_k']}")  # fmt: skip
+    flight_ms = 1000 * min(sc["tf_guess_s"] for sc in config["scenarios"].values())
+    if config["events"]["window_ms"] > flight_ms:
+        errors.append(f"config key 'events.window_ms': expected at most the shortest flight, {flight_ms:g} ms "
+                      f"(scenarios' tf_guess_s), got {config['events']['window_ms']}")  # fmt: skip
     pixel = config["events"]["pixel"]
     if pixel["hot_pixel_fraction"] > 0 and not pixel["hot_pixel_hz"] > 0:
         errors.append("config key 'events.pixel.hot_pixel_hz': expected > 0 when events.pixel.hot_pixel_fraction > 0")
@@ -208,9 +218,30 @@ def _display_errors(config: dict) -> list[str]:
     return []
 
 
+# An integer key takes integers only: JSON Schema counts 2.0 as one, and the stages would
+# then meet a float where they count (range(2.0)).
+_Validator = jsonschema.validators.extend(
+    jsonschema.Draft202012Validator,
+    type_checker=jsonschema.Draft202012Validator.TYPE_CHECKER.redefine(
+        "integer", lambda _, value: isinstance(value, int) and not isinstance(value, bool)
+    ),
+)
+
+
+def _boulder_cover(terrain: dict) -> float:
+    """Share of the ground boulders cover: the integral of (pi/4) D^2 |dN/dD| from the smallest
+    diameter to the largest, N(>D) = K D^-s per m^2 (terrain.boulder_*)."""
+    k, s = terrain["boulder_density_k"], terrain["boulder_slope"]
+    lo, hi = terrain["boulder_diameter_min_m"], terrain["boulder_diameter_max_m"]
+    if k == 0 or hi <= lo:
+        return 0.0
+    power = math.log(hi / lo) if s == 2 else (hi ** (2 - s) - lo ** (2 - s)) / (2 - s)
+    return math.pi / 4 * k * s * power
+
+
 def validate_config(config: Any, schema: dict | None = None) -> None:
     """Raise ConfigError naming the first offending key (schema first, then semantics)."""
-    validator = jsonschema.Draft202012Validator(schema if schema is not None else load_yaml(SCHEMA_PATH))
+    validator = _Validator(schema if schema is not None else load_yaml(SCHEMA_PATH))
     errors = sorted(
         validator.iter_errors(config), key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path)))
     )
