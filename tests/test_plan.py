@@ -86,3 +86,21 @@ def test_events_grow_faster_than_the_pixels_as_measured():
     # 0.73 bytes per pixel over the default dataset at 128^2, 1.55 at 1024^2
     assert events_bytes_per_px(128) == pytest.approx(0.73)
     assert events_bytes_per_px(1024) == pytest.approx(1.55, rel=0.03)
+
+
+def test_every_per_trajectory_rule_is_in_the_slurm_profiles_trajectory_group():
+    # A rule whose outputs sit in results/{scenario}/{id}/ left out of the group would be
+    # one more SLURM submission per trajectory (seconds of scheduling each).
+    import re
+
+    import yaml
+
+    per_trajectory = set()
+    for path in (ROOT / "workflow" / "rules").glob("*.smk"):
+        for name, body in re.findall(r"^rule (\w+):\n((?:[ \t]+.*\n|\n)*)", path.read_text(), re.M):
+            output = body.split("output:", 1)[1].split("\n    log:", 1)[0] if "output:" in body else ""
+            if "{id}" in output:
+                per_trajectory.add(name)
+    groups = yaml.safe_load((ROOT / "profiles" / "slurm" / "config.yaml").read_text())["groups"]
+    assert {"camera_poses", "render", "events", "imu"} <= per_trajectory
+    assert per_trajectory == {rule for rule, group in groups.items() if group == "trajectory"}

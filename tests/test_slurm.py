@@ -40,7 +40,7 @@ def test_smoke_dataset_on_slurm_equals_a_local_run(cluster, tmp_path):
     run = on_slurm(tmp_path / "slurm", cluster)
     out = run.stdout + run.stderr
     assert run.returncode == 0, out[-4000:]
-    # Each trajectory's eight jobs went as one SLURM job (a group), not eight.
+    # Each trajectory's nine jobs went as one SLURM job (a group), not nine.
     assert out.count("Group job trajectory") == 2
     assert "SLURM jobid" in out
     snakemake(tmp_path / "local")
