@@ -16,6 +16,7 @@ command -v git >/dev/null || need_apt+=(git)
 command -v ffmpeg >/dev/null || need_apt+=(ffmpeg)                     # video (FFV1, H.264)
 { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || need_apt+=(libosmesa6)  # headless OpenGL for pyrender
 { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libEGL_mesa.so || need_apt+=(libegl1 libegl-mesa0)  # EGL (render.backend)
+if [[ -n "$extras" ]]; then command -v h5dump >/dev/null || need_apt+=(hdf5-tools); fi  # tests read the files as C users do
 if ((${#need_apt[@]})); then
   echo "setup: installing system packages: ${need_apt[*]}"
   SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"

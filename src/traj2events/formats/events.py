@@ -8,7 +8,7 @@ import os
 import numpy as np
 
 from .atomic import atomic_output, ensure_free_space
-from .hdf5 import Attributes, blosc, create, open_file, set_attrs
+from .hdf5 import Attributes, blosc, create, mark_blosc, open_file, set_attrs
 
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
 
@@ -65,6 +65,7 @@ class EventsWriter:
         if labels:
             set_attrs(self._sets["label"], {"label_names": ",".join(EVENT_LABELS)})
         self._file.create_dataset("t_offset", data=np.int64(t_offset_us), track_times=False)
+        mark_blosc(self._file)
         set_attrs(self._file, {"width": width, "height": height, **attrs})
         self.t_offset_us = t_offset_us
         self.n = 0  # events appended

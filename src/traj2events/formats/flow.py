@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import ChunkWriter, blosc, create, write_dataset
+from .hdf5 import ChunkWriter, blosc, create, mark_blosc, write_dataset
 
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
@@ -62,6 +62,7 @@ def motion_field_file(
     # for a few per cent more bytes (bench/motion_field_command.py).
     compression = blosc("lz4", 5, bitshuffle=False)
     with atomic_output(path) as tmp, create(tmp) as f:
+        mark_blosc(f)
         write_dataset(f, "t", t)
         write_dataset(f, "frame_index", frame_index)
         writers = {}

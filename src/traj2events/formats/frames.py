@@ -23,6 +23,7 @@ from .hdf5 import (
     FileFormatError,
     blosc,
     create,
+    mark_blosc,
     open_for_reading,
     set_attrs,
     write_dataset,
@@ -65,6 +66,7 @@ class FramesWriter:
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
+        mark_blosc(self._file)
         self._t: list[float] = []
         self._frame_index: list[int] = []
         self._sets = {

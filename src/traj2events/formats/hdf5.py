@@ -14,10 +14,31 @@ from typing import Iterator
 import h5py
 import numpy as np
 
+# What a reader needs, in every file's root attributes (docs/dataset.md "Reading the files
+# without Python"): gzip by default; files with Blosc datasets say so (mark_blosc).
+GZIP_READING = {
+    "compression": "gzip and shuffle (HDF5's own filters)",
+    "reading": "any HDF5 reader",
+}
+BLOSC_READING = {
+    "compression": "Blosc (HDF5 filter 32001, from hdf5plugin) for the large datasets, gzip for the others",
+    "reading": "Python: import hdf5plugin before reading with h5py. Other readers (h5dump, HDFView, MATLAB, "
+    "Julia, C): set HDF5_PLUGIN_PATH to hdf5plugin's plugins folder "
+    "(python -c 'import hdf5plugin; print(hdf5plugin.PLUGIN_PATH)'); without it h5dump prints empty data",
+}
+
 
 def create(path: Path) -> h5py.File:
-    """A new HDF5 file for writing (normally the temporary path of `atomic_output`)."""
-    return h5py.File(path, "w", libver=("v110", "v110"), track_order=True)
+    """A new HDF5 file for writing (normally the temporary path of `atomic_output`), its
+    root attributes saying how it is compressed and read (GZIP_READING; mark_blosc)."""
+    f = h5py.File(path, "w", libver=("v110", "v110"), track_order=True)
+    set_attrs(f, GZIP_READING)
+    return f
+
+
+def mark_blosc(f: h5py.File) -> None:
+    """Say in `f`'s root attributes that some of its datasets need the Blosc plugin."""
+    set_attrs(f, BLOSC_READING)
 
 
 def blosc(cname: str = "zstd", clevel: int = 1, bitshuffle: bool = True) -> dict:
