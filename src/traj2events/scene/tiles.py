@@ -18,8 +18,9 @@ Building a tile is mostly evaluating the terrain's heights on its grid: with a t
 TileSet with the same terrain, quadtree and Sun side, in this process or another. A drawn
 tile's shading texture (its area evaluated `levels` levels finer) is stored there too, whole.
 
-Light scattered into shadows (scattering.py): per tile vertex, a horizon march over the
-tile's grid and its ancestors' (coarser, wider) grids of heights and sunlit fractions.
+Light scattered into shadows (scattering.py): per drawn tile's vertex, a horizon march over
+the tile's grid, then over the 3 x 3 tiles around each of its ancestors (coarser, wider
+grids of heights and sunlit fractions), computed when the renderer first asks.
 
 Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
 grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights

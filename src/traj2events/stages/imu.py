@@ -22,13 +22,13 @@ def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settin
     rate = float(settings["rate_hz"])
     if not rate > 0:
         raise ValueError(f"imu: rate_hz: expected > 0, got {rate}")
+    if seed < 0:
+        raise ValueError(f"imu: seed: expected a value >= 0, got {seed}")
     tr = read_trajectory(trajectory)
     dynamics = Dynamics(tr.vehicle)
     t = np.arange(int(np.floor(float(tr.t_nodes[-1]) * rate + 1e-9)) + 1) / rate
     states = ReintegratedStates(dynamics, tr.t_nodes, tr.state_nodes[0], tr.control_nodes).states(t)
     controls = interpolate_controls(tr.t_nodes, tr.control_nodes, t)
-    if seed < 0:
-        raise ValueError(f"imu: seed: expected a value >= 0, got {seed}")
     noise = ImuNoise.from_config(settings["noise"])
     rng = np.random.Generator(np.random.PCG64([seed, 0x1A0]))  # its own stream of the trajectory's seed
     force, rates = specific_force_body(dynamics, states, controls), angular_rate_body(states)
