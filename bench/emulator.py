@@ -118,9 +118,8 @@ def profile(n_frames: int) -> None:
 
     columns = {
         "advance": "frame pass",
+        "shot_noise_events": "noise",
         "emit": "event times",
-        "noise_candidates": "noise",
-        "reset_reference": "reference resets",
         "assemble": "ordering",
     }
     for name in columns:

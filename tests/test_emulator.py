@@ -131,31 +131,25 @@ def test_shot_noise_rate_balance_and_exponential_intervals():
     assert stats.kstest(gaps, "expon", args=(0, gaps.mean())).pvalue > 0.001
 
 
-@pytest.mark.parametrize("weights", [[1.0, 2.0, 3.0, 4.0], [1.0] * 7 + [25.0]])
-def test_noise_candidates_pick_pixels_by_weight_uniform_in_time(weights):
-    # The packed alias table and the branch-free thinning kernel, directly: with I = 0 every
-    # candidate is kept (g = g_max), so the counts follow the weights alone.
-    from traj2events.sensor.noise import alias_table, noise_candidates
-
-    weights = np.array(weights)
-    n = 400_000
-    pix, t, on = np.empty(n, np.int64), np.empty(n), np.empty(n, np.bool_)
-    g_max = 1.0 - 0.75 * 20.0 / 275.0
-    k = noise_candidates(
-        n, np.uint64(12345), alias_table(weights), np.zeros(len(weights), np.uint8), 1.0, g_max, 2.0, 0.01, pix, t, on
-    )
-    assert k == n
-    expected = n * weights / weights.sum()
-    counts = np.bincount(pix, minlength=len(weights))
-    assert np.all(np.abs(counts - expected) < 5 * np.sqrt(expected))
-    assert 2.0 <= t.min() and t.max() < 2.01
-    assert stats.kstest((t - 2.0) / 0.01, "uniform").pvalue > 0.001
-    assert on.mean() == pytest.approx(0.5, abs=5 * 0.5 / np.sqrt(n))
-    # Bright pixels keep only g(I) / g_max of their candidates.
-    bright = np.full(len(weights), 255, np.uint8)
-    kept = noise_candidates(n, np.uint64(7), alias_table(weights), bright, 1.0, g_max, 0.0, 0.01, pix, t, on)
-    g = 1 - 0.75 * (255 + 20) / 275
-    assert kept == pytest.approx(n * g / g_max, abs=5 * np.sqrt(n * 0.25))
+def test_shot_noise_per_pixel_scales_as_the_nominal_over_its_own_threshold():
+    # Mismatch freezes each pixel's threshold; its noise rate is R g(0) theta_nom / theta(x).
+    params = replace(CLEAN, shot_noise_hz=50.0, sigma=0.08)
+    h, w, n_frames = 60, 60, 401
+    emu = EventEmulator(w, h, params, seed=9)
+    ev = emu.process(np.zeros((n_frames, h, w)), np.arange(n_frames) / FPS)
+    counts = np.bincount(ev["y"].astype(int) * w + ev["x"], minlength=h * w)
+    weight = 0.25 / (0.5 * (emu.theta_on.astype(float) + emu.theta_off))
+    expected = 50.0 * (1 - 0.75 * 20 / 275) * weight * (n_frames - 1) / FPS
+    assert counts.sum() == pytest.approx(expected.sum(), rel=4 / np.sqrt(expected.sum()))
+    # the least and most sensitive thirds differ as their weights say (~1.4x at sigma = 0.08)
+    order = np.argsort(weight)
+    low, high = order[: len(order) // 3], order[-len(order) // 3 :]
+    ratio = counts[high].sum() / counts[low].sum()
+    assert ratio == pytest.approx(expected[high].sum() / expected[low].sum(), rel=0.05)
+    # times uniform within their intervals, ON and OFF equally likely
+    phase = (ev["t"] % 10_000) / 10_000
+    assert stats.kstest(phase, "uniform").pvalue > 1e-3
+    assert ev["p"].mean() == pytest.approx(0.5, abs=4 * 0.5 / np.sqrt(len(ev)))
 
 
 def test_leak_is_on_only_at_the_expected_mean_rate():
@@ -493,9 +487,9 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     filtered, base = rng.uniform(0.0, 5.0, n), np.zeros(n)
     f0 = filtered.copy()
     theta = np.full(n, 100.0, np.float32)  # no crossings: only the low-pass is looked at
-    work = [np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
-    advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), cutoff_hz, dt, scale,
-             *work, _NO_TABLE, _NO_TABLE, _NO_TABLE, np.zeros(n, np.int64), 0)  # fmt: skip
+    slots = [np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
+    advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), _NO_TABLE, cutoff_hz, dt, scale,
+            _NO_TABLE, _NO_TABLE, 0, *slots)  # fmt: skip
     dn0, dn1 = i0.astype(np.float64) * scale, i1.astype(np.float64) * scale
     target = np.where(dn1 <= 20.0, dn1 * (np.log(20.0) / 20.0), np.log(np.maximum(dn1, 20.0)))
     gain = -np.expm1(-(2.0 * np.pi * dt) * (cutoff_hz * (0.5 * (dn0 + dn1) + 20.0) / 275.0))

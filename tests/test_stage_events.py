@@ -228,7 +228,7 @@ def test_a_lens_blur_spreads_a_step_edges_events_over_its_width(tmp_path):
     for name, blur_um in (("pinhole", 0.0), ("lens", sensor["pixel_pitch_m"] * 1e6)):
         settings = {"preset": "clean", "pixel": dict(preset_params("clean").__dict__), "input": "sensor",
                     "sensor": {**sensor, "lens_blur_um": blur_um}, "labels": False,
-                    "readout": default_config()["events"]["readout"]}  # fmt: skip
+                    "readout": default_config()["events"]["readout"], "device": "cpu"}  # fmt: skip
         events_command(tmp_path / "frames.h5", tmp_path / f"{name}.h5", settings, 0)
         events, attrs = read_events(tmp_path / f"{name}.h5")
         columns[name] = np.bincount(events["x"], minlength=32) / 8  # events per pixel, per column

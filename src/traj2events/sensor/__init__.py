@@ -5,10 +5,13 @@ Read first (the model):
     laws           the pixel's laws, each written once: lin-log response, bandwidth and
                    low-pass gain, shot-noise gain, refractory period
     emulator       the streaming emulator: per-pixel state, the eight steps of the model
-    pixel          the per-pixel loop over one frame interval (crossings, their times)
+    pixel          the model of one pixel over one frame interval (crossings, their times),
+                   and its two passes over a frame on the CPU
+    noise          shot noise (thinning per block of pixels) and hot pixels
 
 Machinery a reader may skip:
-    noise          shot noise drawn by thinning from an alias table, prefetched
+    draws          random draws keyed by (seed, interval, pixel, draw): counter-based hashing
+    cuda_kernels   the same model on an NVIDIA GPU, one thread per pixel
     ordering       each interval's events sorted by (t, y, x, p) with packed keys
     parallel       the per-pixel pass split over threads
 """

@@ -14,8 +14,8 @@ Per frame interval [t_k, t_k+1]:
   6. leak: base drifts down by theta_on per leak period (rate
      R_leak 10^(0.1 N(0, 1)) per pixel, from a random phase)               (pixel.advance)
   7. shot noise: Poisson ON/OFF events at R_shot g(I) theta_nom / theta(x);
-     a noise event resets the pixel's reference to its current signal       (_shot_noise, noise)
-  8. hot pixels: a fraction of pixels firing ON at a fixed rate            (_hot_pixel_events)
+     a noise event resets the pixel's reference to its current signal       (pixel, draws)
+  8. hot pixels: a fraction of pixels firing ON at a fixed rate            (pixel, draws)
 
 Events are a numpy structured array (x, y, t, p) in tonic's convention: x column, y row
 (uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t (or, from
@@ -23,13 +23,14 @@ Events are a numpy structured array (x, y, t, p) in tonic's convention: x column
 event also gets its cause (`formats.events.EVENT_LABELS`): signal, shot noise, leak or hot
 pixel; the labels never change the events. Streaming: `EventEmulator.process` takes any
 number of frames at a time and keeps only per-pixel state, and every random draw is keyed
-by (seed, frame interval), so the output is the same bytes however the video is chunked.
+by (seed, frame interval, pixel) (`draws`), so the output is the same bytes however the
+video is chunked and whichever thread or device does a pixel.
 Input: 8-bit DN, or float DN-equivalents of linear radiance (radiance times `input_scale`,
 applied per pixel in float64 inside the kernels).
 
 Read this module, `pixel` (the per-pixel loop) and `laws`; the machinery behind them is
-`noise` (drawing shot noise fast), `ordering` (sorting each interval's events) and
-`parallel` (the per-pixel pass split over threads).
+`draws` (random numbers keyed by what they are for), `ordering` (sorting each interval's
+events) and `parallel` (the per-pixel pass split over threads).
 """
 
 from __future__ import annotations
@@ -39,12 +40,13 @@ from typing import Iterator
 
 import numpy as np
 
-from ..formats.events import EVENT_DTYPE, HOT_PIXEL, SHOT_NOISE
-from .laws import log_intensity_8bit, lowpass_gain, shot_noise_gain
-from .noise import alias_table, noise_candidates, reset_reference
+from ..formats.events import EVENT_DTYPE
+from .draws import HOT_PIXEL_STREAM, SHOT_NOISE_STREAM, interval_key
+from .laws import log_intensity_8bit, lowpass_gain
+from .noise import block_majorants, shot_noise_events
 from .ordering import assemble
 from .parallel import RangedPass, pixel_ranges
-from .pixel import advance, emit, refractory_mask
+from .pixel import advance, emit, hot_pixel_counts
 
 
 @dataclass(frozen=True)
@@ -83,7 +85,8 @@ def _rng(seed: int, *key: int) -> np.random.Generator:
 
 _LOG_LUT_8BIT = log_intensity_8bit(np.arange(256.0))  # every value 8-bit input can take
 _NO_TABLE = np.empty(0)
-_NO_EVENTS = (np.empty(0, np.int64), np.empty(0), np.empty(0, np.bool_))  # (pixel, t s, ON)
+_NO_PIXELS = np.empty(0, np.int64)
+DEVICES = ("cpu", "cuda")
 
 
 class EventEmulator:
@@ -98,13 +101,18 @@ class EventEmulator:
         labels: bool = False,
         input_scale: float = 1.0,
         threads: int = 1,
+        device: str = "cpu",
     ) -> None:
         """`labels`: also label each event with its cause (`process_with_labels`).
         `input_scale`: the frames times this are the model's DN (e.g. radiance times
         `sensor.dn_per_radiance`), applied per pixel in float64, so float32 frames need
         no float64 copy; 8-bit frames with a scale of 1 use tables. `threads`: the per-pixel
         pass split over up to this many threads (rows of at least PIXELS_PER_THREAD pixels
-        each); the same events however many."""
+        each); the same events however many. `device`: "cpu", or "cuda" for the pixel model
+        on the GPU (`cuda_kernels`: the same events, but where the GPU's math library
+        rounds a crossing differently)."""
+        if device not in DEVICES:
+            raise ValueError(f"EventEmulator: device: expected one of {DEVICES}, got {device!r}")
         if not (input_scale > 0 and np.isfinite(input_scale)):
             raise ValueError(f"EventEmulator: input_scale: expected a finite value > 0, got {input_scale}")
         if not (isinstance(threads, int) and threads >= 1):
@@ -125,14 +133,6 @@ class EventEmulator:
         )
         self.leak_rate = params.leak_hz * 10.0 ** (0.1 * rng.standard_normal(n)) if params.leak_hz else np.zeros(n)
         self.leak_phase = rng.uniform(0.0, 1.0, n)
-        # Shot noise per pixel scales with theta_nominal / theta(x) (frozen: computed once).
-        self._noise_theta = 0.5 * (self.theta_on + self.theta_off)
-        # Thinning majorant: g(I) at its largest (I = 0) times each pixel's theta_nom / theta(x);
-        # candidates pick their pixel by that weight (alias table), so none is wasted on it.
-        self._g_max = float(shot_noise_gain(0.0))
-        weights = params.theta_on / self._noise_theta
-        self._noise_rate_total = params.shot_noise_hz * self._g_max * float(weights.sum())
-        self._alias = alias_table(weights) if params.shot_noise_hz > 0 else None
         hot = rng.uniform(size=n) < params.hot_pixel_fraction
         self.hot_pixels = np.flatnonzero(hot)
         self._filtered: np.ndarray | None = None  # low-passed log intensity at the last frame
@@ -143,14 +143,23 @@ class EventEmulator:
         # pass to read, and these are random draws whose last bits carry nothing.
         self._leak_step = (self.theta_on * self.leak_rate).astype(np.float32)
         self.theta_on, self.theta_off = self.theta_on.astype(np.float32), self.theta_off.astype(np.float32)
+        self._noise_majorants = block_majorants(self.theta_on, self.theta_off, params.theta_on)  # thinning (7.)
         # Work arrays of the compiled kernels, reused every frame.
         self._count = np.zeros(n, np.int64)
         self._x0 = np.zeros(n)
         self._x1 = np.zeros(n)
         self._active = np.zeros(n, np.int64)
         self._n_leak = np.zeros(n, np.int64)
+        self._noise = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.bool_))  # grown as needed
         self._leak_drift = _NO_TABLE  # unspent leak drift per pixel (labels only)
         self._ranged_pass = RangedPass(pixel_ranges(n, threads))
+        self._gpu = None
+        if device == "cuda":
+            from .cuda_kernels import CudaPixels  # numba.cuda only where asked for
+
+            self._gpu = CudaPixels(
+                self.theta_on, self.theta_off, self._leak_step, self._noise_majorants, self.hot_pixels, self.labels
+            )
         self._t: float | None = None
         self._interval = 0  # index of the next frame interval (keys the random draws)
 
@@ -233,22 +242,25 @@ class EventEmulator:
         self._base = log_i - phase_drift
         if self.labels:  # that offset is leak drift, pending from the start
             self._leak_drift = phase_drift.astype(np.float64)
+        if self._gpu is not None:
+            self._gpu.start(intensity, self._filtered, self._base, self._leak_drift)
 
-    def _advance_ranges(self, intensity0, intensity1, cutoff_hz, dt, log_lut, gain_lut) -> int:
+    def _advance_ranges(self, intensity0, intensity1, dt, log_lut, gain_lut) -> int:
         """`pixel.advance` over every pixel, a range of pixels per thread; returns how many
         pixels cross, listed in pixel order in the slots."""
         per_pixel = (self._filtered, self._base, self.theta_on, self.theta_off, self._leak_step)
-        slots = (self._count, self._x0, self._x1, self._active)
+        slots = (self._active, self._count, self._x0, self._x1, self._n_leak)
+        cutoff_hz = float(self.params.cutoff_hz)
 
         def advance_range(start: int, stop: int) -> int:
             r = slice(start, stop)
             return advance(
-                intensity0[r], intensity1[r], *(a[r] for a in per_pixel), cutoff_hz, dt, self.input_scale,
-                *(a[r] for a in slots), log_lut, gain_lut, self._leak_drift[r] if self.labels else self._leak_drift,
-                self._n_leak[r], start,
+                intensity0[r], intensity1[r], *(a[r] for a in per_pixel),
+                self._leak_drift[r] if self.labels else self._leak_drift, cutoff_hz, dt, self.input_scale,
+                log_lut, gain_lut, start, *(a[r] for a in slots),
             )  # fmt: skip
 
-        return self._ranged_pass(advance_range, (*slots, self._n_leak))
+        return self._ranged_pass(advance_range, slots)
 
     def _interval_events(
         self, intensity: np.ndarray, t1: float, columns: bool = False
@@ -256,7 +268,7 @@ class EventEmulator:
         p = self.params
         t0, dt = self._t, t1 - self._t
         # x = signal - base, linear in t within the interval: low-pass (exact, bandwidth from
-        # the interval's mean input), log, the leak's drift of base, crossings.
+        # the interval's mean input), log, the leak's drift of base, crossings; and the noise.
         if intensity.dtype != self._intensity.dtype:  # 8-bit and float frames mixed: all float
             intensity, self._intensity = intensity.astype(np.float64), self._intensity.astype(np.float64)
         if intensity.dtype == np.uint8:
@@ -264,84 +276,55 @@ class EventEmulator:
             gain_lut = lowpass_gain(0.5 * np.arange(511.0), p.cutoff_hz, dt)  # by I0 + I1
         else:
             log_lut = gain_lut = _NO_TABLE
-        n_active = self._advance_ranges(self._intensity, intensity, float(p.cutoff_hz), dt, log_lut, gain_lut)
-        n_signal = int(np.abs(self._count[:n_active]).sum())
-        self._interval += 1
-        # Noise and hot-pixel events are drawn first (the draws depend on the input alone), so
-        # that the signal's events go straight into arrays with room for them: no copy of the
-        # signal's (most of the events) to join them.
-        noise = self._shot_noise(intensity, t0, dt)
-        hot = self._hot_pixel_events(t0, dt)
-        n_room = n_signal + len(noise[0]) + len(hot[0])
+        if self._gpu is not None:
+            pix, t, on, label = self._gpu.interval(
+                intensity, self.input_scale, dt, t0, p, interval_key(self.seed, SHOT_NOISE_STREAM, self._interval),
+                interval_key(self.seed, HOT_PIXEL_STREAM, self._interval),
+            )  # fmt: skip
+            self._intensity, self._t = intensity, t1
+            self._interval += 1
+            return assemble(pix, t, on, label if self.labels else None, self.width, self.width * self.height, columns)
+        n_active = self._advance_ranges(self._intensity, intensity, dt, log_lut, gain_lut)
+        noise_pix, noise_s, noise_on, n_noise = self._shot_noise(intensity, dt)
+        hot_key = interval_key(self.seed, HOT_PIXEL_STREAM, self._interval)
+        hot_pixels = self.hot_pixels if p.hot_pixel_hz > 0 else _NO_PIXELS
+        hot_counts = hot_pixel_counts(hot_pixels, hot_key, float(p.hot_pixel_hz), dt)
+        n_room = int(np.abs(self._count[:n_active]).sum()) + n_noise + int(hot_counts.sum())
         pix = np.empty(n_room, np.int64)
         t = np.empty(n_room, np.float64)
         on = np.empty(n_room, np.bool_)
         label = np.empty(n_room, np.uint8)
         k = emit(
-            self._active,
-            n_active,
-            self._count,
-            self._x0,
-            self._x1,
-            self.theta_on,
-            self.theta_off,
-            self._base,
-            self._last_event,
-            t0,
-            dt,
-            float(p.refractory_s),
-            p.refractory_mode == "defer",
-            self._n_leak,
-            pix,
-            t,
-            on,
-            label,
-        )
-        noise = self._noise_after_signal(*noise)
+            self._active, n_active, self._count, self._x0, self._x1, self._n_leak, noise_pix, noise_s, noise_on,
+            n_noise, hot_pixels, hot_counts, hot_key, float(p.hot_pixel_hz), self.theta_on, self.theta_off,
+            self._filtered, self._base, self._leak_drift, self._last_event, t0, dt, float(p.refractory_s),
+            p.refractory_mode == "defer", pix, t, on, label,
+        )  # fmt: skip
         self._intensity, self._t = intensity, t1
-        end = k
-        for part, cause in ((noise, SHOT_NOISE), (hot, HOT_PIXEL)):
-            n = len(part[0])
-            pix[end : end + n], t[end : end + n], on[end : end + n] = part
-            label[end : end + n] = cause
-            end += n
+        self._interval += 1
         n_pixels = self.width * self.height
-        return assemble(
-            pix[:end], t[:end], on[:end], label[:end] if self.labels else None, self.width, n_pixels, columns
-        )
+        return assemble(pix[:k], t[:k], on[:k], label[:k] if self.labels else None, self.width, n_pixels, columns)
 
-    def _shot_noise(self, intensity: np.ndarray, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _shot_noise(self, intensity: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """7. The interval's shot noise, (pixel, time since the interval's start, ON) in pixel
+        order, and how many (`noise.shot_noise_events`)."""
         p = self.params
         if p.shot_noise_hz <= 0:
-            return _NO_EVENTS
-        rng = _rng(self.seed, 1, self._interval)
-        n = int(rng.poisson(self._noise_rate_total * dt))
-        state = np.uint64(rng.integers(0, 2**63, dtype=np.int64))
-        pix = np.empty(n, np.int64)
-        t = np.empty(n, np.float64)
-        on = np.empty(n, np.bool_)
-        k = noise_candidates(n, state, self._alias, intensity, self.input_scale, self._g_max, t0, dt, pix, t, on)
-        return pix[:k], t[:k], on[:k]
-
-    def _noise_after_signal(self, pix: np.ndarray, t: np.ndarray, on: np.ndarray) -> tuple[np.ndarray, ...]:
-        """The interval's shot noise once its signal events are emitted: the refractory
-        period against those, and each noise event's reset of its pixel."""
-        if self.params.refractory_s > 0:  # step 5 (without it, the last event times are never needed)
-            order = np.lexsort((t, pix))  # the refractory test goes pixel by pixel, in time order
-            pix, t, on = pix[order], t[order], on[order]
-            keep = refractory_mask(pix, t, self._last_event, float(self.params.refractory_s))
-            pix, t, on = pix[keep], t[keep], on[keep]
-        # A noise event resets the pixel like a real one: its reference jumps to the current
-        # signal (for a real crossing that is base +- theta). Applied at the interval's end.
-        reset_reference(pix, self._base, self._filtered, self._leak_drift)
-        return pix, t, on
-
-    def _hot_pixel_events(self, t0: float, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        p = self.params
-        if not len(self.hot_pixels) or p.hot_pixel_hz <= 0:
-            return _NO_EVENTS
-        rng = _rng(self.seed, 2, self._interval)
-        counts = rng.poisson(p.hot_pixel_hz * dt, len(self.hot_pixels))
-        pix = np.repeat(self.hot_pixels, counts)
-        t = t0 + dt * rng.uniform(size=len(pix))
-        return pix.astype(np.int64), t, np.ones(len(pix), np.bool_)
+            return (*self._noise, 0)
+        args = (
+            intensity,
+            self.input_scale,
+            self.theta_on,
+            self.theta_off,
+            float(p.theta_on),
+            self._noise_majorants,
+            float(p.shot_noise_hz),
+            interval_key(self.seed, SHOT_NOISE_STREAM, self._interval),
+            dt,
+        )
+        n = shot_noise_events(*args, *self._noise)
+        if n > len(self._noise[0]):  # more than the room: again, with room to spare
+            room = 2 * n
+            self._noise = (np.empty(room, np.int64), np.empty(room), np.empty(room, np.bool_))
+            n = shot_noise_events(*args, *self._noise)
+        return (*self._noise, n)

@@ -19,6 +19,8 @@ the emulator will see) depends on these laws and not on the rest of the emulator
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import float32, float64, njit, vectorize
 
@@ -42,7 +44,7 @@ def _bandwidth_hz(intensity_dn, cutoff_hz):
 def _lowpass_gain(intensity_dn, cutoff_hz, two_pi_dt):
     if cutoff_hz <= 0.0:
         return 1.0  # no low-pass: the filter follows its input
-    return -np.expm1(-two_pi_dt * bandwidth_hz_scalar(intensity_dn, cutoff_hz))
+    return -math.expm1(-two_pi_dt * bandwidth_hz_scalar(intensity_dn, cutoff_hz))
 
 
 def _shot_noise_gain(intensity_dn):

@@ -1,161 +1,111 @@
-"""Shot noise, drawn fast: the machinery behind the emulator's step 7 (docs/events.md),
-which a reader may skip. The law: Poisson ON/OFF events at R_shot g(I) theta_nom / theta(x)
-per pixel (`laws.shot_noise_gain`). Drawn by thinning: candidates at a majorant rate, each
-on a pixel drawn by its weight theta_nom / theta(x) from an alias table, kept with
-probability g(I) / g_max, so the cost grows with the number of noise events, not with
-pixels times frames. Random bits from splitmix64 (counter-based: an interval's noise
-depends only on (seed, interval)); random reads prefetched ahead of use.
+"""Shot noise and hot pixels, drawn (docs/events.md steps 7 and 8).
+
+The law: a pixel fires ON or OFF shot-noise events, equally likely, as a Poisson process
+of rate R_shot g(I) theta_nom / theta(x) (`laws.shot_noise_gain`); a hot pixel fires ON
+events at R_hot.
+
+Drawn by thinning, per block of NOISE_BLOCK consecutive pixels (the frame's pixels in
+row-major order): the block's candidates arrive as one Poisson process at the majorant
+rate R_shot g_max w_max per pixel (g_max = g(0), w_max the block's largest theta_nom /
+theta(x)), timed by exponential gaps (so in time order), each on a pixel of the block
+drawn uniformly, and kept with probability g(I) w / (g_max w_max) (I at the interval's end). Each
+pixel's kept candidates are then the Poisson process of its own rate. The draws are keyed
+by (seed, interval, block, draw) (`draws`): a CPU pass walks each block's candidates once
+(`shot_noise_events`); a GPU thread walks its block's few (about 3 at 5 Hz and 10 ms) and
+keeps its own. A hot pixel's events are keyed by (seed, interval, pixel).
 """
 
 from __future__ import annotations
 
-import numpy as np
-from llvmlite import ir
-from numba import njit, types
-from numba.core import cgutils
-from numba.extending import intrinsic
+import math
 
+import numpy as np
+from numba import njit
+
+from .draws import arrival_gap_s, draw_bits, poisson_arrivals, unit_key
 from .laws import shot_noise_gain_scalar
 
-
-@njit(cache=True, nogil=True)
-def splitmix_bits(state):
-    """splitmix64: (next state, 64 random bits). Counter-based (the state only adds a
-    constant), so a frame interval's noise depends only on (seed, interval)."""
-    state = (state + np.uint64(0x9E3779B97F4A7C15)) & np.uint64(0xFFFFFFFFFFFFFFFF)
-    z = state
-    z = ((z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)) & np.uint64(0xFFFFFFFFFFFFFFFF)
-    z = ((z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)) & np.uint64(0xFFFFFFFFFFFFFFFF)
-    return state, z ^ (z >> np.uint64(31))
+NOISE_BLOCK = 32  # pixels sharing one stream of shot-noise candidates
+_SHIFT32 = np.uint64(32)
 
 
-@njit(cache=True)
-def alias_table(weights):
-    """Walker/Vose alias table: sample index i with probability weights[i] / sum in O(1).
-    Packed one uint64 per column, (acceptance probability * 2^32) << 31 | alias index, so
-    that a draw reads one 8-byte word at a random place instead of two arrays."""
-    n = weights.size
-    scaled = weights * (n / weights.sum())
-    prob = np.ones(n)
-    alias = np.arange(n)
-    small = np.empty(n, np.int64)
-    large = np.empty(n, np.int64)
-    ns = nl = 0
-    for i in range(n):
-        if scaled[i] < 1.0:
-            small[ns] = i
-            ns += 1
-        else:
-            large[nl] = i
-            nl += 1
-    while ns > 0 and nl > 0:
-        ns -= 1
-        s_i = small[ns]
-        nl -= 1
-        l_i = large[nl]
-        prob[s_i] = scaled[s_i]
-        alias[s_i] = l_i
-        scaled[l_i] = scaled[l_i] + scaled[s_i] - 1.0
-        if scaled[l_i] < 1.0:
-            small[ns] = l_i
-            ns += 1
-        else:
-            large[nl] = l_i
-            nl += 1
-    packed = np.empty(n, np.uint64)
-    for i in range(n):
-        p32 = np.uint64(min(max(np.rint(prob[i] * 4294967296.0), 0.0), 4294967296.0))  # 33 bits
-        packed[i] = (p32 << np.uint64(31)) | np.uint64(alias[i])
-    return packed
+def block_majorants(theta_on: np.ndarray, theta_off: np.ndarray, theta_nominal: float) -> np.ndarray:
+    """Each block's thinning majorant per pixel, g_max w_max with w_max the block's largest
+    theta_nom / theta(x) (frozen with the thresholds; computed once)."""
+    weight = theta_nominal / (0.5 * (theta_on.astype(np.float64) + theta_off))
+    n_blocks = -(-weight.size // NOISE_BLOCK)
+    padded = np.zeros(n_blocks * NOISE_BLOCK)
+    padded[: weight.size] = weight
+    return shot_noise_gain_scalar(0.0) * padded.reshape(n_blocks, NOISE_BLOCK).max(axis=1)
 
 
-@intrinsic
-def _prefetch(typingctx, array, index):
-    """Ask the CPU to start loading array[index] into cache (LLVM's prefetch; no effect
-    on results): random reads issued this way ahead of use overlap their memory latency."""
-
-    def codegen(context, builder, signature, args):
-        array_type = signature.args[0]
-        data = context.make_array(array_type)(context, builder, args[0])
-        pointer = cgutils.get_item_pointer(context, builder, array_type, data, [args[1]], wraparound=False)
-        byte_pointer = ir.IntType(8).as_pointer()
-        int32 = ir.IntType(32)
-        function = cgutils.get_or_insert_function(
-            builder.module, ir.FunctionType(ir.VoidType(), [byte_pointer, int32, int32, int32]), "llvm.prefetch.p0i8"
-        )
-        # read, keep in all cache levels, data cache
-        builder.call(function, [builder.bitcast(pointer, byte_pointer), int32(0), int32(3), int32(1)])
-        return context.get_dummy_value()
-
-    return types.void(array, index), codegen
+@njit(inline="always")
+def kept(coin, majorant, intensity_dn, theta_on, theta_off, theta_nominal):
+    """Is a candidate kept on its pixel, with probability g(I) w / majorant, w = theta_nom /
+    theta(x) (theta(x) the mean of the pixel's two thresholds)? Written without divisions."""
+    return coin * majorant * (0.5 * (theta_on + theta_off)) < shot_noise_gain_scalar(intensity_dn) * theta_nominal
 
 
-PREFETCH_AHEAD = 32  # candidates whose table entry is requested before it is read
+@njit(inline="always")
+def block_mean_gap_s(shot_noise_hz, majorant):
+    """The mean time between a block's candidates: 1 / (R_shot majorant NOISE_BLOCK)."""
+    return 1.0 / (shot_noise_hz * majorant * NOISE_BLOCK)
+
+
+@njit(inline="always")
+def candidate(block_key, j, s, mean_gap_s):
+    """The block's j-th candidate after the one at time s (from the interval's start; 0
+    before the first): (its time, its pixel's offset in the block, its coin in [0, 1),
+    ON?), from one draw: the exponential gap (high 32 bits), the pixel (the next 5), the
+    coin (the next 26) and the polarity (bit 0)."""
+    bits = draw_bits(block_key, j)
+    u = np.float64((bits >> _SHIFT32) + np.uint64(1)) * 2.3283064365386963e-10  # (0, 1], 2^-32 steps
+    offset = np.int64((bits >> np.uint64(27)) & np.uint64(NOISE_BLOCK - 1))
+    coin = np.float64((bits >> np.uint64(1)) & np.uint64(0x3FFFFFF)) * 1.4901161193847656e-08  # 2^-26
+    return s - math.log(u) * mean_gap_s, offset, coin, (bits & np.uint64(1)) == np.uint64(1)
 
 
 @njit(cache=True, nogil=True)
-def _alias_column(bits, n_pixels):
-    """The alias-table column a candidate's pixel draw (high 32 bits) lands on."""
-    return ((bits >> np.uint64(32)) * n_pixels) >> np.uint64(32)
-
-
-@njit(cache=True, nogil=True)
-def _draw_ahead(state, slot, pixel_bits, keep_bits, n_pixels, table, intensity):
-    """A candidate's two draws into the ring's slot, its table and intensity reads
-    requested now; returns the generator's next state."""
-    state, pixel_bits[slot] = splitmix_bits(state)
-    state, keep_bits[slot] = splitmix_bits(state)
-    column = _alias_column(pixel_bits[slot], n_pixels)
-    _prefetch(table, column)
-    _prefetch(intensity, column)
-    return state
-
-
-@njit(cache=True, nogil=True)
-def noise_candidates(n, state, table, intensity, scale, g_max, t0, dt, out_pix, out_t, out_p):
-    """Shot noise by thinning: n candidates at the majorant rate R g_max theta_nom/theta(x),
-    their pixel drawn in proportion to theta_nom/theta(x) (alias table), each kept with
-    probability g(I) / g_max; ON or OFF with equal odds. Two splitmix draws per candidate:
-    pixel (high 32 bits) and alias coin (low 32); keep (high 32), time within the interval
-    (31 bits: 5 ps steps at 10 ms, 5 ns at 10 s) and polarity (1). The table and the
-    intensity are read at random places, out of cache: a candidate's draws are made
-    PREFETCH_AHEAD candidates before it is thinned and its reads prefetched then, so
-    that their memory latencies overlap. Written without data-dependent branches (every candidate
-    is stored, the count advances only if kept): a mispredicted branch would cancel the
-    reads in flight."""
-    n_pixels = np.uint64(table.size)
-    low32 = np.uint64(0xFFFFFFFF)
-    low31 = np.uint64(0x7FFFFFFF)
-    pixel_bits = np.empty(PREFETCH_AHEAD, np.uint64)  # ring of the draws made ahead
-    keep_bits = np.empty(PREFETCH_AHEAD, np.uint64)
-    for c in range(min(PREFETCH_AHEAD, n)):
-        state = _draw_ahead(state, c, pixel_bits, keep_bits, n_pixels, table, intensity)
+def shot_noise_events(
+    intensity1, scale, theta_on, theta_off, theta_nominal, majorants, shot_noise_hz, key, dt, out_pix, out_s, out_on
+):  # fmt: skip
+    """Every block's kept candidates in the interval, as (pixel, time since the interval's
+    start in s, ON), in pixel order and in time order within a pixel; written up to the
+    out arrays' size, returns how many there are (call again with more room if more)."""
+    n_pixels = intensity1.size
+    room = out_pix.size
     k = 0
-    for c in range(n):
-        slot = c % PREFETCH_AHEAD
-        bits, bits2 = pixel_bits[slot], keep_bits[slot]
-        column = _alias_column(bits, n_pixels)
-        entry = table[column]
-        i = np.int64(column if (bits & low32) < (entry >> np.uint64(31)) else entry & low31)
-        g = shot_noise_gain_scalar(np.float64(intensity[i]) * scale)
-        out_pix[k] = i
-        out_t[k] = t0 + dt * (np.float64((bits2 & low32) >> np.uint64(1)) * (1.0 / 2147483648.0))
-        out_p[k] = (bits2 & np.uint64(1)) == np.uint64(1)
-        k += np.int64(np.float64(bits2 >> np.uint64(32)) * (g_max / 4294967296.0) < g)
-        if c + PREFETCH_AHEAD < n:  # the candidate PREFETCH_AHEAD ahead takes this slot
-            state = _draw_ahead(state, slot, pixel_bits, keep_bits, n_pixels, table, intensity)
+    for block in range(majorants.size):
+        mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
+        block_key = unit_key(key, block)
+        first = k
+        j = 0
+        s, offset, coin, on = candidate(block_key, j, 0.0, mean_gap_s)
+        while s < dt:
+            i = block * NOISE_BLOCK + offset
+            # (the frame's last block may be short: its candidates past the last pixel are dropped)
+            if i < n_pixels and kept(
+                coin, majorants[block], np.float64(intensity1[i]) * scale, theta_on[i], theta_off[i], theta_nominal
+            ):
+                if k < room:  # by insertion: stable, so each pixel's stay in time order
+                    m = k
+                    while m > first and out_pix[m - 1] > i:
+                        out_pix[m], out_s[m], out_on[m] = out_pix[m - 1], out_s[m - 1], out_on[m - 1]
+                        m -= 1
+                    out_pix[m], out_s[m], out_on[m] = i, s, on
+                k += 1
+            j += 1
+            s, offset, coin, on = candidate(block_key, j, s, mean_gap_s)
     return k
 
 
-@njit(cache=True, nogil=True)
-def reset_reference(pix, base, filtered, leak_drift):
-    """A noise event sets its pixel's reference to the current signal and clears its
-    unspent leak drift (reads prefetched PREFETCH_AHEAD events ahead: the pixels are random)."""
-    labels = leak_drift.size > 0
-    for j in range(pix.size):
-        if j + PREFETCH_AHEAD < pix.size:
-            _prefetch(base, pix[j + PREFETCH_AHEAD])
-            _prefetch(filtered, pix[j + PREFETCH_AHEAD])
-        base[pix[j]] = filtered[pix[j]]
-        if labels:
-            leak_drift[pix[j]] = 0.0
+@njit(inline="always")
+def hot_pixel_count(hot_key, pixel, rate_hz, dt):
+    """How many events a hot pixel fires in the interval (its own Poisson process)."""
+    return poisson_arrivals(unit_key(hot_key, pixel), rate_hz, dt)
+
+
+@njit(inline="always")
+def hot_pixel_time(pixel_key_, j, s, rate_hz):
+    """The time of a hot pixel's j-th event after the one at s (0 before the first)."""
+    return s + arrival_gap_s(draw_bits(pixel_key_, j), rate_hz)

@@ -1,45 +1,96 @@
-"""The pixel model over one frame interval [t0, t0 + dt], pixel by pixel (docs/events.md
-steps 1-6; ESIM's `imageCallback` is the model for this loop). Two compiled passes:
+"""The pixel model over one frame interval [t0, t0 + dt] (docs/events.md steps 1-8; ESIM's
+`imageCallback` is the model for this loop). The model of one pixel is a few scalar
+functions, compiled by numba for the CPU (the passes below) and for CUDA
+(`cuda_kernels`, one thread per pixel) alike:
 
-`advance`, over every pixel of the frame:
-    target  = L(I1)                                   1. lin-log response (laws)
-    eps     = 1 - exp(-2 pi f_c(mean I) dt)           2. exact low-pass step (laws)
-    f1      = f0 + eps (target - f0)                     the filtered log intensity at t0 + dt
+`advance_pixel` (target L(I1) and the low-pass gain eps given, steps 1-2 in `laws`):
+    f1      = f0 + eps (target - f0)                  2. exact low-pass step
     base   -= leak_rate theta_on dt                   6. the leak drifts the reference down
     x0, x1  = f0 - base (at t0), f1 - base (at t1)       the signal above the reference
-    count   = floor(x1 / theta_on) ON, or -floor(-x1 / theta_off) OFF crossings
+    count   = floor(x1 / theta_on) ON, or -floor(-x1 / theta_off) OFF crossings   4.
 
-`emit`, over the pixels that crossed: the j-th crossing at the time the line x0 -> x1
-reaches j thresholds (4., ESIM's timing, clipped to the interval), the refractory period
-applied in time order (5.), the reference moved by one threshold per crossing ("drop")
-or per emitted event ("defer").
+`crossing_time`: the j-th crossing at the time the line x0 -> x1 reaches j thresholds
+(4., ESIM's timing, clipped to the interval); the refractory period is applied in time
+order (5.), the reference moved by one threshold per crossing ("drop") or per emitted
+event ("defer"). Then the pixel's shot noise (7., a kept one resets the reference to the
+signal) and its hot-pixel events (8.), drawn in `noise`.
 
-The emulator (`emulator.EventEmulator`) holds each pixel's state between intervals and
-adds shot noise and hot pixels (`noise`), then orders the events (`ordering`).
+On the CPU, `advance` runs over every pixel and lists those that cross; `emit` writes
+their events, then the shot noise's (`noise.shot_noise_events`), then the hot pixels'.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
-from ..formats.events import LEAK, SIGNAL
+from ..formats.events import HOT_PIXEL, LEAK, SHOT_NOISE, SIGNAL
+from .draws import unit_key
 from .laws import log_response_scalar, lowpass_gain_scalar, refractory_allows
+from .noise import hot_pixel_count, hot_pixel_time
+
+
+@njit(inline="always")
+def crossings(x, theta_on, theta_off):
+    """4. How many thresholds the signal above the reference has crossed: > 0 ON, < 0 OFF."""
+    if x >= theta_on:
+        return np.int64(math.floor(x / theta_on))
+    if -x >= theta_off:
+        return -np.int64(math.floor(-x / theta_off))
+    return np.int64(0)
+
+
+@njit(inline="always")
+def leak_quanta(drift, leak_step, dt, count, theta_on, theta_off):
+    """Labels only: (how many of the ON crossings are leak, the unspent leak drift). Each
+    whole theta_on of drift is one leak event; an OFF crossing spends the pending quanta
+    instead (they delayed it)."""
+    d = drift + leak_step * dt
+    leak_only = np.int64(0)
+    if count > 0:
+        leak_only = min(count, np.int64(math.floor(d / theta_on)))
+        d -= leak_only * theta_on
+    elif count < 0:
+        d -= math.floor(d / theta_off) * theta_off
+    return leak_only, d
+
+
+@njit(inline="always")
+def advance_pixel(target, gain, f0, base0, theta_on, theta_off, leak_step, drift, labels, dt):
+    """Steps 2, 6 and 4 of one pixel: (f1, base1, crossings, x0, x1, leak crossings, drift1);
+    the leak's drift is followed only with `labels`."""
+    f1 = f0 + gain * (target - f0)
+    x0 = f0 - base0
+    base1 = base0 - leak_step * dt
+    x1 = f1 - base1
+    count = crossings(x1, theta_on, theta_off)
+    n_leak = np.int64(0)
+    if labels:
+        n_leak, drift = leak_quanta(drift, leak_step, dt, count, theta_on, theta_off)
+    return f1, base1, count, x0, x1, n_leak, drift
+
+
+@njit(inline="always")
+def crossing_time(j, step, x0, x1, t0, dt):
+    """4. When the signal, linear from x0 to x1 over the interval, reaches its j-th level
+    j * step (step = theta_on, or -theta_off): a level already passed at t0 fires at t0."""
+    slope = x1 - x0
+    frac = (j * step - x0) / slope if slope != 0.0 else 0.0
+    return t0 + dt * min(max(frac, 0.0), 1.0)
 
 
 @njit(cache=True, nogil=True)
 def advance(
-    intensity0, intensity1, filtered, base, theta_on, theta_off, leak_step, cutoff_hz, dt, scale,
-    count, x0, x1, active, log_lut, gain_lut, leak_drift, n_leak, first_pixel,
+    intensity0, intensity1, filtered, base, theta_on, theta_off, leak_step, leak_drift, cutoff_hz, dt, scale,
+    log_lut, gain_lut, first_pixel, active, count, x0, x1, n_leak,
 ):  # fmt: skip
-    """One interval of every pixel in the arrays (a range of a frame's pixels: threads can
-    run ranges side by side; `first_pixel` is the range's first index). Updates `filtered`
-    and `base` in place and lists the pixels that cross in `active` (as first_pixel + i),
-    with their count (> 0 ON, < 0 OFF), x0 and x1 in the same slots; returns how many.
-
-    With a non-empty `leak_drift` (labels asked for), each pixel's unspent leak drift is
-    advanced, and per active pixel `n_leak` ON crossings are labelled leak: each whole
-    theta_on of drift is one leak event (an OFF crossing spends the pending quanta instead).
+    """`advance_pixel` over every pixel in the arrays (a range of a frame's pixels: threads
+    can run ranges side by side; `first_pixel` is the range's first index), with step 1
+    (target L(I1)) and the low-pass gain; lists the pixels that cross in `active` (as
+    first_pixel + i), their counts, x0, x1 and leak crossings in the same slots; returns
+    how many. Updates filtered, base (and leak_drift: labels, when not empty).
 
     Speed: 8-bit input reads the law's values from tables (`log_lut[I]`, `gain_lut[I0 + I1]`:
     every value they can take); float input computes them, the gain reused while a run of
@@ -51,7 +102,7 @@ def advance(
     run0 = run1 = np.float64(np.nan)  # the inputs of the last gain computed (NaN: none yet)
     run_gain = 1.0
     for i in range(intensity1.size):
-        # 1-2. log response and low-pass gain
+        # 1. log response, and the low-pass gain of step 2
         if tables:
             target = log_lut[np.int64(intensity1[i])]
             gain = gain_lut[np.int64(intensity0[i]) + np.int64(intensity1[i])]
@@ -63,86 +114,86 @@ def advance(
             else:
                 gain = lowpass_gain_scalar(0.5 * (np.float64(intensity0[i]) * scale + i1), cutoff_hz, two_pi_dt)
                 run0, run1, run_gain = intensity0[i], intensity1[i], gain
-        f0 = filtered[i]
-        f1 = f0 + gain * (target - f0)
-        # 6. leak: the reference drifts down
-        a = f0 - base[i]
-        b = base[i] - leak_step[i] * dt
-        x = f1 - b
+        f1, b, c, a, x, leak_only, d = advance_pixel(
+            target, gain, filtered[i], base[i], theta_on[i], theta_off[i], leak_step[i],
+            leak_drift[i] if labels else 0.0, labels, dt,
+        )  # fmt: skip
         filtered[i] = f1
         base[i] = b
-        # 4. how many thresholds the signal crossed
-        if x >= theta_on[i]:
-            c = np.int64(np.floor(x / theta_on[i]))
-        elif -x >= theta_off[i]:
-            c = -np.int64(np.floor(-x / theta_off[i]))
-        else:
-            c = np.int64(0)
-        leak_only = 0
-        if labels:  # leak quanta: each whole threshold of drift is one leak event
-            d = leak_drift[i] + leak_step[i] * dt
-            if c > 0:
-                leak_only = min(c, np.int64(np.floor(d / theta_on[i])))
-                d -= leak_only * theta_on[i]
-            elif c < 0:  # the pending quanta delayed this OFF crossing instead
-                d -= np.floor(d / theta_off[i]) * theta_off[i]
+        if labels:
             leak_drift[i] = d
         if c == 0:
             continue
         active[n_active] = first_pixel + i
-        n_leak[n_active] = leak_only
         count[n_active] = c
         x0[n_active] = a
         x1[n_active] = x
+        n_leak[n_active] = leak_only
         n_active += 1
     return n_active
 
 
 @njit(cache=True, nogil=True)
+def hot_pixel_counts(hot_pixels, hot_key, hot_hz, dt):
+    """8. How many events each hot pixel fires in the interval."""
+    out = np.zeros(hot_pixels.size, np.int64)
+    if hot_hz > 0.0:
+        for h in range(hot_pixels.size):
+            out[h] = hot_pixel_count(hot_key, hot_pixels[h], hot_hz, dt)
+    return out
+
+
+@njit(cache=True, nogil=True)
 def emit(
-    active, n_active, count, x0, x1, theta_on, theta_off, base, last_event, t0, dt, refractory_s, defer, n_leak,
+    active, n_active, count, x0, x1, n_leak, noise_pix, noise_s, noise_on, n_noise, hot_pixels, hot_counts, hot_key,
+    hot_hz, theta_on, theta_off, filtered, base, leak_drift, last_event, t0, dt, refractory_s, defer,
     out_pix, out_t, out_p, out_label,
 ):  # fmt: skip
-    """The events of the active pixels into out_* (pixel index, t in s, ON, label; a
-    pixel's last `n_leak` crossings are leak, the others signal); returns how many."""
+    """The interval's events into out_* (pixel index, t in s, ON, label): the crossing
+    pixels' signal (a pixel's last n_leak crossings labelled leak), then the shot noise's
+    events (`noise.shot_noise_events`, time since t0), then the hot pixels'. Each pixel
+    sees its own in that order (the order the events are written in does not matter: they
+    are sorted after). Returns how many."""
     k = 0
     for a in range(n_active):
         i = active[a]
-        n = count[a]
-        on = n > 0
+        on = count[a] > 0
         step = theta_on[i] if on else -theta_off[i]
-        n = abs(n)
-        slope = x1[a] - x0[a]
+        n = abs(count[a])
         emitted = 0
         for j in range(1, n + 1):
-            # 4. each crossing where its own pixel's signal reaches the level (a level
-            # already passed at t0 fires at t0)
-            frac = (j * step - x0[a]) / slope if slope != 0.0 else 0.0
-            t = t0 + dt * min(max(frac, 0.0), 1.0)
-            # 5. refractory period
-            if refractory_s > 0.0:
+            t = crossing_time(j, step, x0[a], x1[a], t0, dt)
+            if refractory_s > 0.0:  # 5.
                 if not refractory_allows(t, last_event[i], refractory_s):
                     continue
                 last_event[i] = t
-            out_pix[k] = i
-            out_t[k] = t
-            out_p[k] = on
+            out_pix[k], out_t[k], out_p[k] = i, t, on
             out_label[k] = LEAK if j > n - n_leak[a] else SIGNAL
             k += 1
             emitted += 1
         # the reference moves by every crossing (drop) or by the emitted ones only (defer)
         base[i] += (emitted if defer else n) * step
+    reset = -1  # the last pixel whose noise reset its reference
+    for b in range(n_noise):  # 7.
+        i = noise_pix[b]
+        t = t0 + noise_s[b]
+        if refractory_s > 0.0:
+            if not refractory_allows(t, last_event[i], refractory_s):
+                continue
+            last_event[i] = t
+        out_pix[k], out_t[k], out_p[k], out_label[k] = i, t, noise_on[b], SHOT_NOISE
+        k += 1
+        if i != reset:  # a noise event resets the pixel like a real one: the reference jumps to the signal
+            base[i] = filtered[i]
+            if leak_drift.size > 0:
+                leak_drift[i] = 0.0
+            reset = i
+    for h in range(hot_pixels.size):  # 8. ON, past the refractory period and the reference
+        i = hot_pixels[h]
+        key = unit_key(hot_key, i)
+        s = 0.0
+        for j in range(hot_counts[h]):
+            s = hot_pixel_time(key, j, s, hot_hz)
+            out_pix[k], out_t[k], out_p[k], out_label[k] = i, t0 + s, True, HOT_PIXEL
+            k += 1
     return k
-
-
-@njit(cache=True, nogil=True)
-def refractory_mask(pix, t, last_event, refractory_s):
-    """Mask of the events that pass the refractory period (`pix` grouped, `t` increasing
-    per pixel), each pixel's last event time updated by those kept."""
-    keep = np.ones(t.size, np.bool_)
-    for k in range(t.size):
-        if refractory_allows(t[k], last_event[pix[k]], refractory_s):
-            last_event[pix[k]] = t[k]
-        else:
-            keep[k] = False
-    return keep

@@ -12,6 +12,7 @@ EVENTS = {
     "input": "events.input",
     "sensor": "events.sensor",
     "readout": "events.readout",
+    "device": "events.device",
 }
 EVENTS_PICTURE = {"window_ms": "events.window_ms"}
 # The events command's options where a key's own name would say too little.
@@ -20,7 +21,8 @@ EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--reado
 
 def events_settings(config: dict) -> dict:
     """Everything the emulation depends on (the seed aside, per trajectory): the pixel
-    model (and the preset it came from), labels, the input scale, the sensor and its readout."""
+    model (and the preset it came from), labels, the input scale, the sensor and its readout,
+    and the device it runs on (a GPU can round a crossing differently)."""
     return pick(config, EVENTS)
 
 

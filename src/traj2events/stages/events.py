@@ -210,12 +210,14 @@ def emulate(
     labels: bool = False,
     threads: int = 1,
     readout: ReadoutParams = ReadoutParams(),
+    device: str = "cpu",
 ) -> tuple[int, int, float]:
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
     `input_name` are recorded in its attributes; with `labels`, each event's cause too;
     `threads`: CPUs to use, the emulator's per-pixel pass split over those the source's
-    decoder leaves; `readout`: latency, jitter and rate limit after the pixels). Returns
-    (frames, events, time of the last frame in s)."""
+    decoder leaves; `readout`: latency, jitter and rate limit after the pixels; `device`:
+    cpu or cuda, where the pixel model runs). Returns (frames, events, time of the last
+    frame in s)."""
     emulator = EventEmulator(
         source.width,
         source.height,
@@ -224,6 +226,7 @@ def emulate(
         labels=labels,
         input_scale=source.input_scale,
         threads=max(1, threads - source.decoder_cpus),
+        device=device,
     )
     attrs = {
         "preset": preset,
@@ -232,6 +235,7 @@ def emulate(
         "input_kind": source.kind,
         **{f"emulator_{k}": v for k, v in asdict(params).items()},
         "labels": labels,
+        "emulator_device": device,
         **{f"readout_{k}": v for k, v in asdict(readout).items()},
         "traj2events_version": __version__,
         **source.scene,
@@ -365,6 +369,7 @@ def events_command(
         labels=settings["labels"],
         threads=threads,
         readout=ReadoutParams(**settings["readout"]),
+        device=settings["device"],
     )
     frames = str(input) if Path(input).suffix == ".h5" else None
     e = exports or {}

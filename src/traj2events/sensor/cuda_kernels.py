@@ -1,0 +1,241 @@
+"""The pixel model on a CUDA GPU: machinery behind `EventEmulator(device="cuda")`, which a
+reader may skip. The same per-pixel functions as the CPU passes (`pixel`, `noise`,
+`laws`, `draws`), compiled by numba for the GPU, one thread per pixel, three launches per
+frame interval:
+
+    count   steps 1-8 of the pixel's interval: its crossings, the shot-noise candidates of
+            its block that land on it and are kept, its hot-pixel events -> how many events
+    scan    exclusive prefix sum of the counts, by groups of 32: each pixel's first slot
+            (no atomics, so the order does not depend on scheduling)
+    fill    each pixel writes its events from its slot, as `pixel.emit` does
+
+The events come back to the host in pixel order and are ordered as on the CPU
+(`ordering.assemble`), so the same input and seed give the same events on both, except
+where the GPU's log, exp or fused multiply-adds round a crossing time or count
+differently. Tested without a GPU under numba's CUDA simulator (NUMBA_ENABLE_CUDASIM=1)
+and by compiling the kernels to PTX.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import cuda
+
+from ..formats.events import HOT_PIXEL, LEAK, SHOT_NOISE, SIGNAL
+from .draws import unit_key
+from .laws import log_response_scalar, lowpass_gain_scalar, refractory_allows
+from .noise import NOISE_BLOCK, block_mean_gap_s, candidate, hot_pixel_count, hot_pixel_time, kept
+from .pixel import advance_pixel, crossing_time
+
+# CUDA threads per block, for every kernel here (the scan's shared array too); the events
+# do not depend on it.
+THREADS_PER_BLOCK = 256  # CUDA threads per block, for every kernel here (the events do not depend on it)
+
+
+@cuda.jit
+def count_kernel(
+    intensity0, intensity1, scale, cutoff_hz, dt, filtered, base, theta_on, theta_off, leak_step, leak_drift, hot,
+    majorants, shot_noise_hz, theta_nominal, shot_key, hot_hz, hot_key, count, x0, x1, n_leak, n_events,
+):  # fmt: skip
+    """Steps 1-8 of each pixel's interval: its state advanced, its crossings (count, x0, x1,
+    n_leak) stored, and how many events it will write in n_events."""
+    i = cuda.grid(1)
+    if i >= intensity1.size:
+        return
+    i1 = np.float64(intensity1[i]) * scale
+    target = log_response_scalar(i1)
+    gain = lowpass_gain_scalar(0.5 * (np.float64(intensity0[i]) * scale + i1), cutoff_hz, 2.0 * math.pi * dt)
+    labels = leak_drift.size > 0
+    f1, b, c, a, x, leak_only, d = advance_pixel(
+        target, gain, filtered[i], base[i], theta_on[i], theta_off[i], leak_step[i], leak_drift[i] if labels else 0.0,
+        labels, dt,
+    )  # fmt: skip
+    filtered[i] = f1
+    base[i] = b
+    if labels:
+        leak_drift[i] = d
+    count[i], x0[i], x1[i], n_leak[i] = c, a, x, leak_only
+    n = abs(c)
+    if shot_noise_hz > 0.0:  # 7. the block's candidates that land here and are kept
+        block = i // NOISE_BLOCK
+        mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
+        key = np.uint64(unit_key(shot_key, block))  # (a uint64 already: the simulator needs the cast)
+        j = 0
+        s, offset, coin, on = candidate(key, j, 0.0, mean_gap_s)
+        while s < dt:
+            if block * NOISE_BLOCK + offset == i and kept(
+                coin, majorants[block], i1, theta_on[i], theta_off[i], theta_nominal
+            ):
+                n += 1
+            j += 1
+            s, offset, coin, on = candidate(key, j, s, mean_gap_s)
+    if hot_hz > 0.0 and hot[i]:  # 8.
+        n += hot_pixel_count(hot_key, i, hot_hz, dt)
+    n_events[i] = n
+
+
+@cuda.jit
+def fill_kernel(
+    count, x0, x1, n_leak, n_events, first_slot, intensity1, scale, dt, t0, theta_on, theta_off, filtered, base,
+    leak_drift, last_event, hot, majorants, shot_noise_hz, theta_nominal, shot_key, hot_hz, hot_key, refractory_s,
+    defer, out_pix, out_t, out_p, out_label,
+):  # fmt: skip
+    """Each pixel's events from its first slot on, as `pixel.emit` writes them: signal,
+    shot noise (a kept one resets the reference), hot pixel. Slots the refractory period
+    leaves empty keep out_pix = -1."""
+    i = cuda.grid(1)
+    if i >= count.size or n_events[i] == 0:
+        return
+    k = first_slot[i]
+    c = count[i]
+    if c != 0:
+        on = c > 0
+        step = theta_on[i] if on else -theta_off[i]
+        n = abs(c)
+        emitted = 0
+        for j in range(1, n + 1):
+            t = crossing_time(j, step, x0[i], x1[i], t0, dt)
+            if refractory_s > 0.0:
+                if not refractory_allows(t, last_event[i], refractory_s):
+                    continue
+                last_event[i] = t
+            out_pix[k], out_t[k], out_p[k] = i, t, on
+            out_label[k] = LEAK if j > n - n_leak[i] else SIGNAL
+            k += 1
+            emitted += 1
+        base[i] += (emitted if defer else n) * step
+    if shot_noise_hz > 0.0:
+        i1 = np.float64(intensity1[i]) * scale
+        block = i // NOISE_BLOCK
+        mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
+        key = np.uint64(unit_key(shot_key, block))  # (a uint64 already: the simulator needs the cast)
+        j = 0
+        reset = False
+        s, offset, coin, on = candidate(key, j, 0.0, mean_gap_s)
+        while s < dt:
+            if block * NOISE_BLOCK + offset == i and kept(
+                coin, majorants[block], i1, theta_on[i], theta_off[i], theta_nominal
+            ):
+                t = t0 + s
+                if refractory_s <= 0.0 or refractory_allows(t, last_event[i], refractory_s):
+                    if refractory_s > 0.0:
+                        last_event[i] = t
+                    out_pix[k], out_t[k], out_p[k], out_label[k] = i, t, on, SHOT_NOISE
+                    k += 1
+                    reset = True
+            j += 1
+            s, offset, coin, on = candidate(key, j, s, mean_gap_s)
+        if reset:
+            base[i] = filtered[i]
+            if leak_drift.size > 0:
+                leak_drift[i] = 0.0
+    if hot_hz > 0.0 and hot[i]:
+        key = np.uint64(unit_key(hot_key, i))
+        s = 0.0
+        for j in range(hot_pixel_count(hot_key, i, hot_hz, dt)):
+            s = hot_pixel_time(key, j, s, hot_hz)
+            out_pix[k], out_t[k], out_p[k], out_label[k] = i, t0 + s, True, HOT_PIXEL
+            k += 1
+
+
+SCAN_GROUP = 32  # values one thread of the scan sums in order
+
+
+@cuda.jit
+def group_sums(values, sums):
+    """sums[g] = the total of the g-th group of SCAN_GROUP consecutive values."""
+    g = cuda.grid(1)
+    if g < sums.size:
+        total = 0
+        for i in range(g * SCAN_GROUP, min((g + 1) * SCAN_GROUP, values.size)):
+            total += values[i]
+        sums[g] = total
+
+
+@cuda.jit
+def group_offsets(values, group_first, exclusive):
+    """exclusive[i] = the sum of the values before i, a group per thread from its first."""
+    g = cuda.grid(1)
+    if g < group_first.size:
+        running = group_first[g]
+        for i in range(g * SCAN_GROUP, min((g + 1) * SCAN_GROUP, values.size)):
+            exclusive[i] = running
+            running += values[i]
+
+
+def _blocks(n: int) -> int:
+    return max(1, -(-n // THREADS_PER_BLOCK))
+
+
+def exclusive_scan(values):
+    """(exclusive prefix sums of a device int64 array, their total as a Python int): each
+    thread sums a group of SCAN_GROUP values, the groups' totals are scanned the same way,
+    then each thread writes its group's sums. Plain loops, no barriers."""
+    n_groups = max(1, -(-values.size // SCAN_GROUP))
+    sums = cuda.device_array(n_groups, np.int64)
+    group_sums[_blocks(n_groups), THREADS_PER_BLOCK](values, sums)
+    if n_groups == 1:
+        group_first, total = cuda.to_device(np.zeros(1, np.int64)), int(sums.copy_to_host()[0])
+    else:
+        group_first, total = exclusive_scan(sums)
+    exclusive = cuda.device_array(values.size, np.int64)
+    group_offsets[_blocks(n_groups), THREADS_PER_BLOCK](values, group_first, exclusive)
+    return exclusive, total
+
+
+class CudaPixels:
+    """The emulator's per-pixel state on the GPU, and one frame interval's three launches."""
+
+    def __init__(self, theta_on, theta_off, leak_step, majorants, hot_pixels, labels: bool) -> None:
+        if not cuda.is_available():
+            raise RuntimeError(
+                "events.device: cuda: numba finds no usable NVIDIA GPU here (a driver, and `pip install "
+                "traj2events[gpu]` for numba-cuda); set events.device: cpu to emulate on the CPUs"
+            )
+        n = theta_on.size
+        self.n = n
+        self.theta_on, self.theta_off = cuda.to_device(theta_on), cuda.to_device(theta_off)
+        self.leak_step, self.majorants = cuda.to_device(leak_step), cuda.to_device(majorants)
+        hot = np.zeros(n, np.bool_)
+        hot[hot_pixels] = True
+        self.hot = cuda.to_device(hot)
+        self.last_event = cuda.to_device(np.full(n, -np.inf))
+        self.labels = labels
+        self.slots = [cuda.device_array(n, dtype) for dtype in (np.int64, np.float64, np.float64, np.int64, np.int64)]
+        self.filtered = self.base = self.leak_drift = self.intensity = None
+
+    def start(self, intensity, filtered, base, leak_drift) -> None:
+        """The state at the first frame (computed on the host, as the CPU path does)."""
+        self.intensity = cuda.to_device(intensity)
+        self.filtered, self.base = cuda.to_device(filtered), cuda.to_device(base)
+        self.leak_drift = cuda.to_device(leak_drift if self.labels else np.empty(0))
+
+    def interval(self, intensity, scale, dt, t0, params, shot_key, hot_key):
+        """One interval's events as host arrays (pixel, t s, ON, label), in pixel order."""
+        intensity1 = cuda.to_device(np.ascontiguousarray(intensity))
+        count, x0, x1, n_leak, n_events = self.slots
+        noise = (self.majorants, float(params.shot_noise_hz), float(params.theta_on), shot_key)
+        hot = (float(params.hot_pixel_hz), hot_key)
+        grid = (_blocks(self.n), THREADS_PER_BLOCK)
+        count_kernel[grid](
+            self.intensity, intensity1, scale, float(params.cutoff_hz), dt, self.filtered, self.base, self.theta_on,
+            self.theta_off, self.leak_step, self.leak_drift, self.hot, *noise, *hot, count, x0, x1, n_leak, n_events,
+        )  # fmt: skip
+        first_slot, total = exclusive_scan(n_events)
+        out_pix = cuda.to_device(np.full(total, -1, np.int64))
+        out_t = cuda.device_array(total, np.float64)
+        out_p = cuda.device_array(total, np.bool_)
+        out_label = cuda.device_array(total, np.uint8)
+        if total:
+            fill_kernel[grid](
+                count, x0, x1, n_leak, n_events, first_slot, intensity1, scale, dt, t0, self.theta_on,
+                self.theta_off, self.filtered, self.base, self.leak_drift, self.last_event, self.hot, *noise, *hot,
+                float(params.refractory_s), params.refractory_mode == "defer", out_pix, out_t, out_p, out_label,
+            )  # fmt: skip
+        self.intensity = intensity1
+        pix = out_pix.copy_to_host()
+        written = pix >= 0  # the refractory period can leave slots empty
+        events = (pix, out_t.copy_to_host(), out_p.copy_to_host(), out_label.copy_to_host())
+        return events if written.all() else tuple(a[written] for a in events)
