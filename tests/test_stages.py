@@ -344,3 +344,36 @@ def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path)
     assert len(read_video(tmp_path / "v.mkv")) == len(tr.t)  # the video keeps the fixed rate
     n_frames, _, _ = emulate(frame_source(tmp_path / "f.h5"), preset_params("clean"), 1, tmp_path / "e.h5", "c", "f")
     assert n_frames == len(t)  # the emulator takes every frame, in time order
+
+
+def test_render_and_emulate_in_one_job_gives_the_two_jobs_files(built, config, tmp_path):
+    """The streamed job: the same events.h5 datasets and video bytes as `render` then
+    `events`, and a frames.h5 of depth only that the motion field reads as before and the
+    events command refuses by name."""
+    from traj2events.formats.frames import FramesFile
+    from traj2events.settings.events import events_settings
+    from traj2events.stages.events import events_command
+    from traj2events.stages.render_events import render_and_emulate
+
+    settings = events_settings(config)
+    events_command(built / "frames.h5", tmp_path / "two.h5", settings, 5)
+    render_and_emulate(built / "trajectory.h5", RenderSettings.from_config(config, "descent"), settings, 5,
+                       tmp_path / "frames.h5", tmp_path / "video.mkv", None, tmp_path / "one.h5")  # fmt: skip
+    with h5py.File(tmp_path / "two.h5") as two, h5py.File(tmp_path / "one.h5") as one:
+        assert len(two["events/t"]) > 100
+        for name in ("events/x", "events/y", "events/t", "events/p", "events/label", "ms_to_idx"):
+            assert one[name][()].tobytes() == two[name][()].tobytes(), name
+        assert "rendered in the same job" in one.attrs["input_kind"]
+    assert (tmp_path / "video.mkv").read_bytes() == (built / "video.mkv").read_bytes()
+    with FramesFile(tmp_path / "frames.h5") as depth_only, FramesFile(built / "frames.h5") as both:
+        assert not depth_only.has_radiance and depth_only.attrs["radiance"].startswith("emulated in the render job")
+        np.testing.assert_array_equal(depth_only.depth_m(3), both.depth_m(3))
+        with pytest.raises(ValueError, match="depth only .* render.keep_frames"):
+            depth_only.radiance(0)
+    camera = Camera(SIZE, SIZE, config["camera"]["fov_deg"])
+    for name, frames in (("a", built / "frames.h5"), ("b", tmp_path / "frames.h5")):
+        motion_field(built / "trajectory.h5", camera, 1_737_400.0, 7, tmp_path / f"{name}.h5", tmp_path / name, frames)
+    with h5py.File(tmp_path / "a.h5") as a, h5py.File(tmp_path / "b.h5") as b:
+        assert a["displacement_terrain"][()].tobytes() == b["displacement_terrain"][()].tobytes()
+    with pytest.raises(ValueError, match="depth only"):
+        events_command(tmp_path / "frames.h5", tmp_path / "x.h5", settings, 5)

@@ -67,11 +67,16 @@ def cmd_sample(args) -> int:
 
 
 def cmd_render(args) -> int:
-    from .stages.render import RenderSettings, render_trajectory
+    from .stages import render, render_events
 
     keep_freed_memory()
-    settings = _settings(RenderSettings, args.settings)
-    render_trajectory(args.trajectory, settings, args.frames, args.video, args.preview, args.backend, args.tile_cache)
+    settings, files = _settings(render.RenderSettings, args.settings), (args.frames, args.video, args.preview)
+    if args.events:  # the emulator takes the radiance in memory: frames.h5 keeps the depth only
+        events = settings_from(argparse.Namespace(settings=args.events_settings), EVENTS)
+        render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events, None,
+                                         args.backend, args.tile_cache)  # fmt: skip
+    else:
+        render.render_trajectory(args.trajectory, settings, *files, args.backend, args.tile_cache)
     return 0
 
 
@@ -132,12 +137,9 @@ def _calls(stage: str, function: str, *arguments):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="traj2events",
-        description="Synthetic event-camera datasets from mass-optimal lunar landings. "
-        "The Snakemake workflow calls these subcommands; each can also be run by hand. "
-        "Defaults are those of the package's defaults.yaml.",
-    )
+    about = "Synthetic event-camera datasets from mass-optimal lunar landings. The Snakemake workflow calls these "
+    about += "subcommands; each can also be run by hand. Defaults are those of the package's defaults.yaml."
+    parser = argparse.ArgumentParser(prog="traj2events", description=about)
     parser.add_argument("--version", action="version", version=f"traj2events {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -149,12 +151,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("base", help="solve a scenario's base problem (every range at its midpoint)")
     p.add_argument("--settings", required=True, help=settings_help)
     p.add_argument("--output", "-o", required=True, help="base.h5 (nodes only)")
-    p.add_argument(
-        "--record-failure",
-        action="store_true",
-        help="if the problem does not solve, write base.h5 recording it (solver_success 0) and exit 0 "
-        "(the workflow does, so that the failure reaches summary.csv); default: exit 1 and write nothing",
-    )
+    p.add_argument("--record-failure", action="store_true", help="if the problem does not solve, write base.h5 "
+                   "recording it (solver_success 0) and exit 0 (the workflow does, so that the failure reaches "
+                   "summary.csv); default: exit 1 and write nothing")  # fmt: skip
     p.set_defaults(func=cmd_base)
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
@@ -195,6 +194,10 @@ def build_parser() -> argparse.ArgumentParser:
                    "default: %(default)s")  # fmt: skip
     p.add_argument("--tile-cache", metavar="FOLDER", help="share built tiles' terrain heights with other render jobs "
                    "through this folder (the workflow passes render.tile_cache); default: no cache")  # fmt: skip
+    p.add_argument("--events", help="events.h5: also emulate the events, from the frames in memory (frames.h5 then "
+                   "holds the depth only); --events-settings and --seed as for `traj2events events`")  # fmt: skip
+    p.add_argument("--events-settings", metavar="JSON", help="the emulator's settings (`events --settings`)")
+    p.add_argument("--seed", type=int, default=0, help="with --events: the emulator's seed (default 0)")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("motion-field", help="ground-truth motion field of a trajectory (sphere; terrain-true from "

@@ -5,7 +5,9 @@ adaptive frame between two poses, for the emulator only; render.timing); `radian
 (n, H, W) float32 W m^-2 sr^-1 and `depth_m` (n, H, W) float32 along the boresight
 (0 = sky), both rounded to 16 significant bits and compressed one frame per chunk
 (Blosc/LZ4 with byte shuffle: `import hdf5plugin` to read them with h5py);
-attributes: camera, Sun, terrain, reflectance, display, timing."""
+attributes: camera, Sun, terrain, reflectance, display, timing. A render job that also
+emulated the events (`traj2events render --events`) writes the depth only (attribute
+`radiance: "emulated in the render job, not kept"`): what the motion field needs."""
 
 from __future__ import annotations
 
@@ -61,7 +63,9 @@ class FramesWriter:
     with its time and the index of its pose in trajectory.h5 (-1: an adaptive frame
     between two poses, rendered for the emulator only)."""
 
-    def __init__(self, path: str | os.PathLike, height: int, width: int, attrs: dict):
+    def __init__(self, path: str | os.PathLike, height: int, width: int, attrs: dict, radiance: bool = True):
+        """`radiance`: False writes the depth only (the radiance then goes straight to the
+        emulator: `append` still returns it rounded as the file would store it)."""
         self.path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
@@ -78,22 +82,27 @@ class FramesWriter:
                 chunks=(1, height, width),
                 **blosc("lz4", 5, bitshuffle=False),  # rounded floats: byte shuffle is faster and smaller here
             )
-            for name in ("radiance", "depth_m")
+            for name in (("radiance", "depth_m") if radiance else ("depth_m",))
         }
         self._writers = {name: ChunkWriter(dataset) for name, dataset in self._sets.items()}
         # Rounded into one buffer per image, reused: compressed before the next frame comes.
-        self._rounded = {name: np.empty((height, width), np.float32) for name in self._sets}
-        self._attrs = attrs
+        self._rounded = {name: np.empty((height, width), np.float32) for name in ("radiance", "depth_m")}
+        self._attrs = attrs if radiance else {**attrs, "radiance": "emulated in the render job, not kept"}
 
-    def append(self, t_s: float, frame_index: int, radiance: np.ndarray, depth_m: np.ndarray) -> None:
-        ensure_free_space(self.path, 2 * np.asarray(radiance).size * 4)  # both images, uncompressed
+    def append(self, t_s: float, frame_index: int, radiance: np.ndarray, depth_m: np.ndarray) -> np.ndarray:
+        """Adds a frame; returns its radiance rounded as stored (a buffer reused by the next
+        call: copy it to keep it)."""
+        ensure_free_space(self.path, len(self._sets) * np.asarray(radiance).size * 4)  # uncompressed
         i = len(self._t)
         with write_errors_named(self.path):
             for name, image in (("radiance", radiance), ("depth_m", depth_m)):
-                self._sets[name].resize(i + 1, axis=0)
-                self._writers[name][i] = round_mantissa(image, out=self._rounded[name])
+                rounded = round_mantissa(image, out=self._rounded[name])
+                if name in self._sets:
+                    self._sets[name].resize(i + 1, axis=0)
+                    self._writers[name][i] = rounded
         self._t.append(float(t_s))
         self._frame_index.append(int(frame_index))
+        return self._rounded["radiance"]
 
     def _finish(self) -> None:
         write_dataset(self._file, "t", np.asarray(self._t, float))
@@ -123,17 +132,18 @@ class FramesFile:
     def __init__(self, path: str | os.PathLike):
         self.path = Path(path)
         self._file = open_for_reading(self.path, "frames.h5")
-        if "radiance" not in self._file or "t" not in self._file:
+        if not ("radiance" in self._file or "depth_m" in self._file) or "t" not in self._file:
             self._file.close()
-            raise FileFormatError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' and 't')")
+            raise FileFormatError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' or 'depth_m', and 't')")
         self.t = self._file["t"][()]
         self.attrs = Attributes(self.path, self._file.attrs)
-        self.shape = self._file["radiance"].shape
+        self.has_radiance = "radiance" in self._file
+        self.shape = self._file["radiance" if self.has_radiance else "depth_m"].shape
         if len(self.shape) != 3 or len(self.t) != self.shape[0]:
             self._file.close()
             raise FileFormatError(f"{self.path}: radiance has shape {self.shape}, expected ({len(self.t)}, H, W)")
         # Frames are decompressed straight into their arrays (formats.hdf5.ChunkReader).
-        self._radiance = ChunkReader(self._file["radiance"])
+        self._radiance = ChunkReader(self._file["radiance"]) if self.has_radiance else None
         self._depth = ChunkReader(self._file["depth_m"]) if "depth_m" in self._file else None
         self.frame_index = self._file["frame_index"][()] if "frame_index" in self._file else np.arange(len(self.t))
         self._pose_rows = np.flatnonzero(self.frame_index >= 0)
@@ -149,7 +159,15 @@ class FramesFile:
     def row_of_pose(self, k: int) -> int:
         return int(self._pose_rows[k])
 
+    def require_radiance(self) -> None:
+        if not self.has_radiance:
+            raise FileFormatError(
+                f"{self.path}: holds the depth only (its radiance went to the emulator in the render job); "
+                "render.keep_frames: true keeps the radiance"
+            )
+
     def radiance(self, k: int) -> np.ndarray:
+        self.require_radiance()
         return self._radiance[k]
 
     def depth_m(self, k: int) -> np.ndarray:
@@ -167,6 +185,7 @@ class FramesFile:
         are read (copy one to keep it): a new array per chunk cost more in page faults than
         HDF5's decompression. Two let a reader thread fill one while the other is used
         (`read_ahead.read_ahead`)."""
+        self.require_radiance()
         radiance = self._file["radiance"]
         ring = [np.empty((min(chunk, self.shape[0]), *self.shape[1:]), radiance.dtype) for _ in range(buffers)]
         for n, start in enumerate(range(0, self.shape[0], chunk)):

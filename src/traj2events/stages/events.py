@@ -14,7 +14,7 @@ import os
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Generator
+from typing import Generator, Iterator
 
 import numpy as np
 
@@ -110,24 +110,12 @@ def frames_source(
     frames = FramesFile(path)
     _, height, width = frames.shape
     try:
+        frames.require_radiance()  # a depth-only frames.h5 is refused now
         check_recording_length(path, float(frames.t[-1]) if len(frames.t) else None)
+        scale, kind, scene, lens = radiance_input(path, frames.attrs, width, height, sensor, white)
     except ValueError:
         frames.close()
         raise
-    scene = {k: frames.attrs[k] for k in SCENE_ATTRS if k in frames.attrs}
-    if sensor is not None:
-        scale = dn_per_radiance(sensor)
-        kind = "linear radiance as photocurrent (events.sensor)"
-        scene = {**scene, **{f"sensor_{k}": v for k, v in sensor.to_config().items()}}
-    else:
-        white = white or float(frames.attrs.get("display_white_w_m2_sr", 0) or 0)
-        if not white > 0:
-            frames.close()
-            raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
-        scale = display_dn_per_radiance(white)
-        kind = f"linear radiance (white {white:g} W m^-2 sr^-1)"
-
-    lens = _lens(sensor, frames.attrs, width, height) if sensor is not None and sensor.has_optics else None
 
     def radiance():  # float32 as stored: the emulator scales it per pixel (no float64 copy)
         with frames:
@@ -135,6 +123,44 @@ def frames_source(
                 yield (chunk_frames if lens is None else through_lens(chunk_frames, *lens)), times
 
     return FrameSource(width, height, kind, radiance(), scene, scale)
+
+
+def radiance_input(path, attrs, width: int, height: int, sensor: SensorParams | None, white: float | None):
+    """How linear radiance enters the emulator: (DN per radiance, a description, the scene
+    attributes events.h5 repeats, the lens (PSF kernel, vignetting) or None), through
+    `sensor`, or on the display scale 255 L / white (`white` or the frames' display white)."""
+    scene = {k: attrs[k] for k in SCENE_ATTRS if k in attrs}
+    if sensor is not None:
+        scene = {**scene, **{f"sensor_{k}": v for k, v in sensor.to_config().items()}}
+        lens = _lens(sensor, attrs, width, height) if sensor.has_optics else None
+        return dn_per_radiance(sensor), "linear radiance as photocurrent (events.sensor)", scene, lens
+    white = white or float(attrs.get("display_white_w_m2_sr", 0) or 0)
+    if not white > 0:
+        raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
+    return display_dn_per_radiance(white), f"linear radiance (white {white:g} W m^-2 sr^-1)", scene, None
+
+
+def rendered_source(
+    attrs: dict, frames: Iterator[tuple[float, np.ndarray]], sensor: SensorParams | None, chunk: int
+) -> FrameSource:
+    """Frames as a render job yields them, (t, radiance rounded as frames.h5 stores it), in
+    chunks: the same input as frames.h5 read back (`frames_source`), without the file."""
+    width, height = int(attrs["width"]), int(attrs["height"])
+    scale, kind, scene, lens = radiance_input("the render job", attrs, width, height, sensor, None)
+
+    def radiance():
+        batch, times = np.empty((chunk, height, width), np.float32), []
+        for t, frame in frames:
+            batch[len(times)] = frame
+            times.append(t)
+            if len(times) == chunk:
+                yield (batch if lens is None else through_lens(batch, *lens)), np.asarray(times)
+                times = []
+        if times:
+            k = len(times)
+            yield (batch[:k] if lens is None else through_lens(batch[:k], *lens)), np.asarray(times)
+
+    return FrameSource(width, height, kind + ", rendered in the same job", radiance(), scene, scale)
 
 
 def _lens(sensor: SensorParams, attrs, width: int, height: int) -> tuple[np.ndarray, np.ndarray | None]:

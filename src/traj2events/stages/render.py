@@ -156,6 +156,102 @@ def render_between(
         yield t_s, state, frame
 
 
+class TrajectoryRender:
+    """A trajectory's render job: the scene built for it (`attrs`: frames.h5's attributes),
+    then its frames (`frames`)."""
+
+    def __init__(self, trajectory: str | os.PathLike, settings: RenderSettings, tile_cache: str | None = None):
+        self.trajectory, self.settings = trajectory, settings
+        self.tr = tr = read_trajectory(trajectory)
+        if tr.t is None or len(tr.t) < 1:
+            raise ValueError(f"{trajectory}: expected poses/t with at least one pose")
+        self.timing = FrameTiming(**settings.timing)
+        self.camera, self.tiles, self.sun, self.reflectance = settings.build(tile_cache)
+        attrs = {
+            **settings.frame_attrs(self.camera, self.sun),
+            "fps": float(tr.attrs["fps"]),
+            "scenario": tr.attrs["scenario"],
+            "id": int(tr.attrs["id"]),
+            "traj2events_version": __version__,
+        }
+        self.attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
+
+    def frames(
+        self,
+        frames: str | os.PathLike,
+        video: str | os.PathLike,
+        preview: str | os.PathLike | None,
+        backend: str = "auto",
+        keep_radiance: bool = True,
+    ) -> Iterator[tuple[float, np.ndarray]]:
+        """Render every pose, writing frames.h5 (radiance unless not `keep_radiance`, depth),
+        video.mkv and preview.mp4 (None: none) as it goes; yields each frame's (t in s,
+        radiance as frames.h5 stores it, rounded: a buffer the next frame reuses), the
+        adaptive frames between poses included."""
+        s, tr, tiles, camera, timing = self.settings, self.tr, self.tiles, self.camera, self.timing
+        fps, n = self.attrs["fps"], len(tr.t)
+        log(
+            f"{self.trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {self.sun.azimuth_deg} deg, "
+            f"el {self.sun.elevation_deg} deg, {s.reflectance['model']}; {timing.mode} timing)"
+        )
+        # Adaptive frames need poses between the fixed ones: the same re-integration, kept dense.
+        states = None
+        if timing.mode == "adaptive":
+            states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+        start = time.perf_counter()
+        triangles = reused = added = 0
+        with (
+            TerrainRenderer(
+                tiles, camera, self.sun, self.reflectance, stars=s.star_field(), backend=backend,
+                earth=s.earth_light(),
+            ) as renderer,
+            FramesWriter(frames, s.height, s.width, self.attrs, radiance=keep_radiance) as out,
+            VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
+            VideoWriter(preview, s.width, s.height, fps, "h264") if preview else contextlib.nullcontext() as shown,
+        ):  # fmt: skip
+            log(f"  OpenGL: {renderer.backend} ({renderer.gl_renderer})")
+            # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
+            moved = [k == 0 or not np.array_equal(tr.state[k, POSE], tr.state[k - 1, POSE]) for k in range(n)]
+            # Drawn one ahead: the GPU draws pose k+1 while this loop writes frame k.
+            drawn = renderer.render_sequence(camera.pose(tr.state[k]) for k in range(n) if moved[k])
+            for k in range(n):
+                if moved[k]:
+                    frame = next(drawn)
+                    triangles += frame.n_triangles
+                else:
+                    reused += 1
+                yield tr.t[k], out.append(tr.t[k], k, frame.radiance, frame.depth_m)
+                display = display_frame(frame.radiance, s.display_white_w_m2_sr, s.display_gamma)
+                lossless.write(display)
+                if shown is not None:
+                    shown.write(display)
+                if states is not None and k + 1 < n:
+                    between = render_between(
+                        renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing,
+                        s.emulator_white_w_m2_sr,
+                    )  # fmt: skip
+                    for t_extra, _, extra in between:  # written as rendered: memory stays one frame
+                        yield t_extra, out.append(t_extra, -1, extra.radiance, extra.depth_m)
+                        triangles += extra.n_triangles
+                        added += 1
+                if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
+                    elapsed = time.perf_counter() - start
+                    log(
+                        f"  {k + 1}/{n} frames (+{added} adaptive), {elapsed / (k + 1 + added) * 1e3:.1f} ms/frame, "
+                        f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 + added - reused, 1):.0f} "
+                        "triangles/frame"
+                    )
+        log(
+            f"{n} frames and {added} adaptive ones in {time.perf_counter() - start:.1f} s "
+            f"({reused} repeated poses reused)"
+        )
+        log(f"tiles and shading textures: {tiles.building_s:.1f} s building them or reading them from the tile cache")
+        if tiles.disk is not None:
+            log(f"tiles: {tiles.n_evaluated} built, {tiles.disk.n_read} read from the tile cache {tiles.disk.folder}")
+            for textures in tiles.texture_disks.values():
+                log(f"shading textures: {textures.n_written} made, {textures.n_read} read from {textures.folder}")
+
+
 def render_trajectory(
     trajectory: str | os.PathLike,
     settings: RenderSettings,
@@ -169,76 +265,8 @@ def render_trajectory(
     `preview` is None, preview.mp4 (render.preview; its H.264 encoder costs CPU: docs/performance.md).
     `backend`: the OpenGL backend (renderer.context.resolve_backend); `tile_cache`: a folder where
     tile heights are shared with other jobs (formats/tile_cache.py). Neither changes the scene."""
-    s = settings
-    tr = read_trajectory(trajectory)
-    if tr.t is None or len(tr.t) < 1:
-        raise ValueError(f"{trajectory}: expected poses/t with at least one pose")
-    timing = FrameTiming(**s.timing)
-    camera, tiles, sun, reflectance = s.build(tile_cache)
-    fps = float(tr.attrs["fps"])
-    n = len(tr.t)
-    attrs = {
-        **s.frame_attrs(camera, sun),
-        "fps": fps,
-        "scenario": tr.attrs["scenario"],
-        "id": int(tr.attrs["id"]),
-        "traj2events_version": __version__,
-    }
-    attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
-    log(
-        f"{trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {sun.azimuth_deg} deg, "
-        f"el {sun.elevation_deg} deg, {s.reflectance['model']}; {timing.mode} timing)"
-    )
-    # Adaptive frames need poses between the fixed ones: the same re-integration, kept dense.
-    states = None
-    if timing.mode == "adaptive":
-        states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
-    start = time.perf_counter()
-    triangles = reused = added = 0
-    with (
-        TerrainRenderer(
-            tiles, camera, sun, reflectance, stars=s.star_field(), backend=backend, earth=s.earth_light()
-        ) as renderer,
-        FramesWriter(frames, s.height, s.width, attrs) as out,
-        VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
-        VideoWriter(preview, s.width, s.height, fps, "h264") if preview else contextlib.nullcontext() as shown_preview,
-    ):
-        log(f"  OpenGL: {renderer.backend} ({renderer.gl_renderer})")
-        # A pose identical to the previous one (e.g. resting after touchdown) shows the same image.
-        moved = [k == 0 or not np.array_equal(tr.state[k, POSE], tr.state[k - 1, POSE]) for k in range(n)]
-        # Drawn one ahead: the GPU draws pose k+1 while this loop writes frame k.
-        drawn = renderer.render_sequence(camera.pose(tr.state[k]) for k in range(n) if moved[k])
-        for k in range(n):
-            if moved[k]:
-                frame = next(drawn)
-                triangles += frame.n_triangles
-            else:
-                reused += 1
-            out.append(tr.t[k], k, frame.radiance, frame.depth_m)
-            shown = display_frame(frame.radiance, s.display_white_w_m2_sr, s.display_gamma)
-            lossless.write(shown)
-            if shown_preview is not None:
-                shown_preview.write(shown)
-            if states is not None and k + 1 < n:
-                between = render_between(
-                    renderer, camera, states, frame, tr.state[k], tr.t[k], tr.t[k + 1], timing, s.emulator_white_w_m2_sr
-                )
-                for t_extra, _, extra in between:  # written as rendered: memory stays one frame
-                    out.append(t_extra, -1, extra.radiance, extra.depth_m)
-                    triangles += extra.n_triangles
-                    added += 1
-            if (k + 1) % max(1, n // 10) == 0 or k + 1 == n:
-                elapsed = time.perf_counter() - start
-                log(
-                    f"  {k + 1}/{n} frames (+{added} adaptive), {elapsed / (k + 1 + added) * 1e3:.1f} ms/frame, "
-                    f"{tiles.n_cached} tiles cached, {triangles / max(k + 1 + added - reused, 1):.0f} triangles/frame"
-                )
-    log(f"{n} frames and {added} adaptive ones in {time.perf_counter() - start:.1f} s ({reused} repeated poses reused)")
-    log(f"tiles and shading textures: {tiles.building_s:.1f} s building them or reading them from the tile cache")
-    if tiles.disk is not None:
-        log(f"tiles: {tiles.n_evaluated} built, {tiles.disk.n_read} read from the tile cache {tiles.disk.folder}")
-        for textures in tiles.texture_disks.values():
-            log(f"shading textures: {textures.n_written} made, {textures.n_read} read from {textures.folder}")
+    for _ in TrajectoryRender(trajectory, settings, tile_cache).frames(frames, video, preview, backend):
+        pass
 
 
 # frames.h5's attribute order (kept, so the same scene gives the same bytes).

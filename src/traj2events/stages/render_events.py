@@ -1,0 +1,63 @@
+"""Stages 4-5 and 7 in one job: render a trajectory and emulate its events from the frames
+in memory, without writing the radiance to frames.h5 and reading it back (docs/events.md
+"Rendered and emulated in one job"). frames.h5 then holds the depth only, for the motion
+field. The events are the same bytes as `render` then `events` give on the same settings:
+the emulator takes the radiance rounded as frames.h5 would store it.
+"""
+
+from __future__ import annotations
+
+import os
+
+from ..formats.trajectory import read_trajectory
+from ..progress import log
+from ..sensor.emulator import EmulatorParams
+from ..sensor.photocurrent import SensorParams
+from ..sensor.readout import ReadoutParams
+from .events import CHUNK_FRAMES, check_recording_length, emulate, export_events, rendered_source
+from .render import RenderSettings, TrajectoryRender
+
+
+def render_and_emulate(
+    trajectory: str | os.PathLike,
+    settings: RenderSettings,
+    events_settings: dict,
+    seed: int,
+    frames: str | os.PathLike,
+    video: str | os.PathLike,
+    preview: str | os.PathLike | None,
+    events: str | os.PathLike,
+    exports: dict[str, str | None] | None = None,
+    backend: str = "auto",
+    tile_cache: str | None = None,
+    keep_radiance: bool = False,
+) -> None:
+    """`render.render_trajectory` and `events.events_command` on its frames in one pass:
+    frames.h5 (depth, and the radiance only with `keep_radiance`), video.mkv, preview.mp4,
+    events.h5 with the settings.events of `events_settings` and the trajectory's `seed`,
+    and the exports (npz, evt3, aedat4 paths or None). One core: the emulator runs between
+    the renderer's frames."""
+    if seed < 0:
+        raise ValueError(f"render: seed: expected a value >= 0, got {seed}")
+    check_recording_length(trajectory, float(read_trajectory(trajectory).t[-1]))  # refused now, not after the render
+    params = EmulatorParams(**events_settings["pixel"])
+    sensor = SensorParams.from_config(events_settings["sensor"]) if events_settings["input"] == "sensor" else None
+    job = TrajectoryRender(trajectory, settings, tile_cache)
+    rendered = job.frames(frames, video, preview, backend, keep_radiance)
+    source = rendered_source(job.attrs, rendered, sensor, CHUNK_FRAMES)
+    preset_name = events_settings["preset"]
+    log(f"{trajectory}: {source.kind} -> {events} (preset {preset_name}, seed {seed})")
+    emulate(
+        source,
+        params,
+        seed,
+        events,
+        preset_name,
+        f"{trajectory} (rendered in the same job)",
+        progress_every=CHUNK_FRAMES * 10,
+        labels=events_settings["labels"],
+        readout=ReadoutParams(**events_settings["readout"]),
+        device=events_settings["device"],
+    )
+    e = exports or {}
+    export_events(events, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)
