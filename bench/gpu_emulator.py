@@ -79,18 +79,25 @@ def split_times(frames: np.ndarray, scale: float) -> dict[str, float]:
     return spent
 
 
+def card_name() -> str | None:
+    """The GPU's name, or None (said) where numba finds none."""
+    from numba import cuda
+
+    if not cuda.is_available():
+        print("no usable CUDA GPU here (a driver, and pip install '.[gpu]'): nothing to measure")
+        return None
+    card = getattr(cuda.get_current_device(), "name", "numba's CUDA simulator")
+    return card.decode() if isinstance(card, bytes) else card
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--frames", type=int, default=200)
     parser.add_argument("--size", type=int, default=1024)
     args = parser.parse_args()
-    from numba import cuda
-
-    if not cuda.is_available():
-        print("no usable CUDA GPU here (a driver, and pip install '.[gpu]'): nothing to measure")
+    card = card_name()
+    if card is None:
         return
-    card = getattr(cuda.get_current_device(), "name", "numba's CUDA simulator")
-    card = card.decode() if isinstance(card, bytes) else card
     print(f"# GPU emulator, paper preset, {args.size}^2, {args.frames} frames at 100 fps, on {platform.node()} "
           f"({card}), {datetime.date.today()}")  # fmt: skip
     texture = moving_texture(args.size, args.size, args.frames)

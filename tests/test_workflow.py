@@ -425,6 +425,19 @@ def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_
     }
 
 
+def test_frames_not_kept_render_and_emulate_in_one_job(tmp_path):
+    """render.keep_frames false: the render jobs write events.h5 and the exports from the
+    frames in memory (the same events as two jobs: tests/test_stages.py); no events job."""
+    config = two_scenario_smoke()
+    config["render"] = {**config.get("render", {}), "keep_frames": False}
+    config["events"] = {**config.get("events", {}), "exports": ["npz"]}
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    jobs = jobs_in_dry_run(tmp_path)
+    assert "events" not in jobs and jobs["render"] == jobs["events_picture"] == jobs["motion_field"] == 3
+    out = snakemake(tmp_path, "-n", "-p", "results/hover/0000/events.npz").stdout
+    assert "traj2events render" in out and "--events results/hover/0000/events.h5" in out and "--exports npz" in out
+
+
 def test_a_failing_scenario_does_not_stop_the_others(tmp_path):
     config = two_scenario_smoke()
     # 90 km up at 15-20 m/s: the base problem solves, but no sample meets the accuracy

@@ -1,6 +1,5 @@
-"""Command line: `traj2events SUBCOMMAND --help`. Each subcommand parses its arguments and
-calls one stage function (traj2events.stages); the workflow's rules call these, and each
-can be run by hand. Defaults come from defaults.yaml, like the workflow's."""
+"""Command line: `traj2events SUBCOMMAND --help`. Each subcommand parses its arguments and calls one stage
+function (traj2events.stages); the workflow's rules call these, each can be run by hand; defaults: defaults.yaml."""
 
 from __future__ import annotations
 
@@ -18,7 +17,7 @@ from .defaults import section
 from .memory import keep_freed_memory
 from .options import add_settings, inline_or_file, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
-from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE
+from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE, EXPORT_SUFFIX
 from .settings.imu import IMU
 from .settings.poses import POSES
 
@@ -73,7 +72,9 @@ def cmd_render(args) -> int:
     settings, files = _settings(render.RenderSettings, args.settings), (args.frames, args.video, args.preview)
     if args.events:  # the emulator takes the radiance in memory: frames.h5 keeps the depth only
         events = settings_from(argparse.Namespace(settings=args.events_settings), EVENTS)
-        render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events, None,
+        beside = os.path.dirname(args.events)
+        exports = {name: os.path.join(beside, f"events.{EXPORT_SUFFIX[name]}") for name in args.exports}
+        render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events, exports,
                                          args.backend, args.tile_cache)  # fmt: skip
     else:
         render.render_trajectory(args.trajectory, settings, *files, args.backend, args.tile_cache)
@@ -94,18 +95,10 @@ def cmd_events(args) -> int:
     from .stages.events import events_command
 
     keep_freed_memory()
-    events_command(
-        args.input,
-        args.output,
-        settings_from(args, EVENTS),
-        args.seed,
-        fps=args.fps,
-        white=args.white,
-        chunk=args.chunk,
-        threads=len(os.sched_getaffinity(0)) if args.threads is None else args.threads,
-        exports={"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4},
-        trajectory=args.trajectory,
-    )
+    threads = len(os.sched_getaffinity(0)) if args.threads is None else args.threads
+    exports = {"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4}
+    events_command(args.input, args.output, settings_from(args, EVENTS), args.seed, fps=args.fps, white=args.white,
+                   chunk=args.chunk, threads=threads, exports=exports, trajectory=args.trajectory)  # fmt: skip
     return 0
 
 
@@ -198,6 +191,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "holds the depth only); --events-settings and --seed as for `traj2events events`")  # fmt: skip
     p.add_argument("--events-settings", metavar="JSON", help="the emulator's settings (`events --settings`)")
     p.add_argument("--seed", type=int, default=0, help="with --events: the emulator's seed (default 0)")
+    p.add_argument("--exports", nargs="*", default=[], choices=list(EXPORT_SUFFIX), help="with --events: also these")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("motion-field", help="ground-truth motion field of a trajectory (sphere; terrain-true from "

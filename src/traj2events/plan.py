@@ -144,8 +144,12 @@ def too_large(plan: Plan) -> str | None:
 
 def job_resources(config: dict, stage: str, scenario: str | None, threads: int = 1) -> dict[str, int]:
     """What one job of `stage` (render, motion_field, events, sample_trajectories; others
-    get the defaults) is expected to need for the (validated) config: `mem_mb` and
-    `runtime` (minutes), for a cluster scheduler. Estimates with a margin, not bounds."""
+    get the defaults; render_events, the two in one job: their sum) is expected to need for
+    the (validated) config: `mem_mb` and `runtime` (minutes), for a cluster scheduler.
+    Estimates with a margin, not bounds."""
+    if stage == "render_events":
+        parts = [job_resources(config, part, scenario, threads) for part in ("render", "events")]
+        return {key: sum(part[key] for part in parts) for key in ("mem_mb", "runtime")}
     camera = config["camera"]
     pixels = camera["width"] * camera["height"]
     if scenario is None:

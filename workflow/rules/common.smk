@@ -83,17 +83,37 @@ def tile_cache_option(wildcards):
     return f"--tile-cache '{folder}'" if folder else ""
 
 
+# Frames not kept (render.keep_frames: false): one job renders and emulates, the radiance
+# in memory, and frames.h5 holds the depth only, for the motion field (docs/events.md).
+ONE_JOB = not config["render"]["keep_frames"]
+
+
 def frames_output(path):
     """frames.h5 (linear radiance + depth) is large: temporary unless render.keep_frames."""
     return path if config["render"]["keep_frames"] else temp(path)
 
 
 def render_outputs(folder):
-    """The render job's files: frames.h5, video.mkv and, with render.preview, preview.mp4."""
+    """The render job's files: frames.h5, video.mkv and, with render.preview, preview.mp4;
+    as one job with the events (ONE_JOB), events.h5 and its exports too."""
     outputs = {"frames": frames_output(f"{folder}/frames.h5"), "video": f"{folder}/video.mkv"}
     if config["render"]["preview"]:
         outputs["preview"] = f"{folder}/preview.mp4"
+    if ONE_JOB:
+        outputs.update(events=f"{folder}/events.h5", **export_outputs(folder))
     return outputs
+
+
+def events_in_render(wildcards, output):
+    """The render command's --events options as one job (ONE_JOB), else nothing. Its
+    settings, seed and code are also the rule's own params, so that they rerun it."""
+    if not ONE_JOB:
+        return ""
+    exports = " ".join(config["events"]["exports"])
+    settings = shlex.quote(json.dumps(events_settings_of(config), sort_keys=True))
+    return f"--events {output.events} --events-settings {settings} --seed {trajectory_seed(wildcards)}" + (
+        f" --exports {exports}" if exports else ""
+    )
 
 
 def preview_option(wildcards, output):

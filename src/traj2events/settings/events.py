@@ -15,6 +15,8 @@ EVENTS = {
     "device": "events.device",
 }
 EVENTS_PICTURE = {"window_ms": "events.window_ms"}
+# events.exports: each format's file suffix beside events.h5 (events.npz, events.raw, events.aedat4).
+EXPORT_SUFFIX = {"npz": "npz", "evt3": "raw", "aedat4": "aedat4"}
 # The events command's options where a key's own name would say too little.
 EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--readout-mode"}
 

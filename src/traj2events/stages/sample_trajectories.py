@@ -114,6 +114,8 @@ def sample_trajectories(
     """Solve the scenario's samples (drawing again for failed ones); write solutions.h5
     and samples.csv. A base that did not solve (recorded by `traj2events base
     --record-failure`) draws nothing: both files say so and hold no sample."""
+    if jobs < 1:
+        raise ValueError(f"sample: --jobs: expected >= 1, got {jobs}")
     s = settings
     base_solution = read_base(base, s)
     if base_solution.success:
