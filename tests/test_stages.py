@@ -154,6 +154,15 @@ def test_motion_field_with_the_terrain_field(built, config):
         np.testing.assert_allclose(f.attrs["camera_matrix_px"], camera.matrix)
         assert set(np.unique(f["status_terrain"][()])) <= {0, 1, 2, 3, 4}
     assert sorted(p.name for p in (built / "flow").iterdir()) == [f"{k:06d}.flo" for k in frames]
+    # The range meter at every pose: the central pixel's depth along its ray (half a pixel
+    # off the boresight), the same readings the ELOPE export samples at 10 Hz.
+    with h5py.File(built / "mf.h5") as f, h5py.File(built / "frames.h5") as rendered:
+        t, slant = f["range_meter/t"][()], f["range_meter/slant_range_m"][()]
+        depth = rendered["depth_m"][:, SIZE // 2, SIZE // 2]
+    np.testing.assert_array_equal(t, read_trajectory(built / "trajectory.h5").t)
+    ray = np.sqrt(1 + 2 * (0.5 / camera_focal(config)) ** 2)
+    np.testing.assert_allclose(slant, depth * ray, rtol=1e-6)
+    assert slant.min() > 0 and slant[-1] < slant[0]  # ground in view all the way, nearer at the end
     with pytest.raises(ValueError, match="every_n_frames"):
         motion_field(built / "trajectory.h5", camera, 1_737_400.0, 0, built / "x.h5", built / "x")
 

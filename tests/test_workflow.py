@@ -176,6 +176,8 @@ def test_the_loader_reads_the_built_dataset(built):
     radiance, depth = landing.frame(5)
     with h5py.File(landing.folder / "frames.h5") as f:
         assert (radiance == f["radiance"][5]).all() and (depth == f["depth_m"][5]).all()
+    t_range, slant = landing.range_meter()
+    assert np.array_equal(t_range, t) and slant.dtype == np.float32 and 0 < slant[5] < 2 * depth[16, 16]
     np.testing.assert_allclose(landing.camera_matrix[0, 0], attrs["focal_px"])
     windows = EventWindows(dataset, 0.5)
     assert len(windows) == sum(int(x.poses()[0][-1] / 0.5 + 1e-9) for x in dataset)

@@ -8,6 +8,7 @@
     events, labels = landing.labelled_events(1.0, 1.01)  # and each event's cause
     t, state = landing.poses()               # (K,) s, (K, 13) in the units of state_units
     fields = landing.motion_field(3)         # the 4th field written: arrays by name
+    t, slant = landing.range_meter()         # the range meter at every pose (s, m)
     radiance, depth = landing.frame(100)     # frames.h5, when kept
 
 Each `Landing` reads only what is asked, when it is asked (event windows through
@@ -85,6 +86,12 @@ class Landing:
             if not -n <= i < n:
                 raise IndexError(f"{self.folder / 'motion_field.h5'}: field {i} of {n}")
             return {name: f[name][i] for name in f if isinstance(f[name], h5py.Dataset) and len(f[name]) == n}
+
+    def range_meter(self) -> tuple[np.ndarray, np.ndarray]:
+        """The range meter at every pose (motion_field.h5): t (s) and the slant range along
+        the central pixel's ray to the rendered terrain (m, 0 = sky)."""
+        with open_file(self.folder / "motion_field.h5", "motion_field.h5") as f:
+            return f["range_meter/t"][()], f["range_meter/slant_range_m"][()]
 
     def frame(self, k: int) -> tuple[np.ndarray, np.ndarray]:
         """Pose k's frame: linear radiance (H, W) W m^-2 sr^-1 and depth (H, W) m (frames.h5 kept)."""

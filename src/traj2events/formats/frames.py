@@ -179,6 +179,17 @@ class FramesFile:
         """The depth of pixel (row i, column j) in every frame (n,)."""
         return self._file["depth_m"][:, i, j]
 
+    def slant_range_m(self) -> np.ndarray:
+        """The range meter's reading in every row: the distance along the central pixel's
+        ray (pixel (H/2, W/2), half a pixel off the boresight for even sizes) to the rendered
+        terrain, m; 0 = sky. The depth (along the boresight) times the ray's length per unit
+        depth."""
+        _, h, w = self.shape
+        i, j = h // 2, w // 2
+        focal = float(self.attrs["focal_px"])
+        ray = np.sqrt(1.0 + ((j + 0.5 - w / 2) / focal) ** 2 + ((i + 0.5 - h / 2) / focal) ** 2)
+        return self.depth_at(i, j) * ray
+
     def radiance_chunks(self, chunk: int, buffers: int = 1) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames.
         The chunks take turns in a ring of `buffers` arrays, each valid until `buffers` more

@@ -14,8 +14,8 @@ Per frame interval [t_k, t_k+1]:
   6. leak: base drifts down by theta_on per leak period (rate
      R_leak 10^(0.1 N(0, 1)) per pixel, from a random phase)               (pixel.advance)
   7. shot noise: Poisson ON/OFF events at R_shot g(I) theta_nom / theta(x);
-     a noise event resets the pixel's reference to its current signal       (pixel, draws)
-  8. hot pixels: a fraction of pixels firing ON at a fixed rate            (pixel, draws)
+     a noise event resets the pixel's reference to its current signal       (noise, pixel.emit)
+  8. hot pixels: a fraction of pixels firing ON at a fixed rate            (noise, pixel.emit)
 
 Events are a numpy structured array (x, y, t, p) in tonic's convention: x column, y row
 (uint16), t int64 microseconds (rounded), p 1 = ON, 0 = OFF, sorted by t (or, from
@@ -28,7 +28,7 @@ video is chunked and whichever thread or device does a pixel.
 Input: 8-bit DN, or float DN-equivalents of linear radiance (radiance times `input_scale`,
 applied per pixel in float64 inside the kernels).
 
-Read this module, `pixel` (the per-pixel loop) and `laws`; the machinery behind them is
+Read this module, `pixel` (the per-pixel loop), `noise` and `laws`; the machinery behind them is
 `draws` (random numbers keyed by what they are for), `ordering` (sorting each interval's
 events) and `parallel` (the per-pixel pass split over threads).
 """

@@ -309,14 +309,10 @@ RANGE_METER_HZ = 10.0  # ELOPE's range meter rate
 
 
 def central_range(frames: str | os.PathLike, rate_hz: float = RANGE_METER_HZ) -> np.ndarray:
-    """(n, 2): t (s) every 1/rate_hz and the distance along the central pixel's ray (m,
-    0 = sky) in the frame nearest that time, from frames.h5's depth (along the boresight)."""
+    """(n, 2): t (s) every 1/rate_hz and the range meter's reading (`FramesFile.slant_range_m`)
+    in the frame nearest that time: ELOPE's range meter."""
     with FramesFile(frames) as f:
-        _, h, w = f.shape
-        i, j = h // 2, w // 2
-        focal = float(f.attrs["focal_px"])
-        ray = np.sqrt(1.0 + ((j + 0.5 - w / 2) / focal) ** 2 + ((i + 0.5 - h / 2) / focal) ** 2)
-        distance = f.depth_at(i, j) * ray
+        distance = f.slant_range_m()
         t_frames = f.t
     t = np.arange(int(np.floor(t_frames[-1] * rate_hz + 1e-9)) + 1) / rate_hz
     nearest = np.clip(np.searchsorted(t_frames, t), 1, len(t_frames) - 1)

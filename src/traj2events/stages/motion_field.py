@@ -1,6 +1,7 @@
 """Stage 6: the ground-truth motion field of every n-th frame of a trajectory, over the
 Moon's sphere (analytic) and, given frames.h5, of the rendered terrain from its depth:
-instantaneous flow (px/s) and the exact displacement to the next frame (px)."""
+instantaneous flow (px/s) and the exact displacement to the next frame (px); and, from
+the same depth, the range meter (slant range along the central pixel) at every pose."""
 
 from __future__ import annotations
 
@@ -120,6 +121,10 @@ def motion_field(
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
             if rendered is not None:
+                # The range meter at every pose (not only at the fields): ELOPE's, at the camera's rate.
+                poses = [rendered.row_of_pose(k) for k in range(len(tr.t))]
+                write_dataset(out, "range_meter/t", tr.t)
+                write_dataset(out, "range_meter/slant_range_m", rendered.slant_range_m()[poses].astype(np.float32))
                 write_dataset(out, "sphere_minus_terrain_mean_px_s", offset_mean)
                 write_dataset(out, "sphere_minus_terrain_rms_px_s", offset_rms)
                 median = float(np.nanmedian(offset_rms)) if np.isfinite(offset_rms).any() else np.nan
