@@ -61,7 +61,7 @@ def dataset_config(keep_frames: bool) -> dict:
 
 
 def snakemake(repo: Path, workdir: Path, env: dict, *args: str) -> subprocess.CompletedProcess:
-    cmd = [str(SNAKEMAKE), "-s", str(repo / "Snakefile"), "--directory", str(workdir), "--cores", "2",
+    cmd = [str(SNAKEMAKE), "-s", str(repo / "workflow" / "Snakefile"), "--directory", str(workdir), "--cores", "2",
            "--configfile", str(workdir / "config.yaml"), *args]  # fmt: skip
     run = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=workdir)
     if run.returncode != 0:

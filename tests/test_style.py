@@ -24,5 +24,5 @@ def test_python_is_formatted():
 
 
 def test_snakefiles_are_formatted():
-    result = run("snakefmt", "--check", "Snakefile", "workflow")
+    result = run("snakefmt", "--check", "workflow")
     assert result.returncode == 0, result.stdout + result.stderr

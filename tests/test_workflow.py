@@ -25,7 +25,7 @@ def snakemake(workdir, *args, env=None, check=True):
     cmd = [
         str(SNAKEMAKE),
         "-s",
-        str(ROOT / "Snakefile"),
+        str(ROOT / "workflow" / "Snakefile"),
         "--directory",
         str(workdir),
         "--cores",
@@ -281,7 +281,7 @@ def test_a_killed_run_recovers_as_the_readme_says(built, tmp_path):
     emulating (their temporaries exist), each time followed by --unlock and the same
     command, as the README says: one run killed three times, so the dataset is built once."""
     shutil.copy(built / "config.yaml", tmp_path / "config.yaml")
-    cmd = [str(SNAKEMAKE), "-s", str(ROOT / "Snakefile"), "--directory", str(tmp_path), "--cores", "2",
+    cmd = [str(SNAKEMAKE), "-s", str(ROOT / "workflow" / "Snakefile"), "--directory", str(tmp_path), "--cores", "2",
            "--configfile", str(tmp_path / "config.yaml")]  # fmt: skip
     for marker in ("logs/*/sample_trajectories.log", "*/*/.frames.h5.*.part", "*/*/.events.h5.*.part"):
         run = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
@@ -427,6 +427,18 @@ def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_
     }
 
 
+def test_the_catalog_layout_finds_the_workflow_from_the_root_with_its_test_config(tmp_path):
+    """snakemake-workflow-catalog: workflow/Snakefile, found from the repository's root
+    without -s, and `.test/config/config.yaml` for `--directory .test` (copied here, so
+    that the run writes nothing into the checkout)."""
+    shutil.copytree(ROOT / ".test", tmp_path / ".test")
+    run = subprocess.run([str(SNAKEMAKE), "-n", "--directory", str(tmp_path / ".test")], capture_output=True,
+                         text=True, cwd=ROOT)  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert f"Snakefile: {ROOT / 'workflow' / 'Snakefile'}" in run.stdout + run.stderr
+    assert "dataset_index" in run.stdout and not (ROOT / ".test" / ".snakemake").exists()
+
+
 def test_frames_not_kept_render_and_emulate_in_one_job(tmp_path):
     """render.keep_frames false: the render jobs write events.h5 and the exports from the
     frames in memory (the same events as two jobs: tests/test_stages.py); no events job."""
@@ -491,7 +503,7 @@ def test_a_config_file_that_is_not_utf8_is_named(tmp_path):
 
 def test_lint_passes():
     run = subprocess.run(
-        [str(SNAKEMAKE), "--lint", "-s", str(ROOT / "Snakefile")], capture_output=True, text=True, cwd=ROOT
+        [str(SNAKEMAKE), "--lint", "-s", str(ROOT / "workflow" / "Snakefile")], capture_output=True, text=True, cwd=ROOT
     )
     assert run.returncode == 0, run.stdout + run.stderr
     assert "Congratulations" in run.stdout + run.stderr

@@ -34,7 +34,7 @@ if DeploymentMethod.CONDA in workflow.deployment_settings.deployment_method:
     # --sdm conda: each rule's environment (envs/*.yaml) holds the dependencies and the
     # package runs from this checkout, as `python -m traj2events`.
     shell.prefix(
-        f"set -euo pipefail; export PYTHONPATH={shlex.quote(str(Path(workflow.basedir) / 'src'))}"
+        f"set -euo pipefail; export PYTHONPATH={shlex.quote(str(Path(workflow.basedir).parent / 'src'))}"
         ':"${PYTHONPATH:-}"; traj2events() { python -m traj2events "$@"; }; '
     )
 else:
