@@ -83,3 +83,25 @@ def test_radiance_chunks_take_turns_in_a_ring_of_buffers(tmp_path, buffers):
                 assert np.shares_memory(a, b) == (n % buffers == m % buffers)
         for n in range(len(chunks) - buffers, len(chunks)):  # the last `buffers` chunks are still intact
             np.testing.assert_array_equal(chunks[n][0], rounded_reference(radiance[2 * n : 2 * n + 2]))
+
+
+def test_the_range_meter_is_recorded_as_written_and_equals_the_stored_depths(tmp_path):
+    """slant_range_m, taken from each depth as it is written, is what the stored depth gives
+    (the central pixel's depth times its ray length), without decompressing every frame."""
+    import h5py
+
+    from traj2events.formats.frames import central_ray
+
+    rng = np.random.default_rng(2)
+    with FramesWriter(tmp_path / "frames.h5", 6, 8, {"focal_px": 7.0}, radiance=False) as out:
+        for k in range(5):
+            out.append(k / 10, k, np.zeros((6, 8)), rng.uniform(10.0, 900.0, (6, 8)))
+    i, j, ray = central_ray(6, 8, 7.0)
+    assert (i, j) == (3, 4) and ray == pytest.approx(np.sqrt(1 + 2 * (0.5 / 7.0) ** 2), rel=1e-15)
+    with FramesFile(tmp_path / "frames.h5") as f:
+        recorded = f.slant_range_m()
+        np.testing.assert_array_equal(recorded, f.depth_at(i, j) * np.float64(ray))
+    with h5py.File(tmp_path / "frames.h5", "a") as f:  # a file written before the record: the same values
+        del f["slant_range_m"]
+    with FramesFile(tmp_path / "frames.h5") as f:
+        np.testing.assert_array_equal(f.slant_range_m(), recorded)

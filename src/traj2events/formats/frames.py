@@ -5,9 +5,11 @@ adaptive frame between two poses, for the emulator only; render.timing); `radian
 (n, H, W) float32 W m^-2 sr^-1 and `depth_m` (n, H, W) float32 along the boresight
 (0 = sky), both rounded to 16 significant bits and compressed one frame per chunk
 (Blosc/LZ4 with byte shuffle: `import hdf5plugin` to read them with h5py);
-attributes: camera, Sun, terrain, reflectance, display, timing. A render job that also
-emulated the events (`traj2events render --events`) writes the depth only (attribute
-`radiance: "emulated in the render job, not kept"`): what the motion field needs."""
+`slant_range_m` (n,) float64 the range meter (`FramesFile.slant_range_m`), taken from each
+depth as it was written; attributes: camera, Sun, terrain, reflectance, display, timing.
+A render job that also emulated the events (`traj2events render --events`) writes the
+depth only (attribute `radiance: "emulated in the render job, not kept"`): what the
+motion field needs."""
 
 from __future__ import annotations
 
@@ -31,6 +33,14 @@ from .hdf5 import (
     write_dataset,
     write_errors_named,
 )
+
+
+def central_ray(height: int, width: int, focal_px: float) -> tuple[int, int, float]:
+    """The range meter's pixel (row H/2, column W/2: half a pixel off the boresight for even
+    sizes) and its ray's length per unit depth along the boresight."""
+    i, j = height // 2, width // 2
+    across, down = (j + 0.5 - width / 2) / focal_px, (i + 0.5 - height / 2) / focal_px
+    return i, j, float(np.sqrt(1.0 + across**2 + down**2))
 
 
 def round_mantissa(x: np.ndarray, bits: int = 16, out: np.ndarray | None = None) -> np.ndarray:
@@ -73,6 +83,10 @@ class FramesWriter:
         mark_blosc(self._file)
         self._t: list[float] = []
         self._frame_index: list[int] = []
+        # The range meter, taken from each depth as it is written (read back it would cost
+        # decompressing every frame): only where the camera's focal length is known.
+        self._ray = central_ray(height, width, float(attrs["focal_px"])) if "focal_px" in attrs else None
+        self._slant_range: list[float] = []
         self._sets = {
             name: self._file.create_dataset(
                 name,
@@ -102,11 +116,16 @@ class FramesWriter:
                     self._writers[name][i] = rounded
         self._t.append(float(t_s))
         self._frame_index.append(int(frame_index))
+        if self._ray is not None:
+            i, j, ray = self._ray
+            self._slant_range.append(float(self._rounded["depth_m"][i, j] * np.float64(ray)))
         return self._rounded["radiance"]
 
     def _finish(self) -> None:
         write_dataset(self._file, "t", np.asarray(self._t, float))
         write_dataset(self._file, "frame_index", np.asarray(self._frame_index, np.int64))
+        if self._ray is not None:
+            write_dataset(self._file, "slant_range_m", np.asarray(self._slant_range, float))
         set_attrs(self._file, self._attrs)
 
     def __enter__(self):
@@ -183,12 +202,12 @@ class FramesFile:
         """The range meter's reading in every row: the distance along the central pixel's
         ray (pixel (H/2, W/2), half a pixel off the boresight for even sizes) to the rendered
         terrain, m; 0 = sky. The depth (along the boresight) times the ray's length per unit
-        depth."""
-        _, h, w = self.shape
-        i, j = h // 2, w // 2
-        focal = float(self.attrs["focal_px"])
-        ray = np.sqrt(1.0 + ((j + 0.5 - w / 2) / focal) ** 2 + ((i + 0.5 - h / 2) / focal) ** 2)
-        return self.depth_at(i, j) * ray
+        depth: recorded as the frames were written (`slant_range_m`), else (a file written
+        without it) from the stored depth, the same values."""
+        if "slant_range_m" in self._file:
+            return self._file["slant_range_m"][()]
+        i, j, ray = central_ray(*self.shape[1:], float(self.attrs["focal_px"]))
+        return self.depth_at(i, j) * np.float64(ray)
 
     def radiance_chunks(self, chunk: int, buffers: int = 1) -> Iterator[tuple[np.ndarray, np.ndarray]]:
         """(radiance (k, H, W), t (k,)) for consecutive chunks of at most `chunk` frames.
