@@ -224,7 +224,8 @@ class CudaPixels:
             self.theta_off, self.leak_step, self.leak_drift, self.hot, *noise, *hot, count, x0, x1, n_leak, n_events,
         )  # fmt: skip
         first_slot, total = exclusive_scan(n_events)
-        out_pix = cuda.to_device(np.full(total, -1, np.int64))
+        gaps = params.refractory_s > 0  # only the refractory period leaves slots empty
+        out_pix = cuda.to_device(np.full(total, -1, np.int64)) if gaps else cuda.device_array(total, np.int64)
         out_t = cuda.device_array(total, np.float64)
         out_p = cuda.device_array(total, np.bool_)
         out_label = cuda.device_array(total, np.uint8)
@@ -235,7 +236,5 @@ class CudaPixels:
                 float(params.refractory_s), params.refractory_mode == "defer", out_pix, out_t, out_p, out_label,
             )  # fmt: skip
         self.intensity = intensity1
-        pix = out_pix.copy_to_host()
-        written = pix >= 0  # the refractory period can leave slots empty
-        events = (pix, out_t.copy_to_host(), out_p.copy_to_host(), out_label.copy_to_host())
-        return events if written.all() else tuple(a[written] for a in events)
+        events = (out_pix.copy_to_host(), out_t.copy_to_host(), out_p.copy_to_host(), out_label.copy_to_host())
+        return tuple(a[events[0] >= 0] for a in events) if gaps else events

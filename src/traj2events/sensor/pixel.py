@@ -137,9 +137,8 @@ def advance(
 def hot_pixel_counts(hot_pixels, hot_key, hot_hz, dt):
     """8. How many events each hot pixel fires in the interval."""
     out = np.zeros(hot_pixels.size, np.int64)
-    if hot_hz > 0.0:
-        for h in range(hot_pixels.size):
-            out[h] = hot_pixel_count(hot_key, hot_pixels[h], hot_hz, dt)
+    for h in range(hot_pixels.size):  # (no rate: poisson_arrivals gives 0)
+        out[h] = hot_pixel_count(hot_key, hot_pixels[h], hot_hz, dt)
     return out
 
 
