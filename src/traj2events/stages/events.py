@@ -344,6 +344,31 @@ def export_events(
             write_faery(path, stream, int(attrs["width"]), int(attrs["height"]))
 
 
+def pixel_and_sensor(settings: dict) -> tuple[EmulatorParams, SensorParams | None]:
+    """settings.events' pixel model and sensor (None: the display scale), checked now."""
+    sensor = SensorParams.from_config(settings["sensor"]) if settings["input"] == "sensor" else None
+    return EmulatorParams(**settings["pixel"]), sensor
+
+
+def emulate_with_settings(
+    source: FrameSource,
+    params: EmulatorParams,
+    settings: dict,
+    seed: int,
+    output: str | os.PathLike,
+    input_name: str,
+    chunk: int,
+    threads: int = 1,
+) -> tuple[int, int, float]:
+    """`emulate` with the preset, labels, readout and device of settings.events (`params`
+    from `pixel_and_sensor`), progress every 10 chunks."""
+    preset = settings["preset"]
+    log(f"{input_name}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset}, seed {seed})")
+    return emulate(source, params, seed, output, preset, input_name, progress_every=chunk * 10,
+                   labels=settings["labels"], threads=threads, readout=ReadoutParams(**settings["readout"]),
+                   device=settings["device"])  # fmt: skip
+
+
 def events_command(
     input: str | os.PathLike,
     output: str | os.PathLike,
@@ -374,25 +399,10 @@ def events_command(
         raise ValueError("events: white: only with the display input scale (the sensor scale needs no white)")
     if trajectory:
         read_trajectory(trajectory)  # refused now, not after the emulation
-    params = EmulatorParams(**settings["pixel"])
-    sensor = SensorParams.from_config(settings["sensor"]) if settings["input"] == "sensor" else None
+    params, sensor = pixel_and_sensor(settings)
     chunk = CHUNK_FRAMES if chunk is None else chunk
     source = frame_source(input, chunk, fps, white, sensor, ahead=threads > 1)
-    preset_name = settings["preset"]
-    log(f"{input}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset_name}, seed {seed})")
-    emulate(
-        source,
-        params,
-        seed,
-        output,
-        preset_name,
-        str(input),
-        progress_every=chunk * 10,
-        labels=settings["labels"],
-        threads=threads,
-        readout=ReadoutParams(**settings["readout"]),
-        device=settings["device"],
-    )
+    emulate_with_settings(source, params, settings, seed, output, str(input), chunk, threads)
     frames = str(input) if Path(input).suffix == ".h5" else None
     e = exports or {}
     export_events(output, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)

@@ -10,11 +10,14 @@ from __future__ import annotations
 import os
 
 from ..formats.trajectory import read_trajectory
-from ..progress import log
-from ..sensor.emulator import EmulatorParams
-from ..sensor.photocurrent import SensorParams
-from ..sensor.readout import ReadoutParams
-from .events import CHUNK_FRAMES, check_recording_length, emulate, export_events, rendered_source
+from .events import (
+    CHUNK_FRAMES,
+    check_recording_length,
+    emulate_with_settings,
+    export_events,
+    pixel_and_sensor,
+    rendered_source,
+)
 from .render import RenderSettings, TrajectoryRender
 
 
@@ -40,24 +43,11 @@ def render_and_emulate(
     if seed < 0:
         raise ValueError(f"render: seed: expected a value >= 0, got {seed}")
     check_recording_length(trajectory, float(read_trajectory(trajectory).t[-1]))  # refused now, not after the render
-    params = EmulatorParams(**events_settings["pixel"])
-    sensor = SensorParams.from_config(events_settings["sensor"]) if events_settings["input"] == "sensor" else None
+    params, sensor = pixel_and_sensor(events_settings)
     job = TrajectoryRender(trajectory, settings, tile_cache)
     rendered = job.frames(frames, video, preview, backend, keep_radiance)
     source = rendered_source(job.attrs, rendered, sensor, CHUNK_FRAMES)
-    preset_name = events_settings["preset"]
-    log(f"{trajectory}: {source.kind} -> {events} (preset {preset_name}, seed {seed})")
-    emulate(
-        source,
-        params,
-        seed,
-        events,
-        preset_name,
-        f"{trajectory} (rendered in the same job)",
-        progress_every=CHUNK_FRAMES * 10,
-        labels=events_settings["labels"],
-        readout=ReadoutParams(**events_settings["readout"]),
-        device=events_settings["device"],
-    )
+    input_name = f"{trajectory} (rendered in the same job)"
+    emulate_with_settings(source, params, events_settings, seed, events, input_name, CHUNK_FRAMES)
     e = exports or {}
     export_events(events, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)
