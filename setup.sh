@@ -2,21 +2,21 @@
 # Set up traj2events on a fresh Debian/Ubuntu machine: system packages (if missing), then
 # a .venv with the package and its pinned dependencies. Idempotent: a second run with
 # nothing changed only checks and returns.
-#   bash setup.sh            # runtime
-#   bash setup.sh --test     # runtime + test dependencies
+#   bash setup.sh            # the pipeline: pip install -e ".[pipeline]"
+#   bash setup.sh --test     # the pipeline + test dependencies
 set -euo pipefail
 cd "$(dirname "$0")"
 
-extras="" ; [[ "${1:-}" == "--test" ]] && extras="[test]"
+extras="[pipeline]" ; [[ "${1:-}" == "--test" ]] && extras="[pipeline,test]"
 
 need_apt=()
 command -v python3 >/dev/null || need_apt+=(python3)
 python3 -c "import ensurepip, venv" 2>/dev/null || need_apt+=(python3-venv)
 command -v git >/dev/null || need_apt+=(git)
 command -v ffmpeg >/dev/null || need_apt+=(ffmpeg)                     # video (FFV1, H.264)
-{ ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || need_apt+=(libosmesa6)  # headless OpenGL for pyrender
+{ ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || need_apt+=(libosmesa6)  # headless OpenGL on the CPU
 { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libEGL_mesa.so || need_apt+=(libegl1 libegl-mesa0)  # EGL (render.backend)
-if [[ -n "$extras" ]]; then command -v h5dump >/dev/null || need_apt+=(hdf5-tools); fi  # tests read the files as C users do
+if [[ "$extras" == *test* ]]; then command -v h5dump >/dev/null || need_apt+=(hdf5-tools); fi  # tests read the files as C users do
 if ((${#need_apt[@]})); then
   echo "setup: installing system packages: ${need_apt[*]}"
   SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"
@@ -32,9 +32,7 @@ if [[ "$(cat "$stamp" 2>/dev/null)" != "$want" ]]; then
   echo "setup: installing Python packages into .venv"
   .venv/bin/python -m pip install -q --upgrade pip
   .venv/bin/python -m pip install -q -e ".$extras"
-  # pyrender pins PyOpenGL==3.1.0, which cannot create an OSMesa context; 3.1.10 can.
-  .venv/bin/python -m pip install -q --no-deps "PyOpenGL==3.1.10"
-  if [[ -n "$extras" ]]; then
+  if [[ "$extras" == *test* ]]; then
     # PyTorch's CPU build, for the tested DataLoader example in docs/dataset.md (the
     # package never imports torch). PyPI's own torch wheel pulls in CUDA (GBs): the CPU
     # build comes from a local wheel store or PyTorch's index, else that test is skipped.

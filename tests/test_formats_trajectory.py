@@ -122,7 +122,7 @@ def test_reading_outputs_needs_only_numpy_and_h5py(tmp_path, solved30, vehicle):
     import sys
 
     write_trajectory(tmp_path / "t.h5", (solved30.t, solved30.state, solved30.control), None, vehicle_attrs(vehicle))
-    heavy = ("casadi", "numba", "pyrender", "OpenGL", "scipy", "matplotlib", "yaml", "pandas")
+    heavy = ("casadi", "numba", "OpenGL", "scipy", "matplotlib", "yaml", "pandas")
     code = (
         "import sys, traj2events.formats.events, traj2events.formats.flow, traj2events.formats.frames, "
         "traj2events.formats.exports, traj2events.data\n"

@@ -81,7 +81,7 @@ for name in config["scenarios"]:
     job_resources(config, "render", name)
 for stage in ("base_solution", "render", "events", "pictures"):
     code_fingerprint(f"traj2events.stages.{{stage}}")
-print(sorted(m for m in ("casadi", "numba", "OpenGL", "scipy", "pyrender") if m in sys.modules))
+print(sorted(m for m in ("casadi", "numba", "OpenGL", "scipy") if m in sys.modules))
 """
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, check=True)
     assert result.stdout.strip() == "[]", result.stdout + result.stderr

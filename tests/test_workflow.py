@@ -192,6 +192,37 @@ def test_the_loader_reads_the_built_dataset(built):
     assert (labels == SIGNAL).sum() > 100 and (labels == SHOT_NOISE).sum() > 100 and labels.max() <= 3
 
 
+def test_the_base_install_reads_the_dataset_without_the_pipeline(built, tmp_path):
+    """`pip install` of the checkout without extras: numpy, h5py and hdf5plugin only, and the
+    loader reads events, poses and a motion field; the command says what it lacks."""
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    py = venv / "bin" / "python"
+    install = subprocess.run([str(py), "-m", "pip", "install", "-q", str(ROOT)], capture_output=True, text=True,
+                             timeout=600)  # fmt: skip
+    assert install.returncode == 0, install.stderr[-3000:]
+    listed = subprocess.run([str(py), "-m", "pip", "list", "--format", "freeze"], capture_output=True, text=True)
+    names = {line.split("==")[0].lower() for line in listed.stdout.split()}
+    assert {"numpy", "h5py", "hdf5plugin", "traj2events"} <= names
+    assert not names & {"casadi", "numba", "snakemake", "pyopengl", "scipy", "pandas", "matplotlib", "pyyaml"}
+    code = (
+        "from traj2events.data import open_dataset\n"
+        f"landing = open_dataset({str(built / 'results')!r}).find('descent', 1)\n"
+        "t, state = landing.poses(); events = landing.events(1.0, 1.5); field = landing.motion_field(2)\n"
+        "print(len(t), state.shape[1], len(events), field['displacement_terrain'].shape)"
+    )
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    read = subprocess.run([str(py), "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert read.returncode == 0, read.stderr[-3000:]
+    from traj2events.data import open_dataset
+
+    landing = open_dataset(built / "results").find("descent", 1)
+    expected = f"{len(landing.poses()[0])} 13 {len(landing.events(1.0, 1.5))} (32, 32, 2)"
+    assert read.stdout.strip() == expected and len(landing.events(1.0, 1.5)) > 0
+    command = subprocess.run([str(venv / "bin" / "traj2events"), "--help"], env=env, capture_output=True, text=True)
+    assert command.returncode == 1 and "pip install 'traj2events[pipeline]'" in command.stderr, command.stderr
+
+
 def test_the_docs_dataloader_example_iterates_the_built_dataset(built):
     pytest.importorskip("torch")  # setup.sh --test installs a CPU build where one can be had
     from traj2events.data import EventWindows, open_dataset

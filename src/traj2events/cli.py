@@ -12,7 +12,7 @@ import gc
 import importlib
 import sys
 
-from . import __version__
+from . import __version__, missing_dependency
 from .defaults import section
 from .memory import keep_freed_memory
 from .options import add_settings, inline_or_file, settings_from
@@ -271,6 +271,9 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
     except (ValueError, OSError) as exc:  # ConfigError and FileNotFoundError included
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except ModuleNotFoundError as exc:  # a stage's import, where only the reader is installed
+        print(f"error: {missing_dependency(exc)}", file=sys.stderr)
         return 2
     except Exception as exc:  # a case no check foresaw: one line, the traceback on request
         if os.environ.get("TRAJ2EVENTS_TRACEBACK"):

@@ -7,9 +7,9 @@ of it. The draw itself (`renderer.draw`) knows nothing of how its context was ma
 
 PyOpenGL binds one platform per process, when OpenGL is first imported: the backend is
 chosen before that (`PYOPENGL_PLATFORM`), and a process already bound to the other one is
-refused with a clear message. pyrender provides the two contexts; its scene graph is not
-used. pyrender pins PyOpenGL==3.1.0, whose OSMesa binding is broken (setup.sh installs
-3.1.10; `check_pyopengl` refuses the old one), and uses NumPy 1's `np.infty` (restored).
+refused with a clear message. The two contexts are made through PyOpenGL's own EGL and
+OSMesa bindings (>= 3.1.5: 3.1.0, which pyrender 0.1.45 pins, has no OSMesaCreateContextAttribs
+and cannot upload half floats; docs/rendering.md says why pyrender is no longer used).
 """
 
 from __future__ import annotations
@@ -20,11 +20,8 @@ import sys
 
 import numpy as np
 
-if not hasattr(np, "infty"):
-    np.infty = np.inf  # pyrender 0.1.45 still uses the NumPy 1 alias
-
 BACKENDS = ("auto", "egl", "osmesa")
-_EGL_EXTENSIONS = 0x3055
+_EGL_EXTENSIONS = 0x3055  # EGL_EXTENSIONS, for eglQueryDeviceStringEXT
 
 
 def check_pyopengl() -> None:
@@ -33,8 +30,8 @@ def check_pyopengl() -> None:
     version = tuple(int(p) for p in OpenGL.__version__.split(".")[:3] if p.isdigit())
     if version < (3, 1, 5):
         raise RuntimeError(
-            f"PyOpenGL {OpenGL.__version__} cannot drive OSMesa (pyrender pins 3.1.0); "
-            "install PyOpenGL>=3.1.5 (bash setup.sh does)"
+            f"PyOpenGL {OpenGL.__version__} has no OSMesaCreateContextAttribs and cannot upload half floats; "
+            "install PyOpenGL>=3.1.5"
         )
 
 
@@ -97,26 +94,91 @@ def _bind_platform(backend: str) -> None:
         )
 
 
-def gl_context(backend: str, width: int, height: int):
-    """A current OpenGL context of `backend` (pyrender's platform object)."""
+def gl_context(backend: str, width: int, height: int) -> "EGLContext | OSMesaContext":
+    """A current OpenGL context of `backend` (`egl` or `osmesa`: resolve_backend)."""
     _bind_platform(backend)
-    if backend == "osmesa":
-        from pyrender.platforms.osmesa import OSMesaPlatform
+    return OSMesaContext(width, height) if backend == "osmesa" else EGLContext()
 
-        platform = OSMesaPlatform(width, height)
-    else:
-        # pyrender imports pyglet for its viewer (unused here); pyglet's default windowing
-        # needs X11's libraries, which a GPU server often lacks: its headless mode needs EGL only.
-        os.environ.setdefault("PYGLET_HEADLESS", "true")
-        from pyrender.platforms.egl import EGLPlatform, query_devices
 
-        devices = query_devices()
-        if not devices:
+class EGLContext:
+    """OpenGL 4.1 core on an EGL device (no surface: the draw renders into its own
+    framebuffer): the first device that is not Mesa's software rasteriser, else the first."""
+
+    def __init__(self):
+        from OpenGL import EGL as egl
+        from OpenGL.EGL.EXT.device_base import eglQueryDevicesEXT
+        from OpenGL.EGL.EXT.platform_base import eglGetPlatformDisplayEXT
+        from OpenGL.EGL.EXT.platform_device import EGL_PLATFORM_DEVICE_EXT
+        from OpenGL.raw.EGL._types import EGLDeviceEXT
+
+        count = egl.EGLint()
+        if not eglQueryDevicesEXT(0, None, ctypes.pointer(count)) or count.value < 1:
             raise RuntimeError(
                 "render backend 'egl': no EGL device (install libegl1 with a driver: "
                 "libegl-mesa0 for the CPU, the GPU vendor's for a GPU)"
             )
-        platform = EGLPlatform(width, height, device=devices[hardware_egl_device(egl_devices()) or 0])
-    platform.init_context()
-    platform.make_current()
-    return platform
+        devices = (EGLDeviceEXT * count.value)()
+        eglQueryDevicesEXT(count.value, devices, ctypes.pointer(count))
+        device = devices[hardware_egl_device(egl_devices()) or 0]
+        self._egl = egl
+        self._display = eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, device, None)
+        major, minor, n_configs = egl.EGLint(), egl.EGLint(), egl.EGLint()
+        config = egl.EGLConfig()
+        # EGL_SURFACE_TYPE defaults to windows, which a device display has none of.
+        wanted = (egl.EGLint * 5)(
+            egl.EGL_SURFACE_TYPE, egl.EGL_PBUFFER_BIT, egl.EGL_RENDERABLE_TYPE, egl.EGL_OPENGL_BIT, egl.EGL_NONE
+        )
+        version = (egl.EGLint * 7)(
+            egl.EGL_CONTEXT_MAJOR_VERSION, 4, egl.EGL_CONTEXT_MINOR_VERSION, 1,
+            egl.EGL_CONTEXT_OPENGL_PROFILE_MASK, egl.EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, egl.EGL_NONE,
+        )  # fmt: skip
+        if not (
+            egl.eglInitialize(self._display, major, minor)
+            and egl.eglChooseConfig(self._display, wanted, ctypes.pointer(config), 1, n_configs)
+            and n_configs.value > 0
+            and egl.eglBindAPI(egl.EGL_OPENGL_API)
+        ):
+            raise RuntimeError("render backend 'egl': the EGL device has no OpenGL configuration")
+        self._context = egl.eglCreateContext(self._display, config, egl.EGL_NO_CONTEXT, version)
+        if not self._context:
+            raise RuntimeError("render backend 'egl': no OpenGL 4.1 core context on the EGL device")
+        self.make_current()
+
+    def make_current(self) -> None:
+        egl = self._egl
+        if not egl.eglMakeCurrent(self._display, egl.EGL_NO_SURFACE, egl.EGL_NO_SURFACE, self._context):
+            raise RuntimeError("render backend 'egl': eglMakeCurrent failed")
+
+    def delete_context(self) -> None:
+        self._egl.eglDestroyContext(self._display, self._context)
+        self._egl.eglTerminate(self._display)
+
+
+class OSMesaContext:
+    """OpenGL 3.3 core in Mesa's OSMesa (llvmpipe), current on a width x height RGBA
+    buffer of its own (the draw renders into its own framebuffer)."""
+
+    def __init__(self, width: int, height: int):
+        from OpenGL import osmesa
+
+        attributes = (ctypes.c_int * 11)(
+            osmesa.OSMESA_FORMAT, osmesa.OSMESA_RGBA, osmesa.OSMESA_DEPTH_BITS, 24,
+            osmesa.OSMESA_PROFILE, osmesa.OSMESA_CORE_PROFILE,
+            osmesa.OSMESA_CONTEXT_MAJOR_VERSION, 3, osmesa.OSMESA_CONTEXT_MINOR_VERSION, 3, 0,
+        )  # fmt: skip
+        self._osmesa = osmesa
+        self._context = osmesa.OSMesaCreateContextAttribs(attributes, None)
+        if not self._context:
+            raise RuntimeError("render backend 'osmesa': no OpenGL 3.3 core context (is libOSMesa Mesa's?)")
+        self._buffer = np.zeros((height, width, 4), np.uint8)
+        self._size = (width, height)
+        self.make_current()
+
+    def make_current(self) -> None:
+        from OpenGL import GL as gl
+
+        if not self._osmesa.OSMesaMakeCurrent(self._context, self._buffer, gl.GL_UNSIGNED_BYTE, *self._size):
+            raise RuntimeError("render backend 'osmesa': OSMesaMakeCurrent failed")
+
+    def delete_context(self) -> None:
+        self._osmesa.OSMesaDestroyContext(self._context)
