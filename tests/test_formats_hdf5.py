@@ -5,7 +5,7 @@ import hdf5plugin  # noqa: F401  (the Blosc filter the reader needs)
 import numpy as np
 import pytest
 
-from traj2events.formats.hdf5 import ChunkReader, ChunkWriter, FileFormatError, blosc, create
+from traj2events.formats.hdf5 import ChunkReader, ChunkWriter, FileFormatError, blosc, create, large_dataset_filters
 
 
 @pytest.mark.parametrize("codec, bitshuffle", [("lz4", True), ("lz4", False), ("zstd", True)])
@@ -41,14 +41,16 @@ def test_chunk_writer_writes_the_file_the_hdf5_filter_writes(tmp_path):
     assert (tmp_path / "direct.h5").read_bytes() == (tmp_path / "filter.h5").read_bytes()
 
 
-def test_chunk_writer_refuses_what_it_cannot_write(tmp_path):
+def test_chunk_writer_writes_other_filters_through_h5py_and_refuses_a_wrong_shape(tmp_path):
+    items = np.arange(8, dtype=np.float32).reshape(2, 4)
     with create(tmp_path / "a.h5") as f:
-        plain = f.create_dataset("plain", shape=(2, 4), dtype=np.float32, chunks=(1, 4))
-        with pytest.raises(ValueError, match="plain: expected one Blosc filter"):
-            ChunkWriter(plain)
-        several = f.create_dataset("several", shape=(2, 4), dtype=np.float32, chunks=(2, 4), **blosc())
-        with pytest.raises(ValueError, match="one item per chunk"):
-            ChunkWriter(several)
+        for name, filters in (("plain", {}), ("gzip", large_dataset_filters("gzip", ("lz4", 1, False)))):
+            writer = ChunkWriter(f.create_dataset(name, shape=(2, 4), dtype=np.float32, chunks=(1, 4), **filters))
+            writer[0], writer[1] = items
+            assert np.array_equal(f[name][()], items)
+        several = ChunkWriter(f.create_dataset("several", shape=(2, 4), dtype=np.float32, chunks=(2, 4), **blosc()))
+        several[0], several[1] = items
+        assert np.array_equal(f["several"][()], items)
         writer = ChunkWriter(f.create_dataset("x", shape=(2, 4), dtype=np.float32, chunks=(1, 4), **blosc()))
         with pytest.raises(ValueError, match=r"x: expected an item of shape \(4,\), got \(5,\)"):
             writer[0] = np.zeros(5)
@@ -100,3 +102,46 @@ def test_without_the_filter_library_hdf5_reads_and_writes_the_chunks(tmp_path, m
         writer[0], writer[1] = items
     with h5py.File(tmp_path / "a.h5") as f:
         np.testing.assert_array_equal(ChunkReader(f["x"])[1], items[1])
+
+
+@pytest.mark.parametrize("compression", ["gzip", "none"])
+def test_the_portable_compressions_write_files_plain_h5py_reads(tmp_path, compression):
+    """events.h5, frames.h5 and motion_field.h5 written with `compression: gzip | none` read
+    in a process that never loads hdf5plugin, and their root attributes say any reader will do."""
+    import subprocess
+    import sys
+
+    from traj2events.formats.events import EventsWriter
+    from traj2events.formats.flow import motion_field_file
+    from traj2events.formats.frames import FramesWriter
+
+    rng = np.random.default_rng(3)
+    events = np.zeros(1000, [("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])
+    events["x"], events["y"] = rng.integers(0, 16, (2, 1000))
+    events["t"], events["p"] = np.sort(rng.integers(0, 50_000, 1000)), rng.integers(0, 2, 1000)
+    writer = EventsWriter(tmp_path / "events.h5", 16, 8, {}, compression=compression)
+    writer.append(events)
+    writer.close(50_000)
+    radiance = rng.random((3, 8, 16), np.float32)
+    with FramesWriter(tmp_path / "frames.h5", 8, 16, {}, compression=compression) as frames:
+        for k in range(3):
+            frames.append(0.1 * k, k, radiance[k], radiance[k] + 1)
+    field = rng.random((2, 8, 16, 2), np.float32)
+    with motion_field_file(tmp_path / "motion_field.h5", np.zeros(2), np.arange(2), {"d": ((8, 16, 2), np.float32)},
+                           compression) as (_, writers):  # fmt: skip
+        writers["d"][0], writers["d"][1] = field
+    code = (
+        "import sys, h5py\n"
+        "for name, path in (('events/t', 'events.h5'), ('depth_m', 'frames.h5'), ('d', 'motion_field.h5')):\n"
+        "    with h5py.File(path) as f:\n"
+        "        print(f.attrs['reading'], float(f[name][()].astype('f8').sum()), f[name].compression)\n"
+        "assert 'hdf5plugin' not in sys.modules\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr[-2000:]
+    filters = "gzip" if compression == "gzip" else "None"
+    sums = [events["t"].sum(), (radiance + 1).astype(np.float32).sum(dtype=np.float64), field.sum(dtype=np.float64)]
+    for line, expected in zip(run.stdout.splitlines(), sums):
+        reading, total, used = line.rsplit(" ", 2)
+        assert reading == "any HDF5 reader" and used == filters
+        assert float(total) == pytest.approx(float(expected), rel=1e-4)

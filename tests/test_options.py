@@ -26,7 +26,8 @@ def events(*argv):
 def test_defaults_are_the_defaults_files():
     d = with_preset(default_config())
     assert field() == {**{k: d["camera"][k] for k in ("width", "height", "fov_deg", "mount_height_m")},
-                       **{k: d["motion_field"][k] for k in ("moon_radius_m", "every_n_frames")}}  # fmt: skip
+                       **{k: d["motion_field"][k] for k in ("moon_radius_m", "every_n_frames")},
+                       "compression": "blosc"}  # fmt: skip
     e = events()
     assert e["pixel"] == preset("paper")["pixel"] and e["pixel"]["theta_on"] == 0.25 and e["preset"] == "paper"
     assert e["sensor"] == d["events"]["sensor"] and e["labels"] is True
@@ -58,7 +59,7 @@ def test_the_workflows_pixel_values_pass_unchanged():
     from traj2events.config import resolve_config
 
     config = resolve_config({"events": {"preset": "clean", "pixel": {"refractory_s": 0.002}}})
-    settings = {k: config["events"][k] for k in EVENTS}
+    settings = {k: config["events"][k] for k in EVENTS if k != "compression"} | {"compression": "gzip"}
     assert events("--settings", json.dumps(settings)) == settings and settings["pixel"]["refractory_s"] == 0.002
 
 

@@ -85,9 +85,8 @@ def cmd_motion_field(args) -> int:
     from .stages.motion_field import motion_field
 
     s = settings_from(args, MOTION_FIELD)
-    motion_field(
-        args.trajectory, _camera(s), s["moon_radius_m"], s["every_n_frames"], args.output, args.flo_dir, args.frames
-    )
+    motion_field(args.trajectory, _camera(s), s["moon_radius_m"], s["every_n_frames"], args.output, args.flo_dir,
+                 args.frames, s["compression"])  # fmt: skip
     return 0
 
 

@@ -8,7 +8,7 @@ import os
 import numpy as np
 
 from .atomic import atomic_output, ensure_free_space
-from .hdf5 import Attributes, blosc, create, mark_blosc, open_file, set_attrs
+from .hdf5 import Attributes, create, large_dataset_filters, mark_compression, open_file, set_attrs
 
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
 
@@ -49,7 +49,9 @@ class EventsWriter:
         t_offset_us: int = 0,
         chunk: int = 1 << 18,
         labels: bool = False,
+        compression: str = "blosc",
     ):
+        """`compression`: the large datasets' (hdf5.COMPRESSIONS; Blosc: a codec per column)."""
         self._path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
@@ -57,7 +59,12 @@ class EventsWriter:
         group = self._file.create_group("events")
         self._sets = {
             name: group.create_dataset(
-                name, shape=(0,), maxshape=(None,), dtype=dtype, chunks=(chunk,), **blosc(*codec)
+                name,
+                shape=(0,),
+                maxshape=(None,),
+                dtype=dtype,
+                chunks=(chunk,),
+                **large_dataset_filters(compression, codec),
             )
             for name, (dtype, codec) in COLUMNS.items()
             if labels or name != "label"
@@ -65,7 +72,7 @@ class EventsWriter:
         if labels:
             set_attrs(self._sets["label"], {"label_names": ",".join(EVENT_LABELS)})
         self._file.create_dataset("t_offset", data=np.int64(t_offset_us), track_times=False)
-        mark_blosc(self._file)
+        mark_compression(self._file, compression)
         set_attrs(self._file, {"width": width, "height": height, **attrs})
         self.t_offset_us = t_offset_us
         self.n = 0  # events appended

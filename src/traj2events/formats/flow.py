@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import ChunkWriter, blosc, create, mark_blosc, write_dataset
+from .hdf5 import ChunkWriter, create, large_dataset_filters, mark_compression, write_dataset
 
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
@@ -49,26 +49,30 @@ def read_flo(path: str | os.PathLike) -> np.ndarray:
 
 @contextlib.contextmanager
 def motion_field_file(
-    path: str | os.PathLike, t: np.ndarray, frame_index: np.ndarray, fields: dict[str, tuple[tuple, np.dtype]]
+    path: str | os.PathLike,
+    t: np.ndarray,
+    frame_index: np.ndarray,
+    fields: dict[str, tuple[tuple, np.dtype]],
+    compression: str = "blosc",
 ) -> Iterator[tuple[h5py.File, dict[str, ChunkWriter]]]:
     """motion_field.h5, written one field at a time: t (K,), frame_index (K,) and, per
     name in `fields` ({name: (shape of one field, dtype)}), a (K, *shape) dataset chunked
-    one field per chunk and compressed. Yields the open file and a ChunkWriter per name:
-    the caller sets `writers[name][i]` for every field i and may add small datasets and
+    one field per chunk and compressed (`compression`: hdf5.COMPRESSIONS). Yields the open
+    file and a ChunkWriter per name: the caller sets `writers[name][i]` for every field i and may add small datasets and
     attributes to the file. The file appears under `path` only if the block completes, so
     memory stays one field whatever K."""
     n = len(t)
-    # LZ4 + byte shuffle: faster to compress float32 fields than bit shuffle, zstd or gzip,
-    # for a few per cent more bytes (bench/motion_field_command.py).
-    compression = blosc("lz4", 5, bitshuffle=False)
+    # Blosc: LZ4 + byte shuffle, faster to compress float32 fields than bit shuffle, zstd or
+    # gzip, for a few per cent more bytes (bench/motion_field_command.py).
+    filters = large_dataset_filters(compression, ("lz4", 5, False))
     with atomic_output(path) as tmp, create(tmp) as f:
-        mark_blosc(f)
+        mark_compression(f, compression)
         write_dataset(f, "t", t)
         write_dataset(f, "frame_index", frame_index)
         writers = {}
         for name, (shape, dtype) in fields.items():
             dataset = f.create_dataset(
-                name, shape=(n, *shape), dtype=dtype, chunks=(1, *shape) if n else None, **compression
+                name, shape=(n, *shape), dtype=dtype, chunks=(1, *shape) if n else None, **filters
             )
             writers[name] = ChunkWriter(dataset) if n else None
         yield f, writers

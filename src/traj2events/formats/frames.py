@@ -25,9 +25,9 @@ from .hdf5 import (
     ChunkReader,
     ChunkWriter,
     FileFormatError,
-    blosc,
     create,
-    mark_blosc,
+    large_dataset_filters,
+    mark_compression,
     open_for_reading,
     set_attrs,
     write_dataset,
@@ -73,14 +73,18 @@ class FramesWriter:
     with its time and the index of its pose in trajectory.h5 (-1: an adaptive frame
     between two poses, rendered for the emulator only)."""
 
-    def __init__(self, path: str | os.PathLike, height: int, width: int, attrs: dict, radiance: bool = True):
+    def __init__(
+        self, path: str | os.PathLike, height: int, width: int, attrs: dict, radiance: bool = True,
+        compression: str = "blosc",
+    ):  # fmt: skip
         """`radiance`: False writes the depth only (the radiance then goes straight to the
-        emulator: `append` still returns it rounded as the file would store it)."""
+        emulator: `append` still returns it rounded as the file would store it).
+        `compression`: the images' (hdf5.COMPRESSIONS)."""
         self.path = path
         self._context = atomic_output(path)
         tmp = self._context.__enter__()
         self._file = create(tmp)
-        mark_blosc(self._file)
+        mark_compression(self._file, compression)
         self._t: list[float] = []
         self._frame_index: list[int] = []
         # The range meter, taken from each depth as it is written (read back it would cost
@@ -94,7 +98,8 @@ class FramesWriter:
                 maxshape=(None, height, width),
                 dtype=np.float32,
                 chunks=(1, height, width),
-                **blosc("lz4", 5, bitshuffle=False),  # rounded floats: byte shuffle is faster and smaller here
+                # Blosc: rounded floats, byte shuffle is faster and smaller here.
+                **large_dataset_filters(compression, ("lz4", 5, False)),
             )
             for name in (("radiance", "depth_m") if radiance else ("depth_m",))
         }

@@ -54,6 +54,31 @@ def blosc(cname: str = "zstd", clevel: int = 1, bitshuffle: bool = True) -> dict
     return {**hdf5plugin.Blosc(cname=cname, clevel=clevel, shuffle=shuffle), "track_times": False}
 
 
+# The `compression` setting: how the large datasets (events, frames, motion fields) are
+# compressed. Blosc (the default, faster and as DSEC does) needs hdf5plugin's filter to read;
+# gzip + shuffle and none are HDF5's own, for readers that cannot install a plugin.
+COMPRESSIONS = ("blosc", "gzip", "none")
+GZIP_LEVEL = 1  # of the large datasets: bench/compression.py
+
+
+def large_dataset_filters(compression: str, blosc_codec: tuple[str, int, bool]) -> dict:
+    """create_dataset keywords of a large dataset under the `compression` setting;
+    `blosc_codec`: its (codec, level, bit shuffle) under Blosc."""
+    if compression == "blosc":
+        return blosc(*blosc_codec)
+    if compression == "gzip":
+        return {"compression": "gzip", "compression_opts": GZIP_LEVEL, "shuffle": True, "track_times": False}
+    if compression == "none":
+        return {"track_times": False}
+    raise ValueError(f"compression: expected one of {', '.join(COMPRESSIONS)}, got {compression!r}")
+
+
+def mark_compression(f: h5py.File, compression: str) -> None:
+    """Root attributes for `compression`: Blosc's say what a reader needs (mark_blosc)."""
+    if compression == "blosc":
+        mark_blosc(f)
+
+
 def write_dataset(group: h5py.Group, name: str, data: np.ndarray) -> None:
     """A dataset, gzip-4 + shuffle when larger than 1024 values."""
     data = np.asarray(data)
@@ -198,17 +223,17 @@ def _blosc_codec() -> _BloscLibrary | None:
 
 
 class ChunkWriter:
-    """Writes item i of a dataset chunked one item per chunk (`chunks=(1, *shape)`) with
-    `blosc(...)`: the chunk is compressed here, by the Blosc filter's own library with the
+    """Writes item i of a dataset chunked one item per chunk (`chunks=(1, *shape)`). With
+    `blosc(...)` the chunk is compressed here, by the Blosc filter's own library with the
     dataset's own parameters, and handed to HDF5 whole (`write_direct_chunk`). HDF5's
     filter pipeline copies each chunk on its way, which this skips. Items written in order
-    give the file the filter would have written, byte for byte."""
+    give the file the filter would have written, byte for byte. Any other dataset (gzip,
+    none) is written through h5py."""
 
     def __init__(self, dataset: h5py.Dataset):
         parameters = _blosc_parameters(dataset)
-        if parameters is None:
-            raise ValueError(f"{dataset.name}: expected one Blosc filter and one item per chunk")
-        self._parameters, self._codec, self.dataset = parameters, _blosc_codec(), dataset
+        self._parameters, self.dataset = parameters, dataset
+        self._codec = _blosc_codec() if parameters is not None else None
         # One output buffer, reused (a fresh one per chunk costs page faults),
         # no larger than the item: as the filter, which leaves a chunk that does not shrink raw.
         self._buffer = np.empty(dataset.dtype.itemsize * math.prod(dataset.shape[1:]), np.uint8)
@@ -220,7 +245,7 @@ class ChunkWriter:
                 f"{self.dataset.name}: expected an item of shape {self.dataset.shape[1:]}, got {data.shape}"
             )
         chunk = None if self._codec is None else self._codec.compress(data, *self._parameters, self._buffer)
-        if chunk is None:  # no library, or incompressible: HDF5's pipeline writes it as it would
+        if chunk is None:  # not Blosc, no library, or incompressible: HDF5's pipeline writes it
             self.dataset[i] = data
             self.dataset.id.flush()  # now, not from HDF5's chunk cache later: the file keeps its order
             return

@@ -21,6 +21,12 @@ from __future__ import annotations
 import copy
 
 
+def without_default_compression(settings: dict) -> dict:
+    """`settings` without `compression` where it is Blosc, the default: the key came after
+    datasets were built, and their jobs' settings (the rules' params) stay as they were."""
+    return {k: v for k, v in settings.items() if not (k == "compression" and v == "blosc")}
+
+
 def config_value(config: dict, path: str):
     """The value at a dotted config key, e.g. "events.pixel.theta_on"."""
     for key in path.split("."):

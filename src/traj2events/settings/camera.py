@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from . import pick
+from . import pick, without_default_compression
 
 CAMERA = {
     "width": "camera.width",
@@ -11,7 +11,7 @@ CAMERA = {
     "mount_height_m": "camera.mount_height_m",
     "moon_radius_m": "motion_field.moon_radius_m",
 }
-MOTION_FIELD = {**CAMERA, "every_n_frames": "motion_field.every_n_frames"}
+MOTION_FIELD = {**CAMERA, "every_n_frames": "motion_field.every_n_frames", "compression": "compression"}
 
 
 def camera_settings(config: dict) -> dict:
@@ -20,5 +20,6 @@ def camera_settings(config: dict) -> dict:
 
 
 def motion_field_settings(config: dict) -> dict:
-    """The camera and sphere, and which frames' fields are written."""
-    return pick(config, MOTION_FIELD)
+    """The camera and sphere, which frames' fields are written, and motion_field.h5's
+    compression where it is not the default."""
+    return without_default_compression(pick(config, MOTION_FIELD))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from . import pick
+from . import pick, without_default_compression
 
 # events.pixel: the preset's values under the config's own keys (defaults.with_preset).
 EVENTS = {
@@ -13,6 +13,7 @@ EVENTS = {
     "sensor": "events.sensor",
     "readout": "events.readout",
     "device": "events.device",
+    "compression": "compression",  # events.h5's
 }
 EVENTS_PICTURE = {"window_ms": "events.window_ms"}
 # events.exports: each format's file suffix beside events.h5 (events.npz, events.raw, events.aedat4).
@@ -24,8 +25,9 @@ EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--reado
 def events_settings(config: dict) -> dict:
     """Everything the emulation depends on (the seed aside, per trajectory): the pixel
     model (and the preset it came from), labels, the input scale, the sensor and its readout,
-    and the device it runs on (a GPU can round a crossing differently)."""
-    return pick(config, EVENTS)
+    and the device it runs on (a GPU can round a crossing differently); events.h5's
+    compression where it is not the default."""
+    return without_default_compression(pick(config, EVENTS))
 
 
 def events_picture_settings(config: dict) -> dict:

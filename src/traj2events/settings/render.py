@@ -8,6 +8,7 @@ import random
 from dataclasses import dataclass
 
 from ..geometry.camera import horizon_distance_m
+from . import without_default_compression
 
 TIMING_MODES = ("fixed", "adaptive")
 
@@ -56,8 +57,9 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
 def render_settings(config: dict, name: str, trajectory_id: str | None = None) -> dict:
     """Everything one scenario's frames depend on (the Sun: `trajectory_id`'s, where the
     config gives it as a range; scenario_sun): camera, sphere, terrain, Sun,
-    reflectance, level of detail and its extent, display mapping, frame timing, stars, and
-    with adaptive timing the emulator's input (its scale sets the predicted log change)."""
+    reflectance, level of detail and its extent, display mapping, frame timing, stars,
+    with adaptive timing the emulator's input (its scale sets the predicted log change), and
+    frames.h5's compression where it is not the default."""
     sc = config["scenarios"][name]
     radius = float(config["motion_field"]["moon_radius_m"])
     # Out to the horizon of the scenario's highest camera (with a margin for climbs and
@@ -89,4 +91,5 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
         "emulator_input": {"input": config["events"]["input"], "sensor": dict(config["events"]["sensor"])}
         if adaptive
         else None,
+        **without_default_compression({"compression": config["compression"]}),  # frames.h5's
     }

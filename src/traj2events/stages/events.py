@@ -237,12 +237,13 @@ def emulate(
     threads: int = 1,
     readout: ReadoutParams = ReadoutParams(),
     device: str = "cpu",
+    compression: str = "blosc",
 ) -> tuple[int, int, float]:
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
     `input_name` are recorded in its attributes; with `labels`, each event's cause too;
     `threads`: CPUs to use, the emulator's per-pixel pass split over those the source's
     decoder leaves; `readout`: latency, jitter and rate limit after the pixels; `device`:
-    cpu or cuda, where the pixel model runs). Returns (frames, events, time of the last
+    cpu or cuda, where the pixel model runs; `compression`: events.h5's). Returns (frames, events, time of the last
     frame in s)."""
     emulator = EventEmulator(
         source.width,
@@ -267,7 +268,7 @@ def emulate(
         **source.scene,
     }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
-    writer = EventsWriter(output, source.width, source.height, attrs, labels=labels)
+    writer = EventsWriter(output, source.width, source.height, attrs, labels=labels, compression=compression)
     stream = Readout(readout, seed, len(EVENT_LABELS)) if readout.active else None
     try:
         for frames, times in source.chunks:
@@ -360,13 +361,13 @@ def emulate_with_settings(
     chunk: int,
     threads: int = 1,
 ) -> tuple[int, int, float]:
-    """`emulate` with the preset, labels, readout and device of settings.events (`params`
-    from `pixel_and_sensor`), progress every 10 chunks."""
+    """`emulate` with the preset, labels, readout, device and compression of settings.events
+    (`params` from `pixel_and_sensor`), progress every 10 chunks."""
     preset = settings["preset"]
     log(f"{input_name}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset}, seed {seed})")
     return emulate(source, params, seed, output, preset, input_name, progress_every=chunk * 10,
                    labels=settings["labels"], threads=threads, readout=ReadoutParams(**settings["readout"]),
-                   device=settings["device"])  # fmt: skip
+                   device=settings["device"], compression=settings.get("compression", "blosc"))  # fmt: skip
 
 
 def events_command(

@@ -55,8 +55,10 @@ def motion_field(
     output: str | os.PathLike,
     flo_dir: str | os.PathLike,
     frames: str | os.PathLike | None = None,
+    compression: str = "blosc",
 ) -> None:
-    """Write motion_field.h5 and one .flo per field (the sphere displacement) into flo_dir."""
+    """Write motion_field.h5 and one .flo per field (the sphere displacement) into flo_dir;
+    `compression`: motion_field.h5's fields' (formats.hdf5.COMPRESSIONS)."""
     if every_n_frames < 1:
         raise ValueError(f"motion field: every_n_frames: expected >= 1, got {every_n_frames}")
     if not moon_radius_m > 0:
@@ -98,7 +100,7 @@ def motion_field(
         layout = field_layout(h, w, rendered is not None)
         with (
             atomic_directory(flo_dir) as tmp_dir,
-            motion_field_file(output, tr.t[picked], picked, layout) as (out, fields),
+            motion_field_file(output, tr.t[picked], picked, layout, compression) as (out, fields),
         ):
             for i, k in enumerate(picked):
                 flow, disp, status = sphere_motion(camera, tr.state[k], tr.state[k + 1], moon_radius_m, np.float32)

@@ -29,6 +29,7 @@ from ..scene.sun import Sun
 from ..scene.terrain import ProceduralTerrain, TerrainParams, load_elevation_grid
 from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
+from ..settings import without_default_compression
 from ..settings.render import render_settings
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.state import POSE
@@ -59,6 +60,7 @@ class RenderSettings:
     timing: dict
     stars: dict
     emulator_input: dict | None  # adaptive timing: events.input and events.sensor (its log's scale)
+    compression: str = "blosc"  # frames.h5's images (formats.hdf5.COMPRESSIONS)
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
@@ -73,7 +75,7 @@ class RenderSettings:
         return emulator_white_w_m2_sr(self.emulator_input, self.display_white_w_m2_sr)
 
     def to_json(self) -> str:
-        return json.dumps(self.__dict__, sort_keys=True)
+        return json.dumps(without_default_compression(self.__dict__), sort_keys=True)
 
     @classmethod
     def from_json(cls, text: str) -> "RenderSettings":
@@ -205,7 +207,7 @@ class TrajectoryRender:
                 tiles, camera, self.sun, self.reflectance, stars=s.star_field(), backend=backend,
                 earth=s.earth_light(),
             ) as renderer,
-            FramesWriter(frames, s.height, s.width, self.attrs, radiance=keep_radiance) as out,
+            FramesWriter(frames, s.height, s.width, self.attrs, keep_radiance, s.compression) as out,
             VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
             VideoWriter(preview, s.width, s.height, fps, "h264") if preview else contextlib.nullcontext() as shown,
         ):  # fmt: skip
