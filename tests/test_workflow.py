@@ -1,6 +1,7 @@
 """The real `snakemake` command on the smoke config, in a temporary directory."""
 
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -190,6 +191,28 @@ def test_the_loader_reads_the_built_dataset(built):
     labelled, labels = landing.labelled_events(0.0, 100.0)
     assert labelled.tobytes() == everything.tobytes() and attrs["labels"]
     assert (labels == SIGNAL).sum() > 100 and (labels == SHOT_NOISE).sum() > 100 and labels.max() <= 3
+
+
+def test_the_docs_tonic_example_runs_on_the_built_dataset(built):
+    pytest.importorskip("tonic")  # the test extra installs it
+    from traj2events.data import open_dataset
+
+    text = (ROOT / "docs" / "dataset.md").read_text()
+    code = text.split("<!-- tonic example -->\n```python\n")[1].split("```")[0]
+    run = subprocess.run([sys.executable, "-c", code], cwd=built, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-3000:]
+    events = open_dataset(built / "results").find("descent", 0).events(1.0, 1.5)
+    shapes = r"\((\d+), (\d+), (\d+), (\d+)\)"
+    printed = re.fullmatch(rf"{shapes} (\d+) {shapes} (-?[\d.]+)", run.stdout.strip())
+    assert printed, run.stdout
+    g = printed.groups()
+    assert g[:4] == ("5", "2", "32", "32") and g[5:9] == ("5", "1", "32", "32")
+    n_frames, total = int(g[4]), float(g[9])
+    # ToFrame bins every event but one that falls on the window's last time; the signed
+    # voxel grid's total is at most ON - OFF in size (a last-bin event loses its right part).
+    assert len(events) - 1 <= n_frames <= len(events) > 0
+    on_minus_off = int(events["p"].sum()) - int((events["p"] == 0).sum())
+    assert abs(total) <= abs(on_minus_off) + len(events) / 5 and np.sign(total) == np.sign(on_minus_off)
 
 
 def test_the_base_install_reads_the_dataset_without_the_pipeline(built, tmp_path):
