@@ -9,7 +9,7 @@ from traj2events import fingerprint
 from traj2events.fingerprint import code_fingerprint, import_closure
 
 STAGES = ["base_solution", "sample_trajectories", "camera_poses", "render", "motion_field", "events", "pictures",
-          "index", "summary"]  # fmt: skip
+          "index", "summary", "overview"]  # fmt: skip
 
 
 def short(names):

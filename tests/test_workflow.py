@@ -276,7 +276,27 @@ def test_the_report_holds_every_figure(built, tmp_path):
             for name in ("frames.png", "motion_field.png", "events.png"):
                 assert f'"results/{scenario}/{i:04d}/{name}"' in html, (scenario, i, name)
     assert "results/figures/trajectories.png" in html and "results/summary.csv" in html
+    assert '"results/overview.html"' in html and "a synthetic event-camera dataset" in html  # the front page
     assert report.stat().st_size > 100_000  # the images are embedded
+
+
+def test_the_overview_page_counts_what_was_built(built):
+    """overview.html: every trajectory's events and frames as the files hold them, the bytes
+    on disk of its folder, and the scenarios' totals."""
+    from traj2events.data import open_dataset
+
+    page = (built / "results" / "overview.html").read_text()
+    dataset = open_dataset(built / "results")
+    total_bytes = 0
+    for landing in dataset:
+        with h5py.File(landing.folder / "events.h5") as f:
+            n_events = len(f["events/t"])
+        n_frames = len(landing.poses()[0])
+        assert f"<td>{n_events}</td>" in page and f"<td>{n_frames}</td>" in page
+        total_bytes += sum(p.stat().st_size for p in landing.folder.rglob("*") if p.is_file())
+    assert f"{total_bytes / 1e6:.1f} MB on disk" in page
+    assert f"{len(dataset)} trajectories" in page and "data:image/png;base64," in page
+    assert page.count("<table") == 4 and "&quot;seed&quot;" in page  # the tables in place; the config
 
 
 def test_second_run_has_nothing_to_do(built):
@@ -400,7 +420,7 @@ def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
 
 def test_emulator_change_reruns_events_and_their_dependants_only(edited_source):
     jobs = edited_source("sensor/pixel.py", "two_pi_dt = 2.0 * np.pi * dt", "two_pi_dt = 6.3 * dt")
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
 def test_figure_change_reruns_pictures_only(edited_source):
@@ -411,6 +431,7 @@ def test_figure_change_reruns_pictures_only(edited_source):
         "events_picture": 3,
         "dataset_picture": 1,
         "dataset_index": 2,
+        "dataset_overview": 1,
     }
 
 
@@ -435,31 +456,31 @@ def edit_config(workdir, change):
 def test_picture_setting_reruns_pictures_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("events", {}).update(window_ms=20.0))
-    assert jobs == {"events_picture": 3, "dataset_index": 2}
+    assert jobs == {"events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
 def test_emulator_setting_reruns_events_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("events", {}).update(preset="clean"))
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
     shutil.copytree(built, tmp_path / "wf2")
     jobs = edit_config(tmp_path / "wf2", lambda c: c.setdefault("events", {}).update(pixel={"refractory_s": 1e-3}))
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
 def test_an_imu_setting_or_a_readout_setting_reruns_its_stage_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.update(imu={"rate_hz": 500.0}))
-    assert jobs == {"imu": 3, "dataset_index": 2}
+    assert jobs == {"imu": 3, "dataset_index": 2, "dataset_overview": 1}
     shutil.copytree(built, tmp_path / "wf2")
     jobs = edit_config(tmp_path / "wf2", lambda c: c.setdefault("events", {}).update(readout={"latency_s": 1e-4}))
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2}
+    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
 def test_turning_the_preview_off_reruns_no_render(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("render", {}).update(preview=False))
-    assert jobs == {"dataset_index": 2}  # its inputs lose preview.mp4; no render, nothing after it
+    assert jobs == {"dataset_index": 2, "dataset_overview": 1}  # its inputs lose preview.mp4; no render
     out = snakemake(tmp_path / "wf", "-n", "-p", "--forcerun", "render").stdout
     assert "traj2events render" in out and "--preview" not in out and "preview.mp4" not in out
 
@@ -478,6 +499,7 @@ def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_
         "motion_field_picture": 1,
         "events_picture": 1,
         "dataset_index": 1,
+        "dataset_overview": 1,
     }
 
 

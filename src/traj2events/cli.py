@@ -193,8 +193,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--exports", nargs="*", default=[], choices=list(EXPORT_SUFFIX), help="with --events: also these")
     p.set_defaults(func=cmd_render)
 
-    p = sub.add_parser("motion-field", help="ground-truth motion field of a trajectory (sphere; terrain-true from "
-                       "frames.h5)")  # fmt: skip
+    p = sub.add_parser("motion-field", help="ground-truth motion field of a trajectory (sphere; terrain: frames.h5)")
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
     add_settings(p, MOTION_FIELD, "the camera, the sphere and which frames")
     p.add_argument("--frames", help="frames.h5 from `traj2events render`: adds the terrain-true field from its depth")
@@ -234,20 +233,18 @@ def build_parser() -> argparse.ArgumentParser:
     q = kinds.add_parser("frames", help="frames.png: display frames from video.mkv")
     q.add_argument("trajectory", help="trajectory.h5 (its pose times)")
     q.add_argument("--video", required=True, help="video.mkv")
-    q.add_argument("--output", "-o", required=True, help="PNG")
     q = kinds.add_parser("motion-field", help="motion_field.png: colour wheel and quiver of the sphere's field")
     q.add_argument("trajectory", help="trajectory.h5 (poses)")
     add_settings(q, CAMERA, "the camera and the sphere")
     q.add_argument("--video", help="video.mkv: draw the quivers over its frames")
-    q.add_argument("--output", "-o", required=True, help="PNG")
     q = kinds.add_parser("events", help="events.png: event frames (ON blue, OFF red)")
     q.add_argument("events", help="events.h5")
     q.add_argument("--trajectory", help="trajectory.h5: its end time and title (default: events.h5's end, its name)")
     add_settings(q, EVENTS_PICTURE, "the window")
-    q.add_argument("--output", "-o", required=True, help="PNG")
     q = kinds.add_parser("dataset", help="trajectories.png: height and pitch of every scenario")
     q.add_argument("solutions", nargs="+", help="solutions.h5 of each scenario")
-    q.add_argument("--output", "-o", required=True, help="PNG")
+    for q in kinds.choices.values():
+        q.add_argument("--output", "-o", required=True, help="PNG")
     p.set_defaults(func=cmd_picture)
 
     p = sub.add_parser("index", help="one CSV row per trajectory file of a scenario (the dataset index)")
@@ -261,6 +258,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--tables", nargs="+", required=True, help="samples.csv of each scenario, same order")
     p.add_argument("--output", "-o", required=True, help="summary.csv")
     p.set_defaults(func=_calls("summary", "dataset_summary", "solutions", "tables", "output"))
+
+    p = sub.add_parser("overview", help="overview.html: the dataset in numbers and a figure (the report's first page)")
+    p.add_argument("indexes", nargs="+", help="index.csv of each scenario")
+    p.add_argument("--summary", required=True, help="summary.csv")
+    p.add_argument("--config", required=True, help="the resolved config as JSON (the workflow passes its own)")
+    p.add_argument("--output", "-o", required=True, help="overview.html")
+    p.set_defaults(func=_calls("overview", "dataset_overview", "indexes", "summary", "config", "output"))
     return parser
 
 

@@ -176,6 +176,7 @@ def scenario_outputs(wildcards):
 def all_outputs(wildcards):
     return [
         "results/summary.csv",
+        "results/overview.html",
         "results/figures/trajectories.png",
         *expand("results/{scenario}/index.csv", scenario=SCENARIOS),
     ]

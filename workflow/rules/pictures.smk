@@ -95,3 +95,27 @@ rule dataset_picture:
         code=code("pictures"),
     shell:
         "traj2events picture dataset {input} --output {output} 2> {log}"
+
+
+rule dataset_overview:
+    input:
+        indexes=expand("results/{scenario}/index.csv", scenario=SCENARIOS),
+        summary="results/summary.csv",
+    output:
+        report(
+            "results/overview.html",
+            caption="../report/overview.rst",
+            category="Dataset",
+        ),
+    log:
+        "results/logs/dataset_overview.log",
+    benchmark:
+        "results/benchmarks/dataset_overview.tsv"
+    conda:
+        ENV
+    params:
+        code=code("overview"),
+        config=lambda wildcards: json.dumps(config, sort_keys=True),
+    shell:
+        "traj2events overview {input.indexes} --summary {input.summary} --config {params.config:q} "
+        "--output {output} 2> {log}"

@@ -1,0 +1,158 @@
+"""The dataset's overview page (results/overview.html, the report's "Dataset" page): what was
+built, in numbers and one figure. Per scenario and per trajectory: frames, flight time,
+events and their rate, bytes on disk; the event rate over each flight; bytes per kind of
+file; summary.csv as a table; the code version and the resolved config. One
+self-contained HTML file (the figure embedded), the same bytes for the same dataset."""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import __version__
+from ..formats.atomic import atomic_output
+from ..formats.hdf5 import open_file
+
+RATE_BIN_MS = 10  # the event rate's bin: the paper's event-frame window
+
+
+def event_rate_per_s(ms_to_idx: np.ndarray, n_events: int, bin_ms: int = RATE_BIN_MS) -> np.ndarray:
+    """Events per second in consecutive `bin_ms` bins, from events.h5's ms_to_idx (index of
+    the first event at or after each millisecond) and its event count; a last partial bin
+    is left out."""
+    edges = np.append(np.asarray(ms_to_idx, np.int64), n_events)[::bin_ms]
+    return np.diff(edges) * (1000.0 / bin_ms)
+
+
+def folder_bytes(folder: Path, names: list[str]) -> dict[str, int]:
+    """Bytes on disk of each of `names` in `folder` (a folder: its files, summed); absent: 0."""
+    sizes = {}
+    for name in names:
+        path = folder / name
+        files = sorted(path.rglob("*")) if path.is_dir() else [path]
+        sizes[name] = sum(f.stat().st_size for f in files if f.is_file())
+    return sizes
+
+
+def trajectory_stats(folder: Path, names: list[str]) -> dict:
+    """One trajectory's events (count, mean and peak rate, rate per bin) and bytes per file."""
+    with open_file(folder / "events.h5", "events.h5 from `traj2events events`") as f:
+        n_events = len(f["events/t"])
+        rate = event_rate_per_s(f["ms_to_idx"][()], n_events)
+        pixels = int(f.attrs["width"]) * int(f.attrs["height"])
+    duration_s = len(rate) * RATE_BIN_MS / 1000
+    return {
+        "events": n_events,
+        "mean_rate": n_events / duration_s if duration_s else 0.0,
+        "peak_rate": float(rate.max()) if len(rate) else 0.0,
+        "pixels": pixels,
+        "rate": rate,
+        "bytes": folder_bytes(folder, names),
+    }
+
+
+def rate_figure_png(curves: list[tuple[str, np.ndarray]]) -> bytes:
+    """Event rate against normalised time t / t_f, one line per trajectory, one colour per
+    scenario; PNG bytes without the software tag."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    scenarios = sorted({name for name, _ in curves})
+    colours = {name: plt.get_cmap("tab10")(k % 10) for k, name in enumerate(scenarios)}
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    for name, rate in curves:
+        ax.plot(np.linspace(0, 1, len(rate)), np.maximum(rate, 1.0), color=colours[name], lw=0.8, alpha=0.6)
+    for name in scenarios:
+        ax.plot([], [], color=colours[name], label=name)
+    ax.set(yscale="log", xlabel="t / t_f", ylabel=f"events per s ({RATE_BIN_MS} ms bins)", xlim=(0, 1))
+    ax.set_title("Event rate over each flight")
+    ax.legend(loc="upper left", fontsize=8, frameon=False)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def _table(frame: pd.DataFrame) -> str:
+    return frame.to_html(index=False, border=0, classes="t", float_format=lambda v: f"{v:.4g}")
+
+
+def overview_html(
+    trajectories: pd.DataFrame, summary: pd.DataFrame, sizes: pd.DataFrame, figure_png: bytes, config: dict
+) -> str:
+    """The page: per-scenario and per-trajectory tables, the rate figure, bytes per kind of
+    file, summary.csv, the version and the config."""
+    per_scenario = trajectories.groupby("scenario", sort=False).agg(
+        trajectories=("id", "size"), frames=("frames", "sum"), flight_s=("t_f_s", "sum"), events=("events", "sum"),
+        peak_events_per_s=("peak_events_per_s", "max"), MB=("MB", "sum"),
+    ).reset_index()  # fmt: skip
+    per_scenario.insert(5, "mean_events_per_s", per_scenario["events"] / per_scenario["flight_s"])
+    image = base64.b64encode(figure_png).decode()
+    style = (
+        "body{font-family:sans-serif;margin:1.5em;max-width:70em}table.t{border-collapse:collapse;font-size:90%}"
+        "table.t td,table.t th{padding:2px 8px;text-align:right;border-bottom:1px solid #ddd}"
+        "pre{background:#f6f6f6;padding:1em;font-size:85%}"
+    )
+    return "\n".join([
+        "<!DOCTYPE html>", "<html><head><meta charset='utf-8'><title>traj2events dataset</title>",
+        f"<style>{style}</style></head><body>",
+        f"<h1>Dataset overview</h1><p>traj2events {html.escape(__version__)}: {len(trajectories)} trajectories, "
+        f"{int(trajectories['frames'].sum())} frames of {html.escape(str(config['camera']['width']))} x "
+        f"{html.escape(str(config['camera']['height']))} px, {int(trajectories['events'].sum())} events, "
+        f"{trajectories['MB'].sum():.1f} MB on disk (docs/dataset.md describes every file).</p>",
+        "<h2>Per scenario</h2>", _table(per_scenario),
+        "<h2>Event rate</h2>", f"<img alt='event rate over each flight' src='data:image/png;base64,{image}'>",
+        f"<p>Events per second in {RATE_BIN_MS} ms bins (the paper's event-frame window) against the flight's "
+        "normalised time, one line per trajectory; bins without events drawn at 1.</p>",
+        "<h2>Per trajectory</h2>", _table(trajectories),
+        "<h2>Bytes on disk per kind of file</h2>", _table(sizes),
+        "<h2>Solves (summary.csv)</h2>", _table(summary),
+        "<h2>Configuration</h2><p>The resolved config (defaults.yaml with the overlays), as the jobs got it.</p>",
+        f"<pre>{html.escape(json.dumps(config, indent=1, sort_keys=True))}</pre>",
+        "</body></html>", "",
+    ])  # fmt: skip
+
+
+def dataset_overview(
+    indexes: list[str | os.PathLike],
+    summary: str | os.PathLike,
+    config_json: str,
+    output: str | os.PathLike,
+) -> None:
+    """overview.html from each scenario's index.csv (the trajectories and their folders),
+    summary.csv and the resolved config (JSON). Every file and folder in a trajectory's
+    folder is counted on disk (frames.h5 where kept: a temporary one is gone by then)."""
+    rows, curves, sizes = [], [], []
+    for index in indexes:
+        for row in pd.read_csv(index).itertuples():
+            folder = Path(row.path).parent
+            stats = trajectory_stats(folder, sorted(p.name for p in folder.iterdir()))
+            curves.append((row.scenario, stats["rate"]))
+            sizes.append(stats["bytes"])
+            rows.append({
+                "scenario": row.scenario, "id": int(row.id), "t_f_s": float(row.tf_s), "frames": int(row.n_poses),
+                "events": stats["events"], "mean_events_per_s": stats["mean_rate"],
+                "peak_events_per_s": stats["peak_rate"],
+                "events_per_pixel_s": stats["mean_rate"] / stats["pixels"],
+                "MB": sum(stats["bytes"].values()) / 1e6,
+            })  # fmt: skip
+    if not rows:
+        raise ValueError(f"overview: {', '.join(map(str, indexes))} list no trajectory")
+    table = pd.DataFrame(rows)
+    by_kind = pd.DataFrame(sizes).sum()
+    kinds = pd.DataFrame({"file": by_kind.index, "MB": by_kind.values / 1e6, "MB_per_trajectory": by_kind.values / 1e6
+                          / len(rows), "share": by_kind.values / max(by_kind.sum(), 1)})  # fmt: skip
+    page = overview_html(table, pd.read_csv(summary), kinds, rate_figure_png(curves), json.loads(config_json))
+    with atomic_output(output) as tmp:
+        Path(tmp).write_text(page)
