@@ -27,6 +27,24 @@ def test_ffv1_round_trip_is_exact(tmp_path):
     assert not list(tmp_path.glob(".*part"))
 
 
+def test_a_corrupted_video_is_an_error_naming_the_decoders_report(tmp_path):
+    """Bytes damaged inside FFV1 slices (not a truncation): ffmpeg conceals them, decodes
+    every frame and exits 0; its slice CRCs catch them, and so does iter_video."""
+    rng = np.random.default_rng(1)
+    frames = rng.integers(0, 256, size=(20, 64, 64), dtype=np.uint8)
+    with VideoWriter(tmp_path / "v.mkv", 64, 64, 100.0, "ffv1") as video:
+        for f in frames:
+            video.write(f)
+    data = bytearray((tmp_path / "v.mkv").read_bytes())
+    for k in range(1, 5):
+        at = len(data) * k // 5
+        data[at : at + 64] = bytes(64)
+    (tmp_path / "bad.mkv").write_bytes(bytes(data))
+    with pytest.raises(ValueError, match=r"bad.mkv: corrupt video: ffmpeg reported \d+ decoding errors, the first: "):
+        list(iter_video(tmp_path / "bad.mkv", 8))
+    assert len(np.concatenate(list(iter_video(tmp_path / "v.mkv", 8)))) == 20  # the intact one decodes
+
+
 def test_decode_command_sets_the_decoder_threads_before_its_input():
     args = decode_command("in.mkv", 1)
     assert args[args.index("-threads") + 1] == "1" and args.index("-threads") < args.index("-i")

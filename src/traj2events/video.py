@@ -248,9 +248,12 @@ def iter_video(path: str | os.PathLike, chunk: int = 64, info: tuple | None = No
     `chunk` frames, whatever the video's length. A video that decodes to fewer frames
     than its container announces (truncated, corrupt) raises ValueError at its end.
     `info`: the video's `video_info`, when the caller has it (each probe is ~80 ms).
-    `threads`: the decoder's threads (`decode_command`)."""
+    `threads`: the decoder's threads (`decode_command`). A video whose decoder reports an
+    error (FFV1's slice CRCs, a damaged H.264 slice: ffmpeg conceals them and exits 0)
+    raises ValueError too, naming the first."""
     width, height, _, expected = info or video_info(path)
-    process = subprocess.Popen(decode_command(path, threads), stdout=subprocess.PIPE)
+    errors = tempfile.TemporaryFile()  # a file, not a pipe: a full pipe would stall the decoder
+    process = subprocess.Popen(decode_command(path, threads), stdout=subprocess.PIPE, stderr=errors)
     size = width * height
     decoded = 0
     try:
@@ -264,8 +267,14 @@ def iter_video(path: str | os.PathLike, chunk: int = 64, info: tuple | None = No
     finally:
         process.stdout.close()
         code = process.wait()
+        errors.seek(0)
+        reported = errors.read().decode(errors="replace").splitlines()
+        errors.close()
     # One frame of slack: a duration rounds to the nearest frame.
     if code != 0 or (expected is not None and decoded < expected - 1):
         raise ValueError(
             f"{path}: truncated or corrupt video: decoded {decoded} of {expected} frames (ffmpeg exit {code})"
         )
+    if reported:
+        raise ValueError(f"{path}: corrupt video: ffmpeg reported {len(reported)} decoding errors, the first: "
+                         f"{reported[0].strip()}")  # fmt: skip
