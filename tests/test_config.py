@@ -342,3 +342,10 @@ def test_a_reversed_sensor_band_is_refused_before_any_job():
         resolve_config({"events": {"sensor": {"band_m": [7.0e-7, 4.0e-7]}}})
     with pytest.raises(ConfigError, match="events.sensor.quantum_efficiency"):
         resolve_config({"events": {"sensor": {"quantum_efficiency": 1.2}}})
+
+
+def test_a_number_yaml_reads_as_text_gets_a_hint():
+    with pytest.raises(ConfigError, match=r"got str '1.0e9' \(YAML reads 1.0e9 as text: write it with a dot"):
+        resolve_config({"events": {"window_ms": "1.0e9"}})
+    with pytest.raises(ConfigError, match=r"expected number, got str 'ten'$"):
+        resolve_config({"events": {"window_ms": "ten"}})

@@ -105,3 +105,14 @@ def test_every_per_trajectory_rule_is_in_the_slurm_profiles_trajectory_group():
     groups = yaml.safe_load((ROOT / "profiles" / "slurm" / "config.yaml").read_text())["groups"]
     assert {"camera_poses", "render", "events", "imu"} <= per_trajectory
     assert per_trajectory == {rule for rule, group in groups.items() if group == "trajectory"}
+
+
+def test_the_disk_shortfall_counts_what_is_still_to_write():
+    from traj2events.plan import disk_shortfall
+
+    plan = dataset_plan(load_config(ROOT / "config" / "smoke.yaml"))
+    total = plan.total_disk_bytes
+    assert disk_shortfall(plan, free_bytes=1.01 * total, built_bytes=0) is None
+    assert disk_shortfall(plan, free_bytes=0.5 * total, built_bytes=0.6 * total) is None  # most already built
+    short = disk_shortfall(plan, free_bytes=0.5 * total, built_bytes=0.1 * total)
+    assert short.startswith("~") and "still to write" in short and "free where results/ lies" in short

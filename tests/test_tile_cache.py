@@ -131,3 +131,13 @@ def test_a_killed_writers_temporary_files_go_with_the_next_job(tmp_path):
     TileCache(tmp_path, {"a": 1})  # the next job opens the cache
     left = {p.name for p in (cache.folder / "3").iterdir()}
     assert left == {names["alive here"], names["other host, fresh"]}
+
+
+def test_an_unusable_cache_folder_is_named_before_any_job(tmp_path):
+    from traj2events.formats.tile_cache import unusable
+
+    assert unusable(tmp_path / "not" / "yet" / "made") is None and not (tmp_path / "not").exists()
+    assert list(tmp_path.iterdir()) == []  # the probe folder is gone
+    (tmp_path / "a_file").write_text("x")
+    assert "is a file, not a folder" in unusable(tmp_path / "a_file" / "cache")
+    assert "cannot create a folder in /proc" in unusable("/proc/nonexistent/cache")

@@ -477,6 +477,15 @@ def test_an_imu_setting_or_a_readout_setting_reruns_its_stage_only(built, tmp_pa
     assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
+def test_a_deleted_output_is_built_again(built, tmp_path):
+    """A file deleted by hand is rebuilt by its job, and what depends on it after, not left
+    missing because the index that lists it is up to date."""
+    shutil.copytree(built, tmp_path / "wf")
+    (tmp_path / "wf" / "results" / "descent" / "0001" / "video.mkv").unlink()
+    jobs = {k: v for k, v in jobs_in_dry_run(tmp_path / "wf").items() if k != "all"}
+    assert jobs.get("render") == 1 and jobs.get("dataset_index") == 1 and "camera_poses" not in jobs, jobs
+
+
 def test_turning_the_preview_off_reruns_no_render(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("render", {}).update(preview=False))
@@ -563,6 +572,24 @@ def test_invalid_config_stops_before_any_job(tmp_path):
     run = snakemake(tmp_path, check=False)
     assert run.returncode != 0
     assert "ocp.n_nodes" in run.stdout + run.stderr and ">= 3" in run.stdout + run.stderr
+    assert not (tmp_path / "results").exists()
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"render": {"tile_cache": "/proc/nonexistent/cache"}}, "render.tile_cache: cannot create a folder in /proc"),
+        ({"camera": {"width": 8192, "height": 8192}}, "the dataset does not fit: ~"),  # 46 TB planned (< 50)
+    ],
+)
+def test_what_the_working_directory_cannot_give_stops_before_any_job(tmp_path, change, message):
+    config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+    config["scenarios"]["descent"]["n_trajectories"] = 20
+    for key, value in change.items():
+        config.setdefault(key, {}).update(value)
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    run = snakemake(tmp_path, "-n", check=False)
+    assert run.returncode != 0 and message in run.stdout + run.stderr, run.stderr[-2000:]
     assert not (tmp_path / "results").exists()
 
 

@@ -36,6 +36,14 @@ def _key(path) -> str:
     return ".".join(str(p) for p in path) or "<root>"
 
 
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def describe(error: jsonschema.ValidationError, prefix: list[str] | tuple = ()) -> str:
     """One line naming the config key (`prefix`: the key of the value that was validated)."""
     if error.validator in ("oneOf", "anyOf") and error.context:
@@ -56,7 +64,11 @@ def describe(error: jsonschema.ValidationError, prefix: list[str] | tuple = ()) 
             return f"config key '{prefix}{extra[0]}' is now '{MOVED_KEYS[prefix + extra[0]]}'"
         return f"unknown key '{prefix}{extra[0]}' (expected one of: {', '.join(allowed)})"
     if v == "type":
-        return f"config key '{where}': expected {schema_value}, got {type(got).__name__} {got!r}"
+        hint = ""
+        if isinstance(got, str) and schema_value in ("number", "integer") and _is_number(got):
+            # YAML 1.1 (PyYAML, Snakemake) reads 1.0e9 or 1e-3, without a dot and a sign, as text.
+            hint = f" (YAML reads {got} as text: write it with a dot and a signed exponent, e.g. 1.0e+9)"
+        return f"config key '{where}': expected {schema_value}, got {type(got).__name__} {got!r}{hint}"
     if v in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         op = {"minimum": ">=", "maximum": "<=", "exclusiveMinimum": ">", "exclusiveMaximum": "<"}[v]
         bound = f"{schema_value:g}" if isinstance(schema_value, float) else schema_value

@@ -142,6 +142,15 @@ def too_large(plan: Plan) -> str | None:
     return None
 
 
+def disk_shortfall(plan: Plan, free_bytes: float, built_bytes: float) -> str | None:
+    """Why the outputs still to write do not fit the free space, or None: the planned
+    outputs less those already built (`built_bytes`, under results/), against `free_bytes`."""
+    needed = plan.total_disk_bytes - built_bytes
+    if needed > free_bytes:
+        return f"~{_size(needed)} of outputs still to write, and {_size(free_bytes)} free where results/ lies"
+    return None
+
+
 def job_resources(config: dict, stage: str, scenario: str | None, threads: int = 1) -> dict[str, int]:
     """What one job of `stage` (render, motion_field, events, sample_trajectories; others
     get the defaults; render_events, the two in one job: their sum) is expected to need for

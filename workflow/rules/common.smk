@@ -5,6 +5,7 @@
 import hashlib
 import json
 import shlex
+import shutil
 import sys
 from pathlib import Path
 
@@ -12,7 +13,8 @@ from snakemake.settings.types import DeploymentMethod
 
 from traj2events.config import ConfigError, resolve_config
 from traj2events.fingerprint import code_fingerprint
-from traj2events.plan import dataset_plan, job_resources
+from traj2events.formats.tile_cache import unusable as tile_cache_unusable
+from traj2events.plan import dataset_plan, disk_shortfall, job_resources
 from traj2events.settings.camera import camera_settings as camera_settings_of
 from traj2events.settings.camera import motion_field_settings as motion_field_settings_of
 from traj2events.settings.events import events_picture_settings as events_picture_settings_of
@@ -28,7 +30,27 @@ except ConfigError as error:
     raise WorkflowError(f"invalid configuration: {error}")
 config.clear()
 config.update(_resolved)
-print(f"traj2events: {dataset_plan(config).summary()}", file=sys.stderr)
+_plan = dataset_plan(config)
+print(f"traj2events: {_plan.summary()}", file=sys.stderr)
+
+
+def results_bytes():
+    """Bytes of the dataset already built under results/ (the tile cache aside)."""
+    results = Path("results")
+    files = results.rglob("*") if results.is_dir() else []
+    return sum(f.stat().st_size for f in files if f.is_file() and f.parts[1:2] != ("tile_cache",))
+
+
+# What the working directory cannot give, known before any job: an unusable tile cache
+# folder (every render job would fail on it), outputs that cannot fit the free space.
+if config["render"]["tile_cache"] and (_unusable := tile_cache_unusable(config["render"]["tile_cache"])):
+    raise WorkflowError(f"invalid configuration: render.tile_cache: {_unusable}")
+_free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
+if not config["allow_large_dataset"] and (_short := disk_shortfall(_plan, _free, results_bytes())):
+    raise WorkflowError(
+        f"the dataset does not fit: {_short}; free space, build fewer or smaller trajectories, or set "
+        "'allow_large_dataset: true' if the space will be there (`traj2events check-config` prints the plan)"
+    )
 
 if DeploymentMethod.CONDA in workflow.deployment_settings.deployment_method:
     # --sdm conda: each rule's environment (envs/*.yaml) holds the dependencies and the
@@ -167,16 +189,23 @@ PER_TRAJECTORY = [
 ]
 
 
+def trajectory_files(scenario):
+    """Every per-trajectory file of one scenario."""
+    return [f"results/{scenario}/{i}/{name}" for i in trajectory_ids(scenario) for name in PER_TRAJECTORY]
+
+
 def scenario_outputs(wildcards):
-    """Every per-trajectory file of one scenario (the index's inputs)."""
-    ids = trajectory_ids(wildcards.scenario)
-    return [f"results/{wildcards.scenario}/{i}/{name}" for i in ids for name in PER_TRAJECTORY]
+    """The index's inputs: every per-trajectory file of its scenario."""
+    return trajectory_files(wildcards.scenario)
 
 
 def all_outputs(wildcards):
+    """The dataset. Every per-trajectory file is a target itself, so that one deleted by hand
+    is built again (Snakemake skips a missing input of a job whose outputs are up to date)."""
     return [
         "results/summary.csv",
         "results/overview.html",
         "results/figures/trajectories.png",
         *expand("results/{scenario}/index.csv", scenario=SCENARIOS),
+        *(path for scenario in SCENARIOS for path in trajectory_files(scenario)),
     ]

@@ -92,6 +92,22 @@ class TileCache:
             return False
 
 
+def unusable(root: str | os.PathLike) -> str | None:
+    """Why `root` cannot hold a tile cache, or None: a folder is made and removed at the first
+    existing folder of its path (so a path under /proc, a file, or a read-only mount is known
+    before any job, not from every render job)."""
+    path = Path(root).absolute()
+    while not path.exists():
+        path = path.parent
+    if not path.is_dir():
+        return f"{path} is a file, not a folder"
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".probe-", dir=path))
+    except OSError as exc:
+        return f"cannot create a folder in {path} ({exc.strerror or exc})"
+    return None
+
+
 def _process_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
