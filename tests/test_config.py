@@ -282,14 +282,20 @@ def write_dem(path, kind):
         np.save(path, np.full((4, 4), np.nan))
     elif kind == "garbage":
         path.write_bytes(b"not a numpy file at all")
+    elif kind == "2x2":
+        np.save(path, np.zeros((2, 2)))
+    elif kind == "radii":  # the Moon's radius plus heights: a DEM given as radii
+        np.save(path, 1_737_400.0 + np.arange(64.0).reshape(8, 8))
     else:
         np.save(path, np.zeros((8, 8)))
 
 
 @pytest.mark.parametrize(
     "kind, spacing, fragment",
-    [("1-D", 1.0, "finite 2-D"), ("NaN", 1.0, "finite 2-D"), ("garbage", 1.0, "dem.npy"), ("ok", None, "spacing")],
-)
+    [("1-D", 1.0, "finite 2-D"), ("NaN", 1.0, "finite 2-D"), ("garbage", 1.0, "dem.npy"), ("ok", None, "spacing"),
+     ("2x2", 1.0, "2 x 2 samples; expected at least 8 a side"),
+     ("radii", 1.0, "a height of 1.737e+06 m; expected heights above the mean sphere")],
+)  # fmt: skip
 def test_a_bad_elevation_grid_is_refused_before_any_job(tmp_path, kind, spacing, fragment):
     write_dem(tmp_path / "dem.npy", kind)
     with pytest.raises(ConfigError, match="terrain.elevation_grid") as info:

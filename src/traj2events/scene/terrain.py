@@ -418,6 +418,10 @@ def bilinear(
     return np.where(inside, val, fill)
 
 
+MIN_GRID_SAMPLES = 8  # a side, of a user elevation grid
+MAX_HEIGHT_M = 30_000.0  # of a user elevation grid, above or below the mean sphere
+
+
 def load_elevation_grid(
     path: str | os.PathLike, spacing_m: float | None = None, origin_m: tuple[float, float] | None = None
 ) -> GridTerrain:
@@ -453,6 +457,18 @@ def load_elevation_grid(
     if heights.ndim != 2 or min(heights.shape) < 2 or not np.all(np.isfinite(heights)):
         raise ValueError(
             f"terrain.elevation_grid: {path}: expected a finite 2-D array of heights, got shape {heights.shape}"
+        )
+    if min(heights.shape) < MIN_GRID_SAMPLES:
+        raise ValueError(
+            f"terrain.elevation_grid: {path}: {heights.shape[0]} x {heights.shape[1]} samples; expected at least "
+            f"{MIN_GRID_SAMPLES} a side (fewer interpolate to a few tilted planes, not a terrain)"
+        )
+    highest = float(np.abs(heights).max())
+    if highest > MAX_HEIGHT_M:
+        raise ValueError(
+            f"terrain.elevation_grid: {path}: a height of {highest:.4g} m; expected heights above the mean sphere "
+            f"(0 outside the grid) within +-{MAX_HEIGHT_M:.0f} m (no body's relief reaches it: the Moon -9.1 to "
+            "+10.8 km, Mars -8.2 to +21.2 km): radii, or other units?"
         )
     if spacing_m is None or not spacing_m > 0:
         raise ValueError(f"terrain.elevation_grid: {path}: grid spacing unknown; give terrain.grid_spacing_m > 0")
