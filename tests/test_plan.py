@@ -116,3 +116,19 @@ def test_the_disk_shortfall_counts_what_is_still_to_write():
     assert disk_shortfall(plan, free_bytes=0.5 * total, built_bytes=0.6 * total) is None  # most already built
     short = disk_shortfall(plan, free_bytes=0.5 * total, built_bytes=0.1 * total)
     assert short.startswith("~") and "still to write" in short and "free where results/ lies" in short
+
+
+def test_faint_stars_are_planned_as_the_frames_they_cost():
+    """V 12 (~3 M stars) costs the render STAR_S per star the sky cells put in view."""
+    from traj2events.geometry.camera import Camera
+    from traj2events.plan import STAR_S, render_s_per_frame
+    from traj2events.scene.stars import stars_in_view
+
+    config = load_config(ROOT / "config" / "smoke.yaml")
+    pixels = config["camera"]["width"] * config["camera"]["height"]
+    base = render_s_per_frame(config, pixels)
+    config["render"]["stars"]["magnitude_limit"] = 12.0
+    camera = Camera(config["camera"]["width"], config["camera"]["height"], config["camera"]["fov_deg"])
+    extra = render_s_per_frame(config, pixels) - base
+    assert extra == pytest.approx(STAR_S * (stars_in_view(12.0, camera) - stars_in_view(7.0, camera)), rel=1e-9)
+    assert extra > 0.03  # at 32^2 the stars then cost more than the frame

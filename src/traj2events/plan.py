@@ -22,6 +22,7 @@ RENDER_S = tuple(COSTS["cpu_s"]["render_per_frame"])  # (per frame, per pixel), 
 PREVIEW_S_PER_PX = COSTS["cpu_s"]["preview_per_px"]  # of RENDER_S: the preview's encoder
 EVENTS_S = tuple(COSTS["cpu_s"]["events_per_frame"])  # (per frame, per pixel): decoding, emulation, writing
 FIELD_S_PER_PX = COSTS["cpu_s"]["motion_field_per_px"]
+STAR_S = COSTS["cpu_s"]["star_in_view"]  # per star a frame projects (scene.stars.stars_in_view)
 MEMORY_MB = {stage: tuple(v) for stage, v in COSTS["memory_mb"].items()}  # (fixed, per pixel)
 ADAPTIVE_EXTRA = tuple(COSTS["adaptive_extra"])  # (a, p, q): see rendered_per_frame
 RUNTIME_MARGIN = 3.0  # requested run time / estimate: t_f may exceed its guess, nodes vary
@@ -96,9 +97,17 @@ def rendered_per_frame(config: dict) -> float:
 
 
 def render_s_per_frame(config: dict, pixels: int) -> float:
-    """One core's seconds per rendered frame, encoders included (the preview's only with render.preview)."""
+    """One core's seconds per rendered frame, encoders included (the preview's only with
+    render.preview), and the stars a frame projects (beyond the default's few thousand, a
+    cost of its own: V 12 adds ~45 ms a frame)."""
+    from .geometry.camera import Camera
+    from .scene.stars import stars_in_view
+
     preview = 0.0 if config["render"]["preview"] else PREVIEW_S_PER_PX * pixels
-    return RENDER_S[0] + RENDER_S[1] * pixels - preview
+    stars = config["render"]["stars"]
+    camera = Camera(config["camera"]["width"], config["camera"]["height"], config["camera"]["fov_deg"])
+    star_s = STAR_S * stars_in_view(stars["magnitude_limit"], camera) if stars["enabled"] else 0.0
+    return RENDER_S[0] + RENDER_S[1] * pixels - preview + star_s
 
 
 def dataset_plan(config: dict) -> Plan:

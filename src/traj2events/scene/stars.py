@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.camera import Camera, CameraPose
+from .sky_cells import SkyCells, mean_cell_radius_rad
 from .sun import SOLAR_CONSTANT_W_M2
 
 COUNT_LOG10_AT_V0 = 0.74  # log10 N(< V) = COUNT_LOG10_AT_V0 + COUNT_SLOPE V, whole sky
@@ -44,12 +45,39 @@ def star_irradiance_w_m2(v_mag: np.ndarray) -> np.ndarray:
     return SOLAR_CONSTANT_W_M2 * 10.0 ** (-0.4 * (np.asarray(v_mag, dtype=float) - SUN_V_MAG))
 
 
+def view_cone_rad(camera: Camera) -> float:
+    """Half-angle of the cone around the boresight that holds the image, one pixel beyond
+    its corners (a star's splat reaches the next pixel)."""
+    return float(np.arctan(np.hypot(camera.width / 2 + 1, camera.height / 2 + 1) / camera.focal_px))
+
+
+def stars_in_view(magnitude_limit: float, camera: Camera) -> float:
+    """Expected stars a frame projects: the whole sky's count times the share of the sky
+    within the view cone widened by a sky cell's mean radius (sky_cells.py)."""
+    reach = min(view_cone_rad(camera) + mean_cell_radius_rad(), np.pi)
+    return float(stars_brighter_than(magnitude_limit)) * (1.0 - np.cos(reach)) / 2.0
+
+
 @dataclass(frozen=True)
 class StarField:
-    """Unit directions (n, 3) in the inertial frame and irradiances (n,) W/m^2."""
+    """Unit directions (n, 3) in the inertial frame and irradiances (n,) W/m^2; `cells`:
+    where drawn, the stars are grouped by sky cell, so that a frame takes only those of the
+    cells in its view (sky_cells.py)."""
 
     directions: np.ndarray
     irradiance_w_m2: np.ndarray
+    cells: SkyCells | None = None
+
+    def in_view(self, camera: Camera, pose: CameraPose) -> StarField:
+        """The stars of the sky cells the camera's view cone touches (a superset of those in
+        the image; all of them without cells)."""
+        if self.cells is None:
+            return self
+        parts = self.cells.slices_in_cone(pose.rotation[:, 2], view_cone_rad(camera))
+        if not parts:
+            return StarField(self.directions[:0], self.irradiance_w_m2[:0])
+        directions = np.concatenate([self.directions[s] for s in parts])
+        return StarField(directions, np.concatenate([self.irradiance_w_m2[s] for s in parts]))
 
     @classmethod
     def draw(cls, magnitude_limit: float, seed: int) -> StarField:
@@ -64,12 +92,14 @@ class StarField:
         phi = rng.uniform(0.0, 2.0 * np.pi, n)
         s = np.sqrt(1.0 - z**2)
         directions = np.stack([s * np.cos(phi), s * np.sin(phi), z], axis=1)
-        return cls(directions, star_irradiance_w_m2(v_mag))
+        cells, order = SkyCells.sorting(directions)
+        return cls(directions[order], star_irradiance_w_m2(v_mag)[order], cells)
 
 
 def star_splat(stars: StarField, camera: Camera, pose: CameraPose) -> tuple[np.ndarray, np.ndarray]:
     """The stars in view as (flat pixel indices, radiance W m^-2 sr^-1) pairs, four per
     star (bilinear), before any masking; an index may repeat."""
+    stars = stars.in_view(camera, pose)
     d_cam = stars.directions @ pose.rotation  # inertial -> camera (rotation is camera -> inertial)
     d_cam = d_cam[d_cam[:, 2] > 1e-6]
     irradiance = stars.irradiance_w_m2[stars.directions @ pose.rotation[:, 2] > 1e-6]
