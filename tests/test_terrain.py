@@ -104,14 +104,14 @@ def test_surface_points_on_the_sphere_and_tangent_at_the_site():
 
 
 def test_user_grids_load_and_interpolate(tmp_path):
-    heights = np.add.outer(np.arange(5.0), 10 * np.arange(4.0))
+    heights = np.add.outer(np.arange(9.0), 10 * np.arange(8.0))
     np.save(tmp_path / "dem.npy", heights)
     grid = load_elevation_grid(tmp_path / "dem.npy", spacing_m=2.0, origin_m=(0.0, 0.0))
     assert grid.height_m(np.array([3.0]), np.array([5.0]))[0] == pytest.approx(1.5 + 25.0)
     assert grid.height_m(np.array([100.0]), np.array([0.0]))[0] == 0.0  # outside: the mean sphere
     np.savez(tmp_path / "dem.npz", heights_m=heights, spacing_m=2.0)
     centred = load_elevation_grid(tmp_path / "dem.npz")
-    assert centred.origin_m == (-4.0, -3.0)
+    assert centred.origin_m == (-8.0, -7.0)
     tifffile = pytest.importorskip("tifffile")
     tifffile.imwrite(
         tmp_path / "dem.tif", heights.astype(np.float32), extratags=[(33550, "d", 3, (2.0, 2.0, 0.0))]
@@ -126,7 +126,8 @@ def test_user_grids_load_and_interpolate(tmp_path):
     [
         ("missing.npy", None, "does not exist"),
         ("dem.npy", np.zeros(5), "2-D array"),
-        ("dem.npy", np.zeros((3, 3)), "spacing unknown"),
+        ("dem.npy", np.zeros((8, 8)), "spacing unknown"),
+        ("dem.npy", np.zeros((3, 3)), "3 x 3 samples; expected at least 8"),
         ("dem.txt", "x", "expected .npy"),
     ],
 )
