@@ -13,7 +13,10 @@ SLURM job-step plugin drops every SLURM_* variable, SLURM_CONF included, before 
 Facts behind the configuration (Slurm 22.05): no accounting database, so jobs are
 followed with `squeue` (MinJobAge keeps finished jobs visible to it for 10 min); no
 cgroups or systemd (proctrack/linuxproc, task/none); cores and memory consumable, so jobs
-that ask for memory share the node.
+that ask for memory share the node. The node declares one GPU as a generic resource, and
+a `gpu` partition sits beside the default `test` one, so that GPU profiles' requests can be
+checked without a GPU: gres.conf gives /dev/null as its device file (Slurm 22.05 drops a
+GPU without one: "Removing file-less GPU").
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from pathlib import Path
 
 PACKAGES = ["slurm-wlm", "slurmctld", "slurmd", "slurm-client", "munge"]
 SYSTEM_CONF = Path("/etc/slurm/slurm.conf")
+GRES_CONF = SYSTEM_CONF.with_name("gres.conf")
 MARKER = "# written by traj2events' tests/slurm_cluster.py"
 DAEMONS = ["munged", "slurmctld", "slurmd", "sbatch", "squeue"]
 
@@ -73,9 +77,11 @@ class SingleNodeSlurm:
         f = self.folder
         for sub in ("ctld", "d", "log"):
             (f / sub).mkdir(parents=True, exist_ok=True)
-        if self.conf.exists() and not self.conf.read_text().startswith(MARKER):
-            raise SlurmUnavailable(f"{self.conf} exists (a real SLURM?): not replacing it for a test cluster")
+        for conf in (self.conf, GRES_CONF):
+            if conf.exists() and not conf.read_text().startswith(MARKER):
+                raise SlurmUnavailable(f"{conf} exists (a real SLURM?): not replacing it for a test cluster")
         self.conf.parent.mkdir(parents=True, exist_ok=True)
+        GRES_CONF.write_text(f"{MARKER}\nName=gpu File=/dev/null Count=1\n")
         self.conf.write_text(
             f"""{MARKER}
 ClusterName=traj2events-test
@@ -96,14 +102,16 @@ JobCompType=jobcomp/none
 MinJobAge=600
 ReturnToService=2
 SchedulerType=sched/backfill
+GresTypes=gpu
 StateSaveLocation={f}/ctld
 SlurmdSpoolDir={f}/d
 SlurmctldPidFile={f}/ctld.pid
 SlurmdPidFile={f}/d.pid
 SlurmctldLogFile={f}/log/slurmctld.log
 SlurmdLogFile={f}/log/slurmd.log
-NodeName={self.host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} RealMemory={_memory_mb()} State=UNKNOWN
+NodeName={self.host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} RealMemory={_memory_mb()} Gres=gpu:1 State=UNKNOWN
 PartitionName=test Nodes=ALL Default=YES MaxTime=INFINITE State=UP
+PartitionName=gpu Nodes=ALL Default=NO MaxTime=INFINITE State=UP
 """
         )
 
@@ -158,8 +166,9 @@ PartitionName=test Nodes=ALL Default=YES MaxTime=INFINITE State=UP
                 time.sleep(0.1)
             if _alive(pid):
                 os.kill(pid, signal.SIGKILL)
-        if self.conf.exists() and self.conf.read_text().startswith(MARKER):
-            self.conf.unlink()
+        for conf in (self.conf, GRES_CONF):
+            if conf.exists() and conf.read_text().startswith(MARKER):
+                conf.unlink()
 
 
 def _read_pid(path: Path) -> int:

@@ -24,10 +24,10 @@ def cluster(tmp_path_factory):
         pytest.skip(f"no single-node SLURM for this test: {exc}")
 
 
-def on_slurm(workdir: Path, cluster, *args) -> subprocess.CompletedProcess:
+def on_slurm(workdir: Path, cluster, *args, profile: str = "slurm") -> subprocess.CompletedProcess:
     # A 2-core node, polled every 2 s at first instead of the profile's 10 (a real cluster's
     # courtesy): the plugin's wait grows by 10 s per check that finds nothing finished.
-    profile = ["--profile", str(ROOT / "profiles" / "slurm"), "--set-threads", "sample_trajectories=2",
+    profile = ["--profile", str(ROOT / "profiles" / profile), "--set-threads", "sample_trajectories=2",
                "--slurm-init-seconds-before-status-checks", "2"]  # fmt: skip
     return snakemake(workdir, *profile, *args, env=cluster.env, check=False)
 
@@ -74,3 +74,29 @@ def test_the_profile_sizes_jobs_from_the_config(cluster, tmp_path):
     assert memory[0] == memory[1], memory
     block = out.split("rule dataset_index:")[1].split("rule ")[0]
     assert "mem_mb=1000," in block and "runtime=10" in block
+
+
+def slurm_jobs(cluster) -> list[dict[str, str]]:
+    """Every job slurmctld still holds (MinJobAge: 10 min), as its `scontrol` fields."""
+    out = subprocess.run(["scontrol", "show", "job", "-o"], env=cluster.env, capture_output=True, text=True).stdout
+    lines = [line for line in out.splitlines() if line.startswith("JobId=")]
+    return [dict(field.split("=", 1) for field in line.split() if "=" in field) for line in lines]
+
+
+def test_the_gpu_profile_renders_k_trajectories_on_one_card_and_keeps_the_rest_off_it(cluster, tmp_path):
+    """profiles/slurm-gpu up to the render jobs: both trajectories' renders go as one
+    submission to the gpu partition with one card (gres) and a CPU each; every other
+    submission goes to the default partition without a card."""
+    (tmp_path / "config.yaml").write_text((ROOT / "config" / "smoke.yaml").read_text())
+    before = {job["JobId"] for job in slurm_jobs(cluster)}
+    run = on_slurm(tmp_path, cluster, "--until", "render", profile="slurm-gpu")
+    assert run.returncode == 0, (run.stdout + run.stderr)[-4000:]
+    assert sorted(p.parent.name for p in (tmp_path / "results" / "descent").glob("*/video.mkv")) == ["0000", "0001"]
+    jobs = [job for job in slurm_jobs(cluster) if job["JobId"] not in before]
+    on_gpu = [job for job in jobs if job["Partition"] == "gpu"]
+    assert len(on_gpu) == 1 and len(jobs) >= 4, [(j["Partition"], j.get("Comment")) for j in jobs]
+    # The card asked for (TresPerNode; TRES lists gres only where accounting tracks it).
+    assert on_gpu[0].get("TresPerNode") == "gres:gpu:1" and on_gpu[0]["NumCPUs"] == "2", on_gpu[0]
+    for job in jobs:
+        if job is not on_gpu[0]:
+            assert job["Partition"] == "test" and "gpu" not in job.get("TresPerNode", ""), job
