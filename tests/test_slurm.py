@@ -2,6 +2,7 @@
 equals a local run's results, and a rerun has nothing to do. The test installs Debian's
 slurm-wlm and munge when they are missing (root only) and stops the daemons it started."""
 
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -32,20 +33,27 @@ def on_slurm(workdir: Path, cluster, *args, profile: str = "slurm") -> subproces
     return snakemake(workdir, *profile, *args, env=cluster.env, check=False)
 
 
-def test_smoke_dataset_on_slurm_equals_a_local_run(cluster, tmp_path):
-    config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
-    for name in ("slurm", "local"):
-        (tmp_path / name).mkdir()
-        (tmp_path / name / "config.yaml").write_text(yaml.safe_dump(config))
-    run = on_slurm(tmp_path / "slurm", cluster)
+@pytest.fixture(scope="module")
+def smoke_on_slurm(cluster, tmp_path_factory):
+    """The smoke dataset built through profiles/slurm: (its folder, the run's output)."""
+    workdir = tmp_path_factory.mktemp("slurm")
+    (workdir / "config.yaml").write_text((ROOT / "config" / "smoke.yaml").read_text())
+    run = on_slurm(workdir, cluster)
     out = run.stdout + run.stderr
     assert run.returncode == 0, out[-4000:]
+    return workdir, out
+
+
+def test_smoke_dataset_on_slurm_equals_a_local_run(smoke_on_slurm, cluster, tmp_path):
+    workdir, out = smoke_on_slurm
     # Each trajectory's nine jobs went as one SLURM job (a group), not nine.
     assert out.count("Group job trajectory") == 2
     assert "SLURM jobid" in out
+    (tmp_path / "local").mkdir()
+    (tmp_path / "local" / "config.yaml").write_text((workdir / "config.yaml").read_text())
     snakemake(tmp_path / "local")
-    assert_same_dataset(tmp_path / "slurm", tmp_path / "local")
-    rerun = on_slurm(tmp_path / "slurm", cluster)
+    assert_same_dataset(workdir, tmp_path / "local")
+    rerun = on_slurm(workdir, cluster)
     assert rerun.returncode == 0 and "Nothing to be done" in rerun.stdout + rerun.stderr
 
 
@@ -83,20 +91,26 @@ def slurm_jobs(cluster) -> list[dict[str, str]]:
     return [dict(field.split("=", 1) for field in line.split() if "=" in field) for line in lines]
 
 
-def test_the_gpu_profile_renders_k_trajectories_on_one_card_and_keeps_the_rest_off_it(cluster, tmp_path):
-    """profiles/slurm-gpu up to the render jobs: both trajectories' renders go as one
-    submission to the gpu partition with one card (gres) and a CPU each; every other
-    submission goes to the default partition without a card."""
-    (tmp_path / "config.yaml").write_text((ROOT / "config" / "smoke.yaml").read_text())
+def test_the_gpu_profile_renders_k_trajectories_on_one_card_and_keeps_the_rest_off_it(
+    smoke_on_slurm, cluster, tmp_path
+):
+    """profiles/slurm-gpu on a copy of the smoke dataset whose videos were deleted: both
+    trajectories' renders go as one submission to the gpu partition with one card (gres)
+    and a CPU each; no other job asks for a card or the gpu partition."""
+    shutil.copytree(smoke_on_slurm[0], tmp_path / "wf")
+    for video in (tmp_path / "wf" / "results" / "descent").glob("*/video.mkv"):
+        video.unlink()
+    plan = on_slurm(tmp_path / "wf", cluster, "-n", profile="slurm-gpu").stdout
+    blocks = plan.split("rule ")[1:]
+    assert sum(b.startswith("render:") for b in blocks) == 2 and len(blocks) > 4  # and what reads the frames
+    for block in blocks:
+        on_card = "gres=gpu:1" in block and "slurm_partition=gpu" in block
+        assert on_card == block.startswith("render:"), block[:2000]
     before = {job["JobId"] for job in slurm_jobs(cluster)}
-    run = on_slurm(tmp_path, cluster, "--until", "render", profile="slurm-gpu")
+    run = on_slurm(tmp_path / "wf", cluster, "--until", "render", profile="slurm-gpu")
     assert run.returncode == 0, (run.stdout + run.stderr)[-4000:]
-    assert sorted(p.parent.name for p in (tmp_path / "results" / "descent").glob("*/video.mkv")) == ["0000", "0001"]
+    assert len(list((tmp_path / "wf" / "results" / "descent").glob("*/video.mkv"))) == 2
     jobs = [job for job in slurm_jobs(cluster) if job["JobId"] not in before]
-    on_gpu = [job for job in jobs if job["Partition"] == "gpu"]
-    assert len(on_gpu) == 1 and len(jobs) >= 4, [(j["Partition"], j.get("Comment")) for j in jobs]
+    assert len(jobs) == 1 and jobs[0]["Partition"] == "gpu", jobs
     # The card asked for (TresPerNode; TRES lists gres only where accounting tracks it).
-    assert on_gpu[0].get("TresPerNode") == "gres:gpu:1" and on_gpu[0]["NumCPUs"] == "2", on_gpu[0]
-    for job in jobs:
-        if job is not on_gpu[0]:
-            assert job["Partition"] == "test" and "gpu" not in job.get("TresPerNode", ""), job
+    assert jobs[0].get("TresPerNode") == "gres:gpu:1" and jobs[0]["NumCPUs"] == "2", jobs[0]
