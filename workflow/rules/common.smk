@@ -41,16 +41,23 @@ def results_bytes():
     return sum(f.stat().st_size for f in files if f.is_file() and f.parts[1:2] != ("tile_cache",))
 
 
-# What the working directory cannot give, known before any job: an unusable tile cache
-# folder (every render job would fail on it), outputs that cannot fit the free space.
-if config["render"]["tile_cache"] and (_unusable := tile_cache_unusable(config["render"]["tile_cache"])):
-    raise WorkflowError(f"invalid configuration: render.tile_cache: {_unusable}")
-_free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
-if not config["allow_large_dataset"] and (_short := disk_shortfall(_plan, _free, results_bytes())):
-    raise WorkflowError(
-        f"the dataset does not fit: {_short}; free space, build fewer or smaller trajectories, or set "
-        "'allow_large_dataset: true' if the space will be there (`traj2events check-config` prints the plan)"
-    )
+def check_working_directory():
+    """What the working directory cannot give, known before any job: an unusable tile cache
+    folder (every render job would fail on it), outputs that cannot fit the free space."""
+    if config["render"]["tile_cache"] and (unusable := tile_cache_unusable(config["render"]["tile_cache"])):
+        raise WorkflowError(f"invalid configuration: render.tile_cache: {unusable}")
+    free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
+    if not config["allow_large_dataset"] and (short := disk_shortfall(_plan, free, results_bytes())):
+        raise WorkflowError(
+            f"the dataset does not fit: {short}; free space, build fewer or smaller trajectories, or set "
+            "'allow_large_dataset: true' if the space will be there (`traj2events check-config` prints the plan)"
+        )
+
+
+# By the controller only: a job that runs the workflow again (a group's, on SLURM) would walk
+# results/ in every submission, and could refuse itself as the disk fills as planned.
+if workflow.is_main_process:
+    check_working_directory()
 
 if DeploymentMethod.CONDA in workflow.deployment_settings.deployment_method:
     # --sdm conda: each rule's environment (envs/*.yaml) holds the dependencies and the
