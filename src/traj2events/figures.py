@@ -1,13 +1,41 @@
 """Figures (pure: data in, matplotlib figure out): the dataset figure, the motion-field,
-frame and event-frame mosaics."""
+frame and event-frame mosaics, the event rate over each flight; and a figure's PNG bytes."""
 
 from __future__ import annotations
 
 import matplotlib
 
 matplotlib.use("Agg")
+import io  # noqa: E402
+
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+
+def png_bytes(fig: plt.Figure, dpi: int) -> bytes:
+    """The figure as PNG without the software tag (same figure, same bytes); closes it."""
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi, metadata={"Software": None})
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def event_rate_figure(curves: list[tuple[str, np.ndarray]], bin_ms: float) -> plt.Figure:
+    """Events per second in `bin_ms` bins against normalised time t / t_f, one line per
+    (scenario, rate) curve, one colour per scenario; empty bins drawn at 1 (log scale)."""
+    scenarios = sorted({name for name, _ in curves})
+    colours = {name: plt.get_cmap("tab10")(k % 10) for k, name in enumerate(scenarios)}
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    for name, rate in curves:
+        ax.plot(np.linspace(0, 1, len(rate)), np.maximum(rate, 1.0), color=colours[name], lw=0.8, alpha=0.6)
+    for name in scenarios:
+        ax.plot([], [], color=colours[name], label=name)
+    ax.set(yscale="log", xlabel="t / t_f", ylabel=f"events per s ({bin_ms:g} ms bins)", xlim=(0, 1))
+    ax.set_title("Event rate over each flight")
+    ax.legend(loc="upper left", fontsize=8, frameon=False)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
 
 
 def height_pitch_bands(samples: list[dict], n_points: int = 101) -> dict[str, np.ndarray]:

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 import json
 import os
 from pathlib import Path
@@ -17,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from ..figures import event_rate_figure, png_bytes
 from ..formats.atomic import atomic_output
 from ..formats.hdf5 import open_file
 
@@ -56,32 +56,6 @@ def trajectory_stats(folder: Path, names: list[str]) -> dict:
         "rate": rate,
         "bytes": folder_bytes(folder, names),
     }
-
-
-def rate_figure_png(curves: list[tuple[str, np.ndarray]]) -> bytes:
-    """Event rate against normalised time t / t_f, one line per trajectory, one colour per
-    scenario; PNG bytes without the software tag."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    scenarios = sorted({name for name, _ in curves})
-    colours = {name: plt.get_cmap("tab10")(k % 10) for k, name in enumerate(scenarios)}
-    fig, ax = plt.subplots(figsize=(8, 3.6))
-    for name, rate in curves:
-        ax.plot(np.linspace(0, 1, len(rate)), np.maximum(rate, 1.0), color=colours[name], lw=0.8, alpha=0.6)
-    for name in scenarios:
-        ax.plot([], [], color=colours[name], label=name)
-    ax.set(yscale="log", xlabel="t / t_f", ylabel=f"events per s ({RATE_BIN_MS} ms bins)", xlim=(0, 1))
-    ax.set_title("Event rate over each flight")
-    ax.legend(loc="upper left", fontsize=8, frameon=False)
-    ax.grid(alpha=0.3)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100, metadata={"Software": None})
-    plt.close(fig)
-    return buffer.getvalue()
 
 
 def _table(frame: pd.DataFrame) -> str:
@@ -153,6 +127,7 @@ def dataset_overview(
     by_kind = pd.DataFrame(sizes).sum()
     kinds = pd.DataFrame({"file": by_kind.index, "MB": by_kind.values / 1e6, "MB_per_trajectory": by_kind.values / 1e6
                           / len(rows), "share": by_kind.values / max(by_kind.sum(), 1)})  # fmt: skip
-    page = overview_html(table, pd.read_csv(summary), kinds, rate_figure_png(curves), json.loads(config_json))
+    figure = png_bytes(event_rate_figure(curves, RATE_BIN_MS), dpi=100)
+    page = overview_html(table, pd.read_csv(summary), kinds, figure, json.loads(config_json))
     with atomic_output(output) as tmp:
         Path(tmp).write_text(page)

@@ -5,10 +5,11 @@ picture setting (the event-frame window) reruns only pictures."""
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import numpy as np
 
-from ..figures import dataset_figure, event_frame, event_mosaic, frame_mosaic, motion_field_mosaic
+from ..figures import dataset_figure, event_frame, event_mosaic, frame_mosaic, motion_field_mosaic, png_bytes
 from ..formats.atomic import atomic_output
 from ..formats.events import read_end_us, read_events_attrs, read_events_window
 from ..formats.trajectory import read_solution_set, read_trajectory
@@ -27,11 +28,8 @@ def paper_times(t: np.ndarray) -> list[int]:
 
 def save_png(fig, path: str | os.PathLike, dpi: int) -> None:
     """A figure as PNG without the software tag (same figure, same bytes)."""
-    import matplotlib.pyplot as plt
-
     with atomic_output(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=dpi, metadata={"Software": None})
-    plt.close(fig)
+        Path(tmp).write_bytes(png_bytes(fig, dpi))
 
 
 def _title(tr) -> str:
