@@ -58,9 +58,9 @@ def motion_field_file(
     """motion_field.h5, written one field at a time: t (K,), frame_index (K,) and, per
     name in `fields` ({name: (shape of one field, dtype)}), a (K, *shape) dataset chunked
     one field per chunk and compressed (`compression`: hdf5.COMPRESSIONS). Yields the open
-    file and a ChunkWriter per name: the caller sets `writers[name][i]` for every field i and may add small datasets and
-    attributes to the file. The file appears under `path` only if the block completes, so
-    memory stays one field whatever K."""
+    file and a ChunkWriter per name: the caller sets `writers[name][i]` for every field i
+    and may add small datasets and attributes to the file. The file appears under `path`
+    only if the block completes, so memory stays one field whatever K."""
     n = len(t)
     # Blosc: LZ4 + byte shuffle, faster to compress float32 fields than bit shuffle, zstd or
     # gzip, for a few per cent more bytes (bench/motion_field_command.py).

@@ -4,7 +4,8 @@
 adaptive frame between two poses, for the emulator only; render.timing); `radiance`
 (n, H, W) float32 W m^-2 sr^-1 and `depth_m` (n, H, W) float32 along the boresight
 (0 = sky), both rounded to 16 significant bits and compressed one frame per chunk
-(Blosc/LZ4 with byte shuffle: `import hdf5plugin` to read them with h5py);
+(Blosc/LZ4 with byte shuffle: `import hdf5plugin` to read them with h5py; gzip or none
+under the `compression` setting);
 `slant_range_m` (n,) float64 the range meter (`FramesFile.slant_range_m`), taken from each
 depth as it was written; attributes: camera, Sun, terrain, reflectance, display, timing.
 A render job that also emulated the events (`traj2events render --events`) writes the

@@ -243,8 +243,8 @@ def emulate(
     `input_name` are recorded in its attributes; with `labels`, each event's cause too;
     `threads`: CPUs to use, the emulator's per-pixel pass split over those the source's
     decoder leaves; `readout`: latency, jitter and rate limit after the pixels; `device`:
-    cpu or cuda, where the pixel model runs; `compression`: events.h5's). Returns (frames, events, time of the last
-    frame in s)."""
+    cpu or cuda, where the pixel model runs; `compression`: events.h5's). Returns (frames,
+    events, time of the last frame in s)."""
     emulator = EventEmulator(
         source.width,
         source.height,
