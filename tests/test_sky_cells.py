@@ -15,6 +15,13 @@ def uniform_directions(n, seed=0):
     return v / np.linalg.norm(v, axis=1, keepdims=True)
 
 
+def boresight_pose(axis):
+    """A camera at the origin looking along the unit `axis` (its rows down from the z pole's side)."""
+    up = np.cross(axis, [0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.cross(axis, [1.0, 0.0, 0.0])
+    right = up / np.linalg.norm(up)
+    return CameraPose(np.zeros(3), np.stack([right, np.cross(axis, right), axis], axis=1))
+
+
 def test_cells_have_equal_areas():
     # Uniform directions fill equal-area cells equally: counts are Poisson with one mean.
     counts = np.bincount(cell_of(uniform_directions(2_000_000)), minlength=N_BANDS * N_SECTORS)
@@ -45,10 +52,7 @@ def test_a_culled_field_draws_the_same_frames_as_the_whole_sky():
     whole = StarField(field.directions, field.irradiance_w_m2)  # no cells
     radiance = np.zeros((120, 200), np.float32)
     depth = np.zeros((120, 200), np.float32)  # all sky
-    for axis in uniform_directions(12, seed=5):
-        up = np.cross(axis, [0.0, 0.0, 1.0]) if abs(axis[2]) < 0.9 else np.cross(axis, [1.0, 0.0, 0.0])
-        right = up / np.linalg.norm(up)
-        pose = CameraPose(np.zeros(3), np.stack([right, np.cross(axis, right), axis], axis=1))
+    for pose in map(boresight_pose, uniform_directions(12, seed=5)):
         culled = add_stars(radiance, depth, field, camera, pose)
         assert culled is not radiance and culled.sum() > 0
         assert np.array_equal(culled, add_stars(radiance, depth, whole, camera, pose))
@@ -63,9 +67,6 @@ def test_the_planned_stars_per_frame_are_those_the_cells_give():
     field = StarField.draw(10.0, seed=6)
     for camera in (Camera(1024, 1024, 45.0), Camera(640, 480, 90.0)):
         counts = []
-        for axis in uniform_directions(40, seed=7):
-            up = np.cross(axis, [0.0, 0.0, 1.0])
-            right = up / np.linalg.norm(up)
-            pose = CameraPose(np.zeros(3), np.stack([right, np.cross(axis, right), axis], axis=1))
+        for pose in map(boresight_pose, uniform_directions(40, seed=7)):
             counts.append(len(field.in_view(camera, pose).directions))
         assert np.mean(counts) == pytest.approx(stars_in_view(10.0, camera), rel=0.1)
