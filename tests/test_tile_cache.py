@@ -140,4 +140,4 @@ def test_an_unusable_cache_folder_is_named_before_any_job(tmp_path):
     assert list(tmp_path.iterdir()) == []  # the probe folder is gone
     (tmp_path / "a_file").write_text("x")
     assert "is a file, not a folder" in unusable(tmp_path / "a_file" / "cache")
-    assert "cannot create a folder in /proc" in unusable("/proc/nonexistent/cache")
+    assert "cannot create a file in /proc" in unusable("/proc/nonexistent/cache")

@@ -578,7 +578,7 @@ def test_invalid_config_stops_before_any_job(tmp_path):
 @pytest.mark.parametrize(
     "change, message",
     [
-        ({"render": {"tile_cache": "/proc/nonexistent/cache"}}, "render.tile_cache: cannot create a folder in /proc"),
+        ({"render": {"tile_cache": "/proc/nonexistent/cache"}}, "render.tile_cache: cannot create a file in /proc"),
         ({"camera": {"width": 8192, "height": 8192}}, "the dataset does not fit: ~"),  # 46 TB planned (< 50)
     ],
 )

@@ -93,18 +93,21 @@ class TileCache:
 
 
 def unusable(root: str | os.PathLike) -> str | None:
-    """Why `root` cannot hold a tile cache, or None: a folder is made and removed at the first
+    """Why `root` cannot hold a tile cache, or None: a file is made and removed at the first
     existing folder of its path (so a path under /proc, a file, or a read-only mount is known
-    before any job, not from every render job)."""
+    before any job, not from every render job). A file, not a folder: a folder that comes
+    and goes under results/ breaks whoever lists results/ recursively at that moment."""
     path = Path(root).absolute()
     while not path.exists():
         path = path.parent
     if not path.is_dir():
         return f"{path} is a file, not a folder"
     try:
-        os.rmdir(tempfile.mkdtemp(prefix=".probe-", dir=path))
+        handle, probe = tempfile.mkstemp(prefix=".probe-", dir=path)
+        os.close(handle)
+        os.unlink(probe)
     except OSError as exc:
-        return f"cannot create a folder in {path} ({exc.strerror or exc})"
+        return f"cannot create a file in {path} ({exc.strerror or exc})"
     return None
 
 
