@@ -252,7 +252,7 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
         {"events": {"hot_pixel_fraction": 0.01}},
         ["events.hot_pixel_fraction", "is now 'events.pixel.hot_pixel_fraction'"],
     ),
-    ({"events": {"preset": "imx"}}, ["events.preset", "expected one of ['clean', 'paper']", "'imx'"]),
+    ({"events": {"preset": "imx"}}, ["events.preset", "expected one of ['clean', 'davis346', 'imx636', 'paper']"]),
     ({"events": {"pixel": {"theta_on": 0.001}}}, ["events.pixel.theta_on", ">= 0.01"]),
     ({"events": {"pixel": {"theta": 0.2}}}, ["unknown key 'events.pixel.theta'"]),
     ({"scenarios": {"descent": {"altitude_m": [-10.0, 100.0]}}}, ["scenarios.descent.altitude_m", "above the ground"]),

@@ -74,7 +74,7 @@ def test_the_workflows_pixel_values_pass_unchanged():
         ),
         (
             ["--settings", '{"preset": "imx"}'],
-            "config key 'events.preset': expected one of ['clean', 'paper'], got 'imx'",
+            "config key 'events.preset': expected one of ['clean', 'davis346', 'imx636', 'paper'], got 'imx'",
         ),
         (["--settings", "[1]"], "--settings: expected a JSON object"),
         (["--theta-off", "0"], "--theta-off: config key 'events.pixel.theta_off': expected a value >= 0.01, got 0.0"),
@@ -94,4 +94,4 @@ def test_every_pixel_key_is_an_option_with_its_description_and_default(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for key, value in preset("paper")["pixel"].items():
         assert f"--{key.replace('_', '-')}" in text and f"[events.pixel.{key}, default {value}]" in text
-    assert "ON contrast threshold, ln units" in text and "--preset {clean,paper}" in text
+    assert "ON contrast threshold, ln units" in text and "--preset {clean,davis346,imx636,paper}" in text

@@ -290,7 +290,8 @@ def resolve_config(overlay: Any) -> dict:
     events = config.get("events")
     if isinstance(events, dict) and isinstance(events.get("preset"), str) and isinstance(events.get("pixel"), dict):
         try:
-            config = with_preset(config)
+            own = (overlay or {}).get("events")
+            config = with_preset(config, own if isinstance(own, dict) else {})
         except ValueError as exc:  # an unknown preset
             raise ConfigError(str(exc)) from None
     validate_config(config)

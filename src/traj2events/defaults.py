@@ -1,7 +1,8 @@
 """The default configuration, defaults.yaml beside this module: the one source of every
-default. Config files are overlays on it: `merge_config(defaults, overlay)`. The pixel
-model's values come from a named preset, a file of presets/ (`events.preset`), under the
-config's own `events.pixel` keys: `with_preset`."""
+default. Config files are overlays on it: `merge_config(defaults, overlay)`. A named
+preset, a file of presets/ (`events.preset`), gives the pixel model's values and, for a
+sensor that exists, its `events.sensor` and `events.readout` values; the config's own keys
+of those sections go on top: `with_preset`."""
 
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ import yaml
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.yaml")
 PRESETS_DIR = Path(__file__).with_name("presets")
+PRESET_SECTIONS = ("pixel", "sensor", "readout")  # the sections of `events` a preset may give
 
 
 @functools.cache
@@ -31,7 +33,7 @@ def section(name: str) -> dict:
 
 
 def preset_names() -> list[str]:
-    """The pixel-model presets: the files of presets/."""
+    """The presets: the files of presets/."""
     return sorted(path.stem for path in PRESETS_DIR.glob("*.yaml"))
 
 
@@ -41,7 +43,8 @@ def _preset(name: str) -> dict:
 
 
 def preset(name: str) -> dict:
-    """Preset `name`'s overlay on the `events` section ({"pixel": {...}})."""
+    """Preset `name`'s overlay on the `events` section: {"pixel": {...}} and, for a named
+    sensor, {"sensor": {...}, "readout": {...}} (some of their keys)."""
     if name not in preset_names():
         raise ValueError(f"config key 'events.preset': expected one of {preset_names()}, got {name!r}")
     return copy.deepcopy(_preset(name))
@@ -52,11 +55,27 @@ def preset_pixel(name: str, own: dict | None = None) -> dict:
     return {**preset(name)["pixel"], **(own or {})}
 
 
-def with_preset(config: dict) -> dict:
-    """`config` with events.pixel = its preset's values, then the config's own events.pixel
-    keys. The same config again once applied."""
+def preset_sections(events: dict, name: str, own: dict | None = None) -> dict:
+    """`events` (an events section) with preset `name`'s sections on top, then the keys of
+    `own` (the events keys given explicitly: a config's own) on top of those."""
+    out = dict(events)
+    for section, values in preset(name).items():
+        if section not in events:
+            continue
+        base, given = events.get(section) or {}, (own or {}).get(section) or {}
+        if isinstance(base, dict) and isinstance(given, dict):  # else left for the schema to name
+            out[section] = {**base, **values, **given}
+    return out
+
+
+def with_preset(config: dict, own: dict | None = None) -> dict:
+    """`config` with its events preset applied: events.pixel, .sensor, .readout are their
+    values in `config`, then the preset's, then `own`'s (the config file's own events keys;
+    without it, the config's events.pixel: defaults.yaml gives no pixel keys). The same
+    config again once applied."""
     events = config["events"]
-    return {**config, "events": {**events, "pixel": preset_pixel(events["preset"], events.get("pixel"))}}
+    own = own if own is not None else {"pixel": events.get("pixel")}
+    return {**config, "events": preset_sections(events, events["preset"], own)}
 
 
 def merge_config(base: dict, overlay: dict | None) -> dict:

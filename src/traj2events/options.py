@@ -17,7 +17,7 @@ from pathlib import Path
 import jsonschema
 
 from .config import SCHEMA_PATH, ConfigError, describe, load_yaml
-from .defaults import default_config, preset_names, preset_pixel, with_preset
+from .defaults import default_config, preset_names, preset_sections, with_preset
 from .settings import config_value, pick
 
 _PREFIX = "setting:"  # argparse dest of an option that changes one setting
@@ -78,7 +78,8 @@ def add_settings(
         option = dict(dest=_PREFIX + ".".join(setting), default=None, help=f"{node.get('description', '')} [{path}, "
                       f"default {default}]")  # fmt: skip
         if setting == ("preset",):
-            option.update(choices=preset_names(), help=f"{node['description']}; sets every events.pixel key "
+            option.update(choices=preset_names(), help=f"{node['description']}; sets every events.pixel key and "
+                          "a named sensor's events.sensor and events.readout keys "
                           f"[{path}, default {default}]")  # fmt: skip
         elif "enum" in node:
             option.update(choices=node["enum"])
@@ -111,9 +112,10 @@ def _json_object(option: str, value: str) -> dict:
 
 
 def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
-    """The settings in layers: defaults.yaml's, then --settings (its preset's pixel values
-    under its pixel keys, as in a config), then --preset (its pixel values), then each
-    option given; each key checked against the schema."""
+    """The settings in layers: defaults.yaml's, then --settings (its preset's values under
+    its own keys, as in a config), then --preset (its values: the pixel's and, for a named
+    sensor, some of the sensor's and readout's), then each option given; each key checked
+    against the schema."""
     settings = _defaults(keys)
     if args.settings:
         given = _json_object("--settings", args.settings)
@@ -127,11 +129,11 @@ def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
                 settings[name] = {**settings[name], **value}
             else:
                 settings[name] = value
-        if "preset" in given and "pixel" in settings:  # as in a config: the preset's values, then pixel's keys
-            settings["pixel"] = preset_pixel(given["preset"], given.get("pixel"))
+        if "preset" in given and "pixel" in settings:  # as in a config: the preset's values, then the given keys
+            settings = preset_sections(settings, given["preset"], given)
     options = {d[len(_PREFIX) :]: v for d, v in vars(args).items() if d.startswith(_PREFIX) and v is not None}
     if options.get("preset"):
-        settings["pixel"] = preset_pixel(options["preset"])
+        settings = preset_sections(settings, options["preset"])
     for setting, value in options.items():
         *parents, leaf = setting.split(".")
         target = settings
