@@ -486,6 +486,27 @@ def test_a_deleted_output_is_built_again(built, tmp_path):
     assert jobs.get("render") == 1 and jobs.get("dataset_index") == 1 and "camera_poses" not in jobs, jobs
 
 
+def test_a_failed_trajectory_leaves_the_others_indexed(built, tmp_path):
+    """One trajectory whose jobs fail (its trajectory.h5 damaged, its later files gone): the
+    run ends non-zero naming it, and its scenario's index.csv lists the trajectories whose
+    every file was built; the index job writes the whole one once all are."""
+    workdir = tmp_path / "wf"
+    shutil.copytree(built, workdir)
+    scenario = workdir / "results" / "descent"
+    for path in (scenario / "0001").iterdir():
+        if path.name != "trajectory.h5":
+            shutil.rmtree(path) if path.is_dir() else path.unlink()
+    (scenario / "0001" / "trajectory.h5").write_bytes(b"not an HDF5 file")
+    (scenario / "index.csv").unlink()
+    run = snakemake(workdir, check=False)
+    out = run.stdout + run.stderr
+    assert run.returncode != 0 and "Error in rule render" in out and "id=0001" in out
+    assert "results/descent/index.csv lists the 1 of 2 trajectories whose files were all built" in out
+    index = pd.read_csv(scenario / "index.csv")
+    assert list(index["id"]) == [0] and index["path"].tolist() == ["results/descent/0000/trajectory.h5"]
+    assert list(pd.read_csv(workdir / "results" / "hover" / "index.csv")["id"]) == [0]  # complete: untouched
+
+
 def test_turning_the_preview_off_reruns_no_render(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("render", {}).update(preview=False))

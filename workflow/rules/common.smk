@@ -206,6 +206,21 @@ def scenario_outputs(wildcards):
     return trajectory_files(wildcards.scenario)
 
 
+def index_what_was_built():
+    """After a run with failed jobs: a scenario some of whose trajectories were built gets an
+    index.csv of those (every file of theirs there), so that the good ones are in an index;
+    the index job writes the whole one once all are built. None where none was built."""
+    from traj2events.stages.index import dataset_index
+
+    for scenario in SCENARIOS:
+        ids = trajectory_ids(scenario)
+        built = [i for i in ids if all(Path(f"results/{scenario}/{i}/{name}").exists() for name in PER_TRAJECTORY)]
+        if built and len(built) < len(ids):
+            dataset_index([f"results/{scenario}/{i}/trajectory.h5" for i in built], f"results/{scenario}/index.csv")
+            print(f"traj2events: results/{scenario}/index.csv lists the {len(built)} of {len(ids)} trajectories "
+                  "whose files were all built (the others failed: see above)", file=sys.stderr)  # fmt: skip
+
+
 def all_outputs(wildcards):
     """The dataset. Every per-trajectory file is a target itself, so that one deleted by hand
     is built again (Snakemake skips a missing input of a job whose outputs are up to date)."""
