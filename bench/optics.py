@@ -58,23 +58,38 @@ def clip(source: Path, n: int, folder: Path) -> Path:
     return out
 
 
-def run(frames: Path, output: Path, settings: dict, src: Path) -> float:
-    """Seconds of one whole `traj2events events` command with these `--settings`."""
+def clip_arguments(description: str, extra=None) -> argparse.Namespace:
+    """The benches' common arguments: a frames.h5, how many of its frames, how many rounds."""
+    parser = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("frames", type=Path)
+    parser.add_argument("--frames", dest="n_frames", type=int, default=1000)
+    parser.add_argument("--repeats", type=int, default=3)
+    if extra is not None:
+        extra(parser)
+    return parser.parse_args()
+
+
+def timed_events(frames: Path, output: Path, options: list[str], src: Path = SRC) -> float:
+    """Seconds of one whole `traj2events events` command on one CPU with these options, by
+    the code under `src`."""
     command = [sys.executable, "-m", "traj2events", "events", str(frames), "--output", str(output),
-               "--preset", "paper", "--no-labels", "--threads", "1", "--settings", json.dumps(settings)]  # fmt: skip
+               "--threads", "1", *options]  # fmt: skip
     env = dict(os.environ, PYTHONPATH=str(src), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
     start = time.perf_counter()
     subprocess.run(command, check=True, env=env, capture_output=True)
     return time.perf_counter() - start
 
 
+def run(frames: Path, output: Path, settings: dict, src: Path) -> float:
+    """Seconds of one whole `traj2events events` command with these `--settings` (the paper
+    preset, no labels)."""
+    return timed_events(frames, output, ["--preset", "paper", "--no-labels", "--settings", json.dumps(settings)], src)
+
+
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("frames", type=Path)
-    parser.add_argument("--frames", dest="n_frames", type=int, default=1000)
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--baseline-src", type=Path, help="an older checkout's src: variant D")
-    args = parser.parse_args()
+    args = clip_arguments(
+        __doc__, lambda p: p.add_argument("--baseline-src", type=Path, help="an older checkout's src: variant D")
+    )
     sensor = dict(default_config()["events"]["sensor"])
     variants = {name: ({**sensor, **lens}, SRC) for name, lens in LENSES.items()}
     if args.baseline_src:

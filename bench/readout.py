@@ -17,7 +17,6 @@ events were dropped, which shifts the ranks).
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 import statistics
@@ -29,7 +28,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import numpy as np  # noqa: E402
-from optics import SRC, clip, run  # noqa: E402
+from optics import SRC, clip, clip_arguments, run  # noqa: E402
 
 from traj2events.formats.events import read_events  # noqa: E402
 
@@ -53,11 +52,7 @@ def delays_us(reference: np.ndarray, delayed: np.ndarray) -> np.ndarray:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("frames", type=Path)
-    parser.add_argument("--frames", dest="n_frames", type=int, default=1000)
-    parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
+    args = clip_arguments(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         frames = clip(args.frames, args.n_frames, Path(tmp))
         run(frames, Path(tmp) / "a.h5", {}, SRC)

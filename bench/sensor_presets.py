@@ -17,12 +17,10 @@ a slow edge sweep come to its published contrast threshold and latency.
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import platform
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -33,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import h5py  # noqa: E402
 import hdf5plugin  # noqa: E402, F401
 import numpy as np  # noqa: E402
-from optics import SRC, clip  # noqa: E402
+from optics import clip, clip_arguments, timed_events  # noqa: E402
 
 from traj2events.defaults import default_config, preset  # noqa: E402
 from traj2events.formats.events import SIGNAL  # noqa: E402
@@ -48,13 +46,8 @@ PHOTONS_PER_J_555 = 555e-9 / (6.62607015e-34 * 299792458.0)
 
 
 def run(frames: Path, output: Path, name: str) -> float:
-    """Seconds of one whole `traj2events events` command with preset `name`."""
-    command = [sys.executable, "-m", "traj2events", "events", str(frames), "--output", str(output),
-               "--preset", name, "--labels", "--threads", "1"]  # fmt: skip
-    env = dict(os.environ, PYTHONPATH=str(SRC), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
-    start = time.perf_counter()
-    subprocess.run(command, check=True, env=env, capture_output=True)
-    return time.perf_counter() - start
+    """Seconds of one whole `traj2events events` command with preset `name`, labels on."""
+    return timed_events(frames, output, ["--preset", name, "--labels"])
 
 
 def threshold_shown(name: str, x: float) -> float:
@@ -89,11 +82,7 @@ def edge_sweep(name: str) -> tuple[float, float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("frames", type=Path)
-    parser.add_argument("--frames", dest="n_frames", type=int, default=1000)
-    parser.add_argument("--repeats", type=int, default=3)
-    args = parser.parse_args()
+    args = clip_arguments(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         frames = clip(args.frames, args.n_frames, Path(tmp))
         print(f"# sensor presets: {args.n_frames} frames of {args.frames}; {platform.node()} "

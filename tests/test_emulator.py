@@ -283,7 +283,7 @@ def test_non_finite_or_negative_intensity_is_refused(bad):
 
 # --- event labels: the cause of each event, checked against scenes whose cause is known ---
 
-from traj2events.formats.events import EVENT_LABELS, HOT_PIXEL, LEAK, SHOT_NOISE, SIGNAL  # noqa: E402
+from traj2events.formats.events import EVENT_LABELS, GLITCH, HOT_PIXEL, LEAK, RADIATION, SHOT_NOISE, SIGNAL  # noqa: E402
 
 
 def run_labelled(frames, params, seed=0, times=None):
@@ -293,8 +293,8 @@ def run_labelled(frames, params, seed=0, times=None):
 
 
 def test_label_names_are_the_documented_codes():
-    assert EVENT_LABELS == ("signal", "shot_noise", "leak", "hot_pixel")
-    assert (SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL) == (0, 1, 2, 3)
+    assert EVENT_LABELS == ("signal", "shot_noise", "leak", "hot_pixel", "radiation", "glitch")
+    assert (SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL, RADIATION, GLITCH) == (0, 1, 2, 3, 4, 5)
 
 
 @pytest.mark.parametrize(

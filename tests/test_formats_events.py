@@ -103,7 +103,7 @@ def test_labels_are_a_parallel_dataset_read_by_window(tmp_path):
     with h5py.File(tmp_path / "l.h5") as f:
         assert (
             f["events/label"].dtype == np.uint8
-            and f["events/label"].attrs["label_names"] == "signal,shot_noise,leak,hot_pixel"
+            and f["events/label"].attrs["label_names"] == "signal,shot_noise,leak,hot_pixel,radiation,glitch"
         )
         np.testing.assert_array_equal(f["events/label"][()], labels)
     window, window_labels = read_labelled_window(tmp_path / "l.h5", 1_000_500, 1_200_500)

@@ -7,7 +7,7 @@ import pytest
 from PIL import Image
 from scipy.special import erf
 
-from traj2events.formats.events import read_events
+from traj2events.formats.events import EVENT_LABELS, read_events
 from traj2events.stages.events import emulate, frame_source, preset_params
 from traj2events.stages.pictures import events_picture
 from traj2events.video import VideoWriter
@@ -266,6 +266,47 @@ def test_the_readout_delays_and_drops_in_the_events_command(tmp_path):
         assert np.all(np.diff(out["t"]) >= 0)
     assert attrs["readout_mode"] == "drop" and attrs["readout_dropped"] > 0
     assert counts["on"] + attrs["readout_dropped"] == counts["off"]
-    assert attrs["readout_dropped"] == sum(
-        attrs[f"readout_dropped_{k}"] for k in ("signal", "shot_noise", "leak", "hot_pixel")
-    )
+    assert attrs["readout_dropped"] == sum(attrs[f"readout_dropped_{k}"] for k in EVENT_LABELS)
+
+
+def test_the_space_environment_in_the_events_command(tmp_path):
+    """events.space on a frames.h5 through the sensor: the hits' and glitches' events are in
+    events.h5, labelled, in time order, the same bytes however the frames are chunked and
+    for the same seed; off, the events are those of a config without it; a video is refused."""
+    from traj2events.config import default_config
+    from traj2events.formats.events import GLITCH, RADIATION
+    from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+    from traj2events.stages.events import events_command
+
+    defaults = default_config()["events"]
+    low = 100.0 / dn_per_radiance(SensorParams.from_config(defaults["sensor"]))
+    with h5py.File(tmp_path / "frames.h5", "w") as f:
+        f["t"] = np.arange(60) / 100.0
+        f["radiance"] = np.full((60, 40, 48), low, np.float32)
+        f["radiance"][:, :, 24:] *= 50.0  # half the frame sunlit: fast recovery there, slow in the dark half
+    space = {**defaults["space"], "enabled": True, "particle_flux_cm2_s": 3e5, "row_column_hz": 5.0}
+    settings = {**{k: defaults[k] for k in ("input", "sensor", "readout", "device")}, "preset": "paper",
+                "pixel": preset_params("paper").__dict__, "labels": True, "space": space}  # fmt: skip
+    for name, chunk, seed in (("a", 7, 3), ("b", 64, 3), ("c", 64, 4)):
+        events_command(tmp_path / "frames.h5", tmp_path / f"{name}.h5", settings, seed, chunk=chunk)
+    a, attrs = read_events(tmp_path / "a.h5")
+    with h5py.File(tmp_path / "a.h5") as f:
+        label = f["events/label"][()]
+    assert attrs["space_enabled"] and attrs["space_hits"] > 20 and attrs["space_glitches"] > 0
+    assert (label == RADIATION).sum() > 0 and (label == GLITCH).sum() >= 40  # a row: 48, a column: 40
+    assert (np.diff(a["t"]) >= 0).all() and a["t"].max() <= 590_000  # none after the last frame
+    assert a.tobytes() == read_events(tmp_path / "b.h5")[0].tobytes()
+    assert a.tobytes() != read_events(tmp_path / "c.h5")[0].tobytes()
+    off = {**settings, "space": {**space, "enabled": False}}
+    events_command(tmp_path / "frames.h5", tmp_path / "off.h5", off, 3)
+    without = {k: v for k, v in settings.items() if k != "space"}
+    events_command(tmp_path / "frames.h5", tmp_path / "none.h5", without, 3)
+    off_events = read_events(tmp_path / "off.h5")[0]
+    assert off_events.tobytes() == read_events(tmp_path / "none.h5")[0].tobytes()
+    signal = a[(label != RADIATION) & (label != GLITCH)]
+    assert signal.tobytes() == off_events.tobytes()  # the space adds events, it changes none
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in ramp_frames():
+            video.write(f)
+    with pytest.raises(ValueError, match="events.space: the space environment acts on the sensor's photocurrent"):
+        events_command(tmp_path / "in.mkv", tmp_path / "v.h5", {**settings, "sensor": defaults["sensor"]}, 3)

@@ -187,6 +187,13 @@ def _semantic_errors(config: dict) -> list[str]:
     if optics and config["events"]["input"] != "sensor":
         errors.append(f"config key 'events.sensor.{optics[0]}': the lens acts on the sensor's input only: "
                       f"expected events.input: sensor, got {config['events']['input']}")  # fmt: skip
+    space = config["events"]["space"]
+    if space["enabled"] and config["events"]["input"] != "sensor":
+        errors.append(f"config key 'events.space.enabled': the space environment acts on the sensor's photocurrent: "
+                      f"expected events.input: sensor, got {config['events']['input']}")  # fmt: skip
+    if space["enabled"] and space["particle_flux_cm2_s"] > 0 and not pixel["cutoff_hz"] > 0:
+        errors.append("config key 'events.space.particle_flux_cm2_s': particle hits need events.pixel.cutoff_hz > 0 "
+                      "(the photoreceptor's bandwidth sets a pixel's answer to a hit)")  # fmt: skip
     band = sensor["band_m"]
     if not band[0] < band[1]:
         errors.append(f"config key 'events.sensor.band_m': expected [low, high] with low < high, got {band}")

@@ -13,8 +13,9 @@ from .hdf5 import Attributes, create, large_dataset_filters, mark_compression, o
 EVENT_DTYPE = np.dtype([("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])  # px, px, us, 1 = ON
 
 # An event's cause (the optional `events/label` dataset): its value is the index here.
-EVENT_LABELS = ("signal", "shot_noise", "leak", "hot_pixel")
-SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL = range(len(EVENT_LABELS))
+# radiation and glitch: the space environment's (events.space, sensor.radiation).
+EVENT_LABELS = ("signal", "shot_noise", "leak", "hot_pixel", "radiation", "glitch")
+SIGNAL, SHOT_NOISE, LEAK, HOT_PIXEL, RADIATION, GLITCH = range(len(EVENT_LABELS))
 
 MAX_T_US = np.iinfo(np.uint32).max  # events/t's range after t_offset (~71.6 min)
 

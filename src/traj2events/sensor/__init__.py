@@ -8,6 +8,9 @@ Read first (the model):
     pixel          the model of one pixel over one frame interval (crossings, their times),
                    and its two passes over a frame on the CPU
     noise          shot noise (thinning per block of pixels) and hot pixels
+    optics         the lens before the log: point-spread function, vignetting
+    readout        after the pixels: latency, jitter, the readout's rate limit
+    radiation      the space environment's events: particle hits, row and column glitches
 
 Machinery a reader may skip:
     draws          random draws keyed by (seed, interval, pixel, draw): counter-based hashing

@@ -12,6 +12,7 @@ EVENTS = {
     "input": "events.input",
     "sensor": "events.sensor",
     "readout": "events.readout",
+    "space": "events.space",
     "device": "events.device",
     "compression": "compression",  # events.h5's
 }
@@ -19,7 +20,8 @@ EVENTS_PICTURE = {"window_ms": "events.window_ms"}
 # events.exports: each format's file suffix beside events.h5 (events.npz, events.raw, events.aedat4).
 EXPORT_SUFFIX = {"npz": "npz", "evt3": "raw", "aedat4": "aedat4"}
 # The events command's options where a key's own name would say too little.
-EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--readout-mode"}
+EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--readout-mode",
+                "events.space.enabled": "--space"}  # fmt: skip
 
 
 def events_settings(config: dict) -> dict:

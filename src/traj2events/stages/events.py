@@ -20,7 +20,7 @@ import numpy as np
 
 from .. import __version__
 from ..defaults import preset_pixel
-from ..formats.events import EVENT_LABELS, MAX_T_US, EventsWriter, read_events
+from ..formats.events import EVENT_DTYPE, EVENT_LABELS, MAX_T_US, EventsWriter, read_events
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
@@ -30,6 +30,7 @@ from ..sensor.emulator import EmulatorParams, EventEmulator
 from ..sensor.laws import display_dn_per_radiance
 from ..sensor.optics import psf_kernel, through_lens, vignetting
 from ..sensor.photocurrent import SensorParams, dn_per_radiance
+from ..sensor.radiation import SpaceEvents, SpaceParams
 from ..sensor.readout import Readout, ReadoutParams
 from ..trajectory.state import BODY_RATES
 from ..video import iter_video, video_info
@@ -40,6 +41,7 @@ IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
 # a chunk only batches the reading; a 1024^2 float32 chunk of 16 is 64 MB, and 64 (before
 # session 18) cost ~0.2 GB more memory and ~0.4 s of page faults per job for no speed.
 CHUNK_FRAMES = 16
+SENSOR_KIND = "linear radiance as photocurrent (events.sensor)"  # a FrameSource's kind through the sensor
 # Chunks in memory at once: the one being emulated and the next, read meanwhile.
 READ_AHEAD_BUFFERS = 2
 
@@ -133,7 +135,7 @@ def radiance_input(path, attrs, width: int, height: int, sensor: SensorParams | 
     if sensor is not None:
         scene = {**scene, **{f"sensor_{k}": v for k, v in sensor.to_config().items()}}
         lens = _lens(sensor, attrs, width, height) if sensor.has_optics else None
-        return dn_per_radiance(sensor), "linear radiance as photocurrent (events.sensor)", scene, lens
+        return dn_per_radiance(sensor), SENSOR_KIND, scene, lens
     white = white or float(attrs.get("display_white_w_m2_sr", 0) or 0)
     if not white > 0:
         raise ValueError(f"events: {path} has no display_white_w_m2_sr attribute; give --white")
@@ -238,13 +240,14 @@ def emulate(
     readout: ReadoutParams = ReadoutParams(),
     device: str = "cpu",
     compression: str = "blosc",
+    space: SpaceEvents | None = None,
 ) -> tuple[int, int, float]:
     """Emulate the event camera over every chunk of `source` into events.h5 (`preset` and
     `input_name` are recorded in its attributes; with `labels`, each event's cause too;
     `threads`: CPUs to use, the emulator's per-pixel pass split over those the source's
     decoder leaves; `readout`: latency, jitter and rate limit after the pixels; `device`:
-    cpu or cuda, where the pixel model runs; `compression`: events.h5's). Returns (frames,
-    events, time of the last frame in s)."""
+    cpu or cuda, where the pixel model runs; `compression`: events.h5's; `space`: the space
+    environment's events, merged in). Returns (frames, events, time of the last frame in s)."""
     emulator = EventEmulator(
         source.width,
         source.height,
@@ -264,16 +267,25 @@ def emulate(
         "labels": labels,
         "emulator_device": device,
         **{f"readout_{k}": v for k, v in asdict(readout).items()},
+        **{f"space_{k}": v for k, v in asdict(space.params if space else SpaceParams()).items()},
         "traj2events_version": __version__,
         **source.scene,
     }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0
     writer = EventsWriter(output, source.width, source.height, attrs, labels=labels, compression=compression)
     stream = Readout(readout, seed, len(EVENT_LABELS)) if readout.active else None
+    t_start = None  # the current interval's start, s
     try:
         for frames, times in source.chunks:
+            ends = range(len(times)) if t_start is not None else range(1, len(times))
+            t_start = float(times[0]) if t_start is None and len(times) else t_start
             # Memory: one interval's events; as columns, which events.h5 stores.
-            for events, event_labels in emulator.intervals(frames, times, columns=True):
+            for (events, event_labels), end in zip(emulator.intervals(frames, times, columns=True), ends):
+                if space is not None:
+                    due = space.interval(t_start, float(times[end]), frames[end].reshape(-1), source.input_scale,
+                                         emulator.theta_on, emulator.theta_off)  # fmt: skip
+                    events, event_labels = merged(events, event_labels, due)
+                t_start = float(times[end])
                 if stream is not None:
                     events = stream.process(events, event_labels)
                     event_labels = events.get("label")
@@ -289,6 +301,14 @@ def emulate(
             close()
         writer.close(0, (type(exc), exc, exc.__traceback__))
         raise
+    if space is not None:  # what is due by the last frame; later events are not recorded
+        events, event_labels = merged(*_no_events(labels), space.due(int(round(t_last * 1e6))))
+        if stream is not None:
+            events = stream.process(events, event_labels)
+            event_labels = events.get("label")
+        writer.append(events, event_labels)
+        n_events += len(events["t"])
+        writer.annotate({"space_hits": space.hits, "space_glitches": space.glitches})
     if stream is not None:
         events = stream.flush()
         if events is not None:
@@ -365,9 +385,41 @@ def emulate_with_settings(
     (`params` from `pixel_and_sensor`), progress every 10 chunks."""
     preset = settings["preset"]
     log(f"{input_name}: {source.width} x {source.height} {source.kind} -> {output} (preset {preset}, seed {seed})")
+    space = space_events(settings, source, params, seed)
     return emulate(source, params, seed, output, preset, input_name, progress_every=chunk * 10,
                    labels=settings["labels"], threads=threads, readout=ReadoutParams(**settings["readout"]),
-                   device=settings["device"], compression=settings.get("compression", "blosc"))  # fmt: skip
+                   device=settings["device"], compression=settings.get("compression", "blosc"),
+                   space=space)  # fmt: skip
+
+
+def space_events(settings: dict, source: FrameSource, params: EmulatorParams, seed: int) -> SpaceEvents | None:
+    """The space environment's events of settings.events.space, or None where it is off. They
+    need the sensor's photocurrent (frames.h5 through events.sensor): a hit's charge is
+    weighed against the pixel's own current."""
+    space = SpaceParams(**settings.get("space", {}))
+    if not space.enabled:
+        return None
+    if settings["input"] != "sensor" or not source.kind.startswith(SENSOR_KIND):
+        raise ValueError("events.space: the space environment acts on the sensor's photocurrent: frames.h5 with "
+                         f"events.input: sensor, not {source.kind}")  # fmt: skip
+    sensor = SensorParams.from_config(settings["sensor"])
+    return SpaceEvents(space, source.width, source.height, sensor.pixel_pitch_m, sensor.dark_current_a,
+                       params.cutoff_hz, seed)  # fmt: skip
+
+
+def merged(events: dict, labels: np.ndarray | None, due: dict) -> tuple[dict, np.ndarray | None]:
+    """An interval's events and the space environment's due by its end, in time order (the
+    emulator's first among equal times)."""
+    if not len(due["t"]):
+        return events, labels
+    order = np.argsort(np.concatenate([events["t"], due["t"]]), kind="stable")
+    out = {k: np.concatenate([np.asarray(events[k]), due[k].astype(np.asarray(events[k]).dtype)])[order]
+           for k in ("x", "y", "t", "p")}  # fmt: skip
+    return out, (None if labels is None else np.concatenate([labels, due["label"]])[order])
+
+
+def _no_events(labels: bool) -> tuple[dict, np.ndarray | None]:
+    return {k: np.empty(0, EVENT_DTYPE[k]) for k in EVENT_DTYPE.names}, (np.empty(0, np.uint8) if labels else None)
 
 
 def events_command(
