@@ -145,3 +145,42 @@ def test_the_portable_compressions_write_files_plain_h5py_reads(tmp_path, compre
         reading, total, used = line.rsplit(" ", 2)
         assert reading == "any HDF5 reader" and used == filters
         assert float(total) == pytest.approx(float(expected), rel=1e-4)
+
+
+def test_a_damaged_file_is_refused_naming_it_or_reads_back_the_same(tmp_path):
+    """Any byte of a small file flipped: opening and reading it either give exactly what was
+    written (the byte was unused) or a FileFormatError naming the file; never other numbers
+    (object headers carry HDF5's checksums, datasets Fletcher-32, gzip's stream Adler-32).
+    Text attributes are the exception: HDF5 keeps variable-length strings in its global
+    heap, which has no checksum (docs/dataset.md)."""
+    from traj2events.formats.hdf5 import open_file, set_attrs, write_dataset
+
+    rng = np.random.default_rng(5)
+    arrays = {"nodes/t": np.linspace(0, 80, 51), "poses/state": rng.normal(size=(400, 13))}  # gzip beyond 1024
+    with create(tmp_path / "good.h5") as f:
+        set_attrs(f, {"scenario": "braking", "tf_s": 80.0})
+        for name, values in arrays.items():
+            write_dataset(f.require_group(name.split("/")[0]), name.split("/")[1], values)
+    good = (tmp_path / "good.h5").read_bytes()
+
+    def read(path):
+        with open_file(path, "a test file") as f:
+            return dict(f.attrs), {name: f[name][()] for name in arrays}
+
+    attrs, _ = read(tmp_path / "good.h5")
+    outcomes = {"same": 0, "refused": 0}
+    for position in rng.choice(len(good), 300, replace=False):
+        damaged = bytearray(good)
+        damaged[position] ^= 0x5A
+        (tmp_path / "bad.h5").write_bytes(bytes(damaged))
+        try:
+            got_attrs, got = read(tmp_path / "bad.h5")
+        except FileFormatError as exc:
+            assert str(exc).startswith(f"{tmp_path / 'bad.h5'}: ")
+            outcomes["refused"] += 1
+            continue
+        numbers = {k: v for k, v in attrs.items() if not isinstance(v, str)}
+        assert {k: got_attrs[k] for k in numbers} == numbers, position
+        assert all(np.array_equal(got[k], v) for k, v in arrays.items()), position
+        outcomes["same"] += 1
+    assert outcomes["refused"] > 100 and outcomes["same"] > 10

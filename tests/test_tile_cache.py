@@ -42,7 +42,7 @@ def test_tiles_read_back_are_the_tiles_built(tmp_path):
         for name in ("vertices", "normals", "lit", "heights_m"):
             assert np.array_equal(getattr(a, name), getattr(b, name)), (key, name)
     identity = json.loads((second.disk.folder / "identity.json").read_text())
-    assert identity["terrain"]["procedural"]["seed"] == 1 and identity["format"] == 1
+    assert identity["terrain"]["procedural"]["seed"] == 1 and identity["format"] == 2
 
 
 def test_another_terrain_or_sun_side_has_its_own_folder(tmp_path):
@@ -89,9 +89,16 @@ def test_a_damaged_tile_is_rebuilt_and_a_failed_write_is_harmless(tmp_path):
     first, keys = tiles(tmp_path)
     damaged = first.disk.path(keys[0])
     damaged.write_bytes(damaged.read_bytes()[:100])  # a truncated file
+    flipped = first.disk.path(keys[1])  # the right size and shape, one bit of a height flipped
+    data = bytearray(flipped.read_bytes())
+    data[len(data) // 2] ^= 0x10
+    flipped.write_bytes(bytes(data))
     second, _ = tiles(tmp_path)
-    assert second.n_evaluated == 1
-    assert np.array_equal(second.tile(keys[0]).heights_m, first.tile(keys[0]).heights_m)
+    assert second.n_evaluated == 2  # both rebuilt, and written again
+    for key in keys[:2]:
+        assert np.array_equal(second.tile(key).heights_m, first.tile(key).heights_m)
+    third, _ = tiles(tmp_path)
+    assert third.n_evaluated == 0
     cache = TileCache(tmp_path / "x", {"a": 1})
     (cache.folder / "9").write_text("a file where the level's folder should be")
     cache.save((9, 0, 0), np.zeros((3, 3)))
@@ -118,10 +125,10 @@ def test_a_killed_writers_temporary_files_go_with_the_next_job(tmp_path):
     host = tile_cache._WRITER.partition("@")[2]
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
     names = {
-        "killed here": f".0_0.npy.{int(dead.stdout)}@{host}.abc123.part",
-        "alive here": f".0_1.npy.{os.getpid()}@{host}.abc123.part",
-        "other host, fresh": ".1_0.npy.99@elsewhere.abc123.part",
-        "other host, two days old": ".1_1.npy.99@elsewhere.abc123.part",
+        "killed here": f".0_0.npz.{int(dead.stdout)}@{host}.abc123.part",
+        "alive here": f".0_1.npz.{os.getpid()}@{host}.abc123.part",
+        "other host, fresh": ".1_0.npz.99@elsewhere.abc123.part",
+        "other host, two days old": ".1_1.npz.99@elsewhere.abc123.part",
     }
     for name in names.values():
         (cache.folder / "3").mkdir(exist_ok=True)

@@ -80,10 +80,12 @@ def mark_compression(f: h5py.File, compression: str) -> None:
 
 
 def write_dataset(group: h5py.Group, name: str, data: np.ndarray) -> None:
-    """A dataset, gzip-4 + shuffle when larger than 1024 values."""
+    """A dataset, gzip-4 + shuffle when larger than 1024 values, with HDF5's Fletcher-32
+    checksum (a reader then tells damaged values from good ones) unless it is a scalar."""
     data = np.asarray(data)
     kwargs = {"compression": "gzip", "compression_opts": 4, "shuffle": True} if data.size > 1024 else {}
-    group.create_dataset(name, data=data, track_times=False, **kwargs)
+    checksum = {"fletcher32": True} if data.ndim and data.size else {}
+    group.create_dataset(name, data=data, track_times=False, **kwargs, **checksum)
 
 
 def set_attrs(obj: h5py.HLObject, attrs: dict) -> None:
@@ -122,9 +124,49 @@ def open_for_reading(path: str | os.PathLike, expected: str) -> h5py.File:
     if not Path(path).is_file():
         raise FileNotFoundError(f"{path}: no such file (expected {expected})")
     try:
-        return h5py.File(path, "r")
+        f = h5py.File(path, "r")
     except OSError as exc:
         raise FileFormatError(f"{path}: not a readable HDF5 file (expected {expected}): {exc}") from None
+    try:
+        read_all_metadata(f)
+    except (OSError, RuntimeError, KeyError) as exc:
+        f.close()
+        raise FileFormatError(f"{path}: damaged HDF5 file (expected {expected}): {first_line(exc)}") from None
+    return f
+
+
+def read_all_metadata(f: h5py.File) -> None:
+    """Read every object's header and attributes: HDF5 checks their checksums (the files are
+    written with libver v110), so damaged metadata is found at opening, not midway."""
+
+    def attributes(_name, obj):
+        for key in obj.attrs:
+            obj.attrs[key]
+
+    attributes("", f)
+    f.visititems(attributes)
+
+
+def first_line(exc: BaseException) -> str:
+    text = str(exc.args[0] if exc.args else exc)
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
+def is_damage(exc: BaseException) -> bool:
+    """An error HDF5 raises on damaged contents (a failed checksum, a filter that cannot
+    decode a chunk), not on a full disk or a missing file."""
+    text = str(exc)
+    return isinstance(exc, (OSError, RuntimeError)) and any(
+        marker in text
+        for marker in (
+            "checksum",
+            "Data error",
+            "Can't read data",
+            "filter returned failure",
+            "Can't synchronously read data",
+            "Unable to synchronously",
+        )  # fmt: skip
+    )
 
 
 @contextlib.contextmanager
@@ -136,6 +178,10 @@ def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
         yield f
     except KeyError as exc:
         raise FileFormatError(f"{path}: {exc.args[0] if exc.args else exc} (expected {expected})") from None
+    except (OSError, RuntimeError) as exc:
+        if not is_damage(exc):
+            raise
+        raise FileFormatError(f"{path}: damaged HDF5 file (expected {expected}): {first_line(exc)}") from None
     finally:
         f.close()
 

@@ -17,13 +17,14 @@ their shadow marches. It is stored whole, in a folder of its own keyed by the he
 identity plus what the shading adds: the exact Sun direction, the Moon's radius, where
 the quadtree ends (`min_spacing_m`), the levels and the tile and illumination code.
 
-One .npy per tile, `{folder}/{level}/{i}_{j}.npy`, written to a temporary name and
+One .npz per tile, `{folder}/{level}/{i}_{j}.npz` (its array as `data`: a zip member with
+its CRC-32, so that a damaged tile is told from a good one), written to a temporary name and
 renamed: concurrent jobs (a cluster's, on a shared file system) never read half a tile,
 and two writing the same tile write the same bytes. A temporary name carries its
 writer's process id and host: a job opening the cache removes those its host's killed
 jobs left (and any older than a day), so a SIGKILL leaves no debris past the next job.
-A file that cannot be read or has the wrong shape is rebuilt; a write that fails (a full
-disk) only leaves the tile uncached. The folder can be deleted at any time.
+A file that cannot be read, fails its CRC or has the wrong shape is rebuilt (and written
+again); a write that fails (a full disk) only leaves the tile uncached. The folder can be deleted at any time.
 """
 
 from __future__ import annotations
@@ -35,11 +36,12 @@ import os
 import socket
 import tempfile
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
 
-FORMAT = 1  # bumped when the stored arrays change meaning
+FORMAT = 2  # bumped when the stored arrays change meaning or form (2: .npz with a CRC)
 STALE_S = 86400.0  # a temporary file older than this is a killed job's, whoever wrote it
 _WRITER = f"{os.getpid()}@{socket.gethostname().replace('.', '-')}"
 
@@ -57,13 +59,15 @@ class TileCache:
 
     def path(self, key: tuple[int, int, int]) -> Path:
         level, i, j = key
-        return self.folder / str(level) / f"{i}_{j}.npy"
+        return self.folder / str(level) / f"{i}_{j}.npz"
 
     def load(self, key: tuple[int, int, int], shape: tuple[int, ...], dtype=np.float64) -> np.ndarray | None:
-        """The tile's stored array, or None (not stored, unreadable, or not `shape` and `dtype`)."""
+        """The tile's stored array, or None (not stored, unreadable, damaged: its CRC-32 fails,
+        or not `shape` and `dtype`): the caller builds it and saves it again."""
         try:
-            array = np.load(self.path(key), allow_pickle=False)
-        except (OSError, ValueError):
+            with np.load(self.path(key), allow_pickle=False) as stored:
+                array = stored["data"]
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
             return None
         if array.shape != shape or array.dtype != dtype:
             return None
@@ -71,7 +75,7 @@ class TileCache:
         return array
 
     def save(self, key: tuple[int, int, int], array: np.ndarray) -> None:
-        if self._write(self.path(key), lambda f: np.save(f, array, allow_pickle=False)):
+        if self._write(self.path(key), lambda f: np.savez(f, data=array)):
             self.n_written += 1
 
     @staticmethod
