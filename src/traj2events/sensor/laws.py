@@ -67,6 +67,7 @@ refractory_allows = njit(inline="always")(_refractory_allows)
 _log_response_ufunc = vectorize([float32(float32), float64(float64)], cache=True)(_log_response)
 _lowpass_gain_ufunc = vectorize([float64(float64, float64, float64)], cache=True)(_lowpass_gain)
 shot_noise_gain = vectorize([float64(float64)], cache=True)(_shot_noise_gain)
+bandwidth_hz = vectorize([float64(float64, float64)], cache=True)(_bandwidth_hz)  # Hz at each intensity
 
 
 def log_intensity_8bit(frame_dn: np.ndarray, dtype=np.float64) -> np.ndarray:

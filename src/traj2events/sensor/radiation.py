@@ -42,7 +42,7 @@ import numpy as np
 from scipy import special
 
 from ..formats.events import EVENT_DTYPE, GLITCH, RADIATION
-from .laws import BANDWIDTH_OFFSET_DN, bandwidth_hz_scalar
+from .laws import BANDWIDTH_OFFSET_DN, bandwidth_hz, bandwidth_hz_scalar
 
 ELEMENTARY_CHARGE_C = 1.602176634e-19
 E_PAIRS_PER_UM = 80.0  # a minimum-ionising particle in silicon (most probable loss ~0.29 keV/um, 3.6 eV a pair)
@@ -90,12 +90,9 @@ def recovery_times_s(charge_ratio: float, levels: np.ndarray, tau_s: float) -> n
 def reference_charge_c(intensity_dn: np.ndarray, dark_current_a: float, cutoff_hz: float) -> np.ndarray:
     """Q_ref = I tau of pixels at `intensity_dn` (the emulator's sensor units: 20 DN is one
     dark current, the bandwidth law's offset the dark current itself)."""
+    intensity_dn = np.asarray(intensity_dn, dtype=np.float64)
     current_a = (intensity_dn + BANDWIDTH_OFFSET_DN) * dark_current_a / BANDWIDTH_OFFSET_DN
     return current_a / (2 * np.pi * bandwidth_hz(intensity_dn, cutoff_hz))
-
-
-def bandwidth_hz(intensity_dn: np.ndarray, cutoff_hz: float) -> np.ndarray:
-    return np.array([bandwidth_hz_scalar(float(x), cutoff_hz) for x in np.atleast_1d(intensity_dn)])
 
 
 def draw_hits(rng: np.random.Generator, flux_cm2_s: float, width: int, height: int, pitch_m: float, dt_s: float):
@@ -116,8 +113,8 @@ def draw_hits(rng: np.random.Generator, flux_cm2_s: float, width: int, height: i
 def track_charges(
     x: float, y: float, cos_theta: float, azimuth: float, charge_number: int, params: SpaceParams, pitch_um: float,
     width: int, height: int,
-) -> dict[int, float]:  # fmt: skip
-    """Electrons each pixel (index y W + x) collects from one particle's track."""
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(pixels (index y W + x), electrons each collects) of one particle's track."""
     depth = params.sensitive_depth_um
     total_e = E_PAIRS_PER_UM * charge_number**2 * depth / max(cos_theta, 1e-3)
     length_px = min(depth * math.sqrt(max(1.0 - cos_theta**2, 0.0)) / max(cos_theta, 1e-3) / pitch_um,
@@ -126,25 +123,17 @@ def track_charges(
     along = (np.arange(steps) + 0.5) / steps * length_px
     xs, ys = x + along * math.cos(azimuth), y + along * math.sin(azimuth)
     sigma_px = params.charge_diffusion_um / pitch_um
-    reach = int(math.ceil(4 * sigma_px))
-    charges: dict[int, float] = {}
-    for px, py in zip(xs, ys):
-        ix, iy = int(math.floor(px)), int(math.floor(py))
-        cols = np.arange(ix - reach, ix + reach + 1)
-        rows = np.arange(iy - reach, iy + reach + 1)
-        wx = _cell_shares(px, cols, sigma_px)
-        wy = _cell_shares(py, rows, sigma_px)
-        for row, w_row in zip(rows, wy):
-            if not 0 <= row < height or w_row < 1e-9:
-                continue
-            for col, w in zip(cols, wx * w_row):
-                if 0 <= col < width and w > 1e-9:
-                    key = int(row) * width + int(col)
-                    charges[key] = charges.get(key, 0.0) + total_e / steps * w
-    return charges
+    offsets = np.arange(-math.ceil(4 * sigma_px), math.ceil(4 * sigma_px) + 1)
+    cols, rows = np.floor(xs)[:, None] + offsets, np.floor(ys)[:, None] + offsets  # (steps, cells)
+    share = _cell_shares(ys[:, None], rows, sigma_px)[:, :, None] * _cell_shares(xs[:, None], cols, sigma_px)[:, None]
+    inside = ((rows >= 0) & (rows < height))[:, :, None] & ((cols >= 0) & (cols < width))[:, None, :]
+    keep = inside & (share > 1e-9)
+    pixels = (rows[:, :, None] * width + cols[:, None, :])[keep].astype(np.int64)
+    unique, slot = np.unique(pixels, return_inverse=True)
+    return unique, np.bincount(slot, weights=share[keep]) * (total_e / steps)
 
 
-def _cell_shares(centre: float, cells: np.ndarray, sigma: float) -> np.ndarray:
+def _cell_shares(centre, cells: np.ndarray, sigma: float) -> np.ndarray:
     """A Gaussian's share in each unit cell [c, c + 1) along one axis."""
     scale = sigma * math.sqrt(2.0)
     return 0.5 * (special.erf((cells + 1 - centre) / scale) - special.erf((cells - centre) / scale))
@@ -202,17 +191,17 @@ class SpaceEvents:
 
     def _burst(self, t_hit_s, hit, intensity, thresholds, pix, t_s, on, label) -> None:
         x, y, cos_theta, azimuth, z = hit
-        charges = track_charges(x, y, cos_theta, azimuth, int(z), self.params, self.pitch_m * 1e6, self.width,
-                                self.height)  # fmt: skip
-        for i, electrons in charges.items():
-            x_dn = float(intensity[0][i]) * intensity[1]
-            ratio = electrons * ELEMENTARY_CHARGE_C / float(reference_charge_c(x_dn, self.dark_current_a,
-                                                                                self.cutoff_hz)[0])  # fmt: skip
-            n_on, levels = burst_levels(ratio, float(thresholds[0][i]), float(thresholds[1][i]))
-            if not n_on:
-                continue
-            tau_s = 1.0 / (2 * np.pi * bandwidth_hz_scalar(x_dn, self.cutoff_hz))
-            times = np.concatenate([np.zeros(n_on), recovery_times_s(ratio, levels, tau_s)])
+        pixels, charges = track_charges(x, y, cos_theta, azimuth, int(z), self.params, self.pitch_m * 1e6,
+                                        self.width, self.height)  # fmt: skip
+        x_dn = intensity[0][pixels].astype(np.float64) * intensity[1]
+        ratios = charges * ELEMENTARY_CHARGE_C / reference_charge_c(x_dn, self.dark_current_a, self.cutoff_hz)
+        theta_on, theta_off = thresholds[0][pixels], thresholds[1][pixels]
+        fires = np.log1p(ratios) >= theta_on  # at least one ON event: the others are left at once
+        for i, x_i, ratio, on_i, off_i in zip(pixels[fires], x_dn[fires], ratios[fires], theta_on[fires],
+                                              theta_off[fires]):  # fmt: skip
+            n_on, levels = burst_levels(float(ratio), float(on_i), float(off_i))
+            tau_s = 1.0 / (2 * np.pi * bandwidth_hz_scalar(float(x_i), self.cutoff_hz))
+            times = np.concatenate([np.zeros(n_on), recovery_times_s(float(ratio), levels, tau_s)])
             pix.append(np.full(len(times), i))
             t_s.append(t_hit_s + times)
             on.append(np.arange(len(times)) < n_on)
