@@ -240,8 +240,23 @@ def test_a_lens_blur_spreads_a_step_edges_events_over_its_width(tmp_path):
     with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
         for f in ramp_frames():
             video.write(f)
-    with pytest.raises(ValueError, match="acts on linear radiance"):
+    with pytest.raises(ValueError, match=r"lens \(events.sensor vignetting: true\) acts on linear radiance"):
         frame_source(tmp_path / "in.mkv", sensor=SensorParams.from_config({**sensor, "vignetting": True}))
+
+
+def test_a_sensor_preset_on_a_video_says_how_to_go_without_its_lens(tmp_path, capsys):
+    from traj2events.cli import main
+
+    with VideoWriter(tmp_path / "in.mkv", 16, 12, 50.0) as video:
+        for f in ramp_frames():
+            video.write(f)
+    args = ["events", str(tmp_path / "in.mkv"), "-o", str(tmp_path / "e.h5"), "--preset", "imx636"]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "psf_diffraction: true, vignetting: true) acts on linear radiance" in err and "--no-vignetting" in err
+    assert main([*args, "--no-psf-diffraction", "--no-vignetting"]) == 0  # the preset's pixel, without the lens
+    events, attrs = read_events(tmp_path / "e.h5")
+    assert len(events) > 0 and attrs["preset"] == "imx636" and attrs["emulator_theta_on"] == 0.2231
 
 
 def test_the_readout_delays_and_drops_in_the_events_command(tmp_path):

@@ -209,8 +209,12 @@ def frame_source(
         raise ValueError(f"events: chunk: expected >= 1 frames, got {chunk}")
     radiance = path.suffix.lower() in (".h5", ".hdf5")
     if sensor is not None and sensor.has_optics and not radiance:
-        raise ValueError(f"events: the lens (events.sensor psf_diffraction, lens_blur_um, vignetting) acts on linear "
-                         f"radiance: frames.h5, not {path}")  # fmt: skip
+        on = {"psf_diffraction": sensor.psf_diffraction, "lens_blur_um": sensor.lens_blur_um,
+              "vignetting": sensor.vignetting}  # fmt: skip
+        keys = ", ".join(f"{k}: {str(v).lower()}" for k, v in on.items() if v)
+        raise ValueError(f"events: the lens (events.sensor {keys}) acts on linear radiance: frames.h5, not {path}; "
+                         "for a video or images, turn it off (--no-psf-diffraction --lens-blur-um 0 --no-vignetting; "
+                         "the sensor presets imx636 and davis346 turn it on)")  # fmt: skip
     if path.is_dir():
         return image_folder_source(path, fps, chunk)
     if radiance:
