@@ -14,7 +14,6 @@ import yaml
 
 DEFAULTS_PATH = Path(__file__).with_name("defaults.yaml")
 PRESETS_DIR = Path(__file__).with_name("presets")
-PRESET_SECTIONS = ("pixel", "sensor", "readout")  # the sections of `events` a preset may give
 
 
 @functools.cache

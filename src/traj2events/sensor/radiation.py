@@ -51,6 +51,8 @@ E_PAIRS_PER_UM = 80.0  # a minimum-ionising particle in silicon (most probable l
 GCR_SPECIES = ((1, 0.87), (2, 0.12), (8, 0.009), (26, 0.001))
 STEPS_PER_PIXEL = 8  # the track's walk
 SPACE_STREAM = 0x5A0E  # the draws' own stream of the seed
+# `SpaceEvents.due` with nothing pending (most intervals): no events, and no work.
+NOTHING_DUE = {**{k: np.empty(0, EVENT_DTYPE[k]) for k in EVENT_DTYPE.names}, "label": np.empty(0, np.uint8)}
 
 
 @dataclass(frozen=True)
@@ -141,7 +143,7 @@ def _cell_shares(centre, cells: np.ndarray, sigma: float) -> np.ndarray:
 
 class SpaceEvents:
     """The space environment's events of one recording, interval by interval: `interval`
-    returns those due by the interval's end (sorted by t), `flush` those due by the end."""
+    returns those due by the interval's end (sorted by t), `due` those due by a time."""
 
     def __init__(
         self, params: SpaceParams, width: int, height: int, pixel_pitch_m: float, dark_current_a: float,
@@ -150,13 +152,12 @@ class SpaceEvents:
         if params.particle_flux_cm2_s > 0 and not cutoff_hz > 0:
             raise ValueError("events.space: particle hits need events.pixel.cutoff_hz > 0 (the photoreceptor's "
                              "bandwidth sets a pixel's answer to a hit)")  # fmt: skip
-        self.params, self.width, self.height, self.seed = params, width, height, seed
+        self.params, self.width, self.height = params, width, height
         self.pitch_m, self.dark_current_a, self.cutoff_hz = pixel_pitch_m, dark_current_a, cutoff_hz
         self._rng = np.random.Generator(np.random.PCG64([seed, SPACE_STREAM]))  # drawn interval by interval
         self._pending = _columns(np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, bool), np.empty(0, np.uint8))
         self.hits = 0
         self.glitches = 0
-        self._empty: dict[str, np.ndarray] | None = None  # what `due` returns when nothing is pending
 
     def interval(
         self, t0_s: float, t1_s: float, frame: np.ndarray, input_scale: float, theta_on: np.ndarray,
@@ -210,18 +211,15 @@ class SpaceEvents:
     def due(self, t_us: int) -> dict[str, np.ndarray]:
         """The pending events at or before t_us as x, y, t, p, label columns, sorted by
         (t, y, x, p); the rest stay pending."""
-        if not len(self._pending["t"]) and self._empty is not None:
-            return self._empty
+        if not len(self._pending["t"]):
+            return NOTHING_DUE
         now = self._pending["t"] <= t_us
         out = {k: v[now] for k, v in self._pending.items()}
         self._pending = {k: v[~now] for k, v in self._pending.items()}
         y, x = np.divmod(out["pix"], self.width)
         order = np.lexsort((out["p"], x, y, out["t"]))
         columns = {"x": x, "y": y, "t": out["t"], "p": out["p"]}
-        due = {**{k: v[order].astype(EVENT_DTYPE[k]) for k, v in columns.items()}, "label": out["label"][order]}
-        if not len(due["t"]):
-            self._empty = due
-        return due
+        return {**{k: v[order].astype(EVENT_DTYPE[k]) for k, v in columns.items()}, "label": out["label"][order]}
 
 
 def _columns(pix: np.ndarray, t_us: np.ndarray, on: np.ndarray, label: np.ndarray) -> dict[str, np.ndarray]:

@@ -279,6 +279,16 @@ def emulate(
     writer = EventsWriter(output, source.width, source.height, attrs, labels=labels, compression=compression)
     stream = Readout(readout, seed, len(EVENT_LABELS)) if readout.active else None
     t_start = None  # the current interval's start, s
+
+    def write(events: dict, event_labels: np.ndarray | None) -> None:
+        """Events sorted by crossing time through the readout (where there is one) into events.h5."""
+        nonlocal n_events
+        if stream is not None:
+            events = stream.process(events, event_labels)
+            event_labels = events.get("label")
+        writer.append(events, event_labels)
+        n_events += len(events["t"])
+
     try:
         for frames, times in source.chunks:
             ends = range(len(times)) if t_start is not None else range(1, len(times))
@@ -290,11 +300,7 @@ def emulate(
                                          emulator.theta_on, emulator.theta_off)  # fmt: skip
                     events, event_labels = merged(events, event_labels, due)
                 t_start = float(times[end])
-                if stream is not None:
-                    events = stream.process(events, event_labels)
-                    event_labels = events.get("label")
-                writer.append(events, event_labels)
-                n_events += len(events["t"])
+                write(events, event_labels)
             n_frames += len(frames)
             t_last = float(times[-1])
             if n_frames % progress_every < len(frames):
@@ -306,12 +312,8 @@ def emulate(
         writer.close(0, (type(exc), exc, exc.__traceback__))
         raise
     if space is not None:  # what is due by the last frame; later events are not recorded
-        events, event_labels = merged(*_no_events(labels), space.due(int(round(t_last * 1e6))))
-        if stream is not None:
-            events = stream.process(events, event_labels)
-            event_labels = events.get("label")
-        writer.append(events, event_labels)
-        n_events += len(events["t"])
+        due = space.due(int(round(t_last * 1e6)))
+        write({k: due[k] for k in EVENT_DTYPE.names}, due["label"] if labels else None)
         writer.annotate({"space_hits": space.hits, "space_glitches": space.glitches})
     if stream is not None:
         events = stream.flush()
@@ -403,7 +405,7 @@ def space_events(settings: dict, source: FrameSource, params: EmulatorParams, se
     space = SpaceParams(**settings.get("space", {}))
     if not space.enabled:
         return None
-    if settings["input"] != "sensor" or not source.kind.startswith(SENSOR_KIND):
+    if not source.kind.startswith(SENSOR_KIND):  # frames.h5 through the sensor (events.input: sensor) only
         raise ValueError("events.space: the space environment acts on the sensor's photocurrent: frames.h5 with "
                          f"events.input: sensor, not {source.kind}")  # fmt: skip
     sensor = SensorParams.from_config(settings["sensor"])
@@ -420,10 +422,6 @@ def merged(events: dict, labels: np.ndarray | None, due: dict) -> tuple[dict, np
     out = {k: np.concatenate([np.asarray(events[k]), due[k].astype(np.asarray(events[k]).dtype)])[order]
            for k in ("x", "y", "t", "p")}  # fmt: skip
     return out, (None if labels is None else np.concatenate([labels, due["label"]])[order])
-
-
-def _no_events(labels: bool) -> tuple[dict, np.ndarray | None]:
-    return {k: np.empty(0, EVENT_DTYPE[k]) for k in EVENT_DTYPE.names}, (np.empty(0, np.uint8) if labels else None)
 
 
 def events_command(
