@@ -60,6 +60,22 @@ def test_vignetting_is_cos4_of_the_field_angle():
     assert big[25, 50] == 1.0 and big[0, 0] == pytest.approx(np.cos(np.arctan(np.hypot(50, 25) / 100)) ** 4)
 
 
+def test_vignetting_through_a_distorting_lens_follows_the_ray_the_pixel_sees():
+    """Barrel distortion brings a wider field onto the corner pixel: its falloff is cos^4
+    of the angle of the ray OpenCV undistorts it to (larger than the pinhole's)."""
+    import cv2
+
+    from traj2events.geometry.distortion import Distortion
+
+    lens = Distortion(k1=-0.3, k2=0.05)
+    falloff = vignetting(101, 51, 100.0, lens)
+    matrix = np.array([[100.0, 0, 50], [0, 100.0, 25], [0, 0, 1]])
+    ray = cv2.undistortPoints(np.array([[[0.0, 0.0]]]), matrix, lens.coefficients,
+                              criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15))[0, 0]  # fmt: skip
+    assert falloff[0, 0] == pytest.approx(np.cos(np.arctan(np.hypot(*ray))) ** 4, rel=1e-7)
+    assert falloff[0, 0] < vignetting(101, 51, 100.0)[0, 0] and falloff[25, 50] == 1.0
+
+
 def test_the_lens_keeps_flux_and_spreads_a_point_as_its_kernel():
     kernel = psf_kernel(PITCH, 2.0, (4e-7, 7e-7), True, 3.0)
     flat = np.full((1, 20, 30), 7.0, np.float32)

@@ -25,7 +25,7 @@ def events(*argv):
 
 def test_defaults_are_the_defaults_files():
     d = with_preset(default_config())
-    assert field() == {**{k: d["camera"][k] for k in ("width", "height", "fov_deg", "mount_height_m")},
+    assert field() == {**{k: d["camera"][k] for k in ("width", "height", "fov_deg", "mount_height_m", "distortion")},
                        **{k: d["motion_field"][k] for k in ("moon_radius_m", "every_n_frames")},
                        "compression": "blosc"}  # fmt: skip
     e = events()

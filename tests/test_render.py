@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 
 from traj2events.geometry.camera import Camera, CameraPose, camera_pose
+from traj2events.geometry.distortion import PINHOLE, Distortion
 from traj2events.renderer import draw as render_module
 from traj2events.renderer.context import check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
 from traj2events.renderer.draw import TerrainRenderer
+from traj2events.renderer.lens import lens_renderer
 from traj2events.scene.earthshine import Earth
 from traj2events.scene.reflectance import ReflectanceParams, angles, bihemispherical_albedo, radiance_factor
 from traj2events.scene.sun import Sun
@@ -52,7 +54,7 @@ def render(
     scattered_azimuths=16,
 ):
     tiles = TileSet(terrain, sun.direction, radius, half_extent, lod, scattered_azimuths=scattered_azimuths)
-    with TerrainRenderer(tiles, camera, sun, reflectance, backend="osmesa") as renderer:
+    with lens_renderer(tiles, camera, sun, reflectance, backend="osmesa") as renderer:
         return renderer.render(pose), tiles
 
 
@@ -111,6 +113,7 @@ from traj2events.geometry.camera import Camera, camera_pose
 from traj2events.scene.sun import Sun
 from traj2events.scene.reflectance import ReflectanceParams
 from traj2events.renderer.draw import TerrainRenderer
+from traj2events.renderer.lens import lens_renderer
 from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
 from traj2events.scene.tiles import TileSet
 sun = Sun(1.496e11, 105.0, 7.0)
@@ -158,11 +161,14 @@ def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch, lod):
     assert np.array_equal(grown.radiance, reference.radiance) and np.array_equal(grown.depth_m, reference.depth_m)
 
 
-def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
-    camera = Camera(48, 48, 45.0)
+@pytest.mark.parametrize("distortion", [PINHOLE, Distortion(k1=-0.3, k2=0.08, p1=0.002)], ids=["pinhole", "lens"])
+def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km(distortion):
+    """Through a distorting lens, each pixel's depth is the mesh's along that pixel's own
+    ray (the pinhole cover's depth resampled in inverse depth)."""
+    camera = Camera(48, 48, 45.0, distortion=distortion)
     pose = camera_pose(state(x=-3000.0, altitude=5000.0, pitch=20.0, roll=3.0, yaw=10.0))
     frame, tiles = render(ProceduralTerrain(TerrainParams(seed=11)), camera, pose)
-    keys = tiles.select(pose, camera)
+    keys = tiles.select(pose, camera.pinhole_cover())
     triangles = np.concatenate([tiles.tile(k).vertices[tiles.tile(k).faces] + tiles.tile(k).centre for k in keys])
     rows, cols = np.meshgrid(np.arange(3, 48, 9), np.arange(3, 48, 9), indexing="ij")
     x_s, y_s = cols.ravel() + 0.5 - 24, rows.ravel() + 0.5 - 24
@@ -184,15 +190,21 @@ def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km():
     np.testing.assert_allclose(depth_render, depth_cast, rtol=1e-3)
 
 
-def test_a_crater_centre_appears_where_the_camera_model_puts_it():
+@pytest.mark.parametrize(
+    "distortion, centre",
+    [(PINHOLE, (150.0, 220.0)), (Distortion(k1=0.6, k2=0.1, p2=-0.003), (-100.0, 50.0))],
+    ids=["pinhole", "lens"],
+)
+def test_a_crater_centre_appears_where_the_camera_model_puts_it(distortion, centre):
+    """Through a lens, near the image's corner where it moves the crater 4.5 px from where
+    a pinhole would show it."""
     spacing = 1.0
     x = np.arange(-600.0, 600.0 + spacing / 2, spacing)
     xx, yy = np.meshgrid(x, x, indexing="ij")
-    centre = (150.0, 220.0)
     rho = np.hypot(xx - centre[0], yy - centre[1]) / 40.0
     crater = GridTerrain(fresh_crater_profile(rho, 16.0, 2.0), spacing, (x[0], x[0]))
     flat = GridTerrain(np.zeros_like(xx), spacing, (x[0], x[0]))
-    camera = Camera(128, 128, 45.0)
+    camera = Camera(128, 128, 45.0, distortion=distortion)
     pose = camera_pose(state(x=-300.0, y=100.0, altitude=900.0, pitch=25.0, roll=-8.0, yaw=15.0))
     with_crater, _ = render(crater, camera, pose, half_extent=20e3)
     without, _ = render(flat, camera, pose, half_extent=20e3)
@@ -205,6 +217,9 @@ def test_a_crater_centre_appears_where_the_camera_model_puts_it():
     predicted = camera.to_pixel_index(camera.project(pose.to_camera(floor)))
     assert np.all((predicted > 20) & (predicted < 108))  # well inside the image
     np.testing.assert_allclose(seen, predicted, atol=0.5)
+    pinhole = Camera(128, 128, 45.0)
+    where_a_pinhole_shows_it = pinhole.to_pixel_index(pinhole.project(pose.to_camera(floor)))
+    assert distortion.is_pinhole or np.abs(where_a_pinhole_shows_it - seen).max() > 2
 
 
 SHADINGS = {

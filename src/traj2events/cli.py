@@ -33,7 +33,7 @@ def _settings(kind, value: str):
 def _camera(settings: dict):
     from .geometry.camera import Camera
 
-    return Camera(settings["width"], settings["height"], settings["fov_deg"], settings["mount_height_m"])
+    return Camera.from_settings(settings)
 
 
 def cmd_check_config(args) -> int:

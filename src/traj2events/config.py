@@ -202,10 +202,27 @@ def _semantic_errors(config: dict) -> list[str]:
     if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
-    errors += _display_errors(config)
+    errors += _display_errors(config) + _lens_errors(config["camera"])
     for name, sc in config["scenarios"].items():
         errors += _scenario_errors(config, name, sc)
     return errors or _elevation_grid_error(terrain)
+
+
+def _lens_errors(camera: dict) -> list[str]:
+    """A distortion whose model folds over inside the image, or needs a pinhole image more
+    than 4x the sensor's to cover it (Camera.pinhole_cover), before any job starts."""
+    from .geometry.camera import Camera
+    from .geometry.distortion import distortion_from
+
+    distortion = distortion_from(camera["distortion"])
+    if distortion.is_pinhole:
+        return []
+    try:
+        size = (camera["width"], camera["height"], camera["fov_deg"], camera["mount_height_m"])
+        Camera(*size, distortion).pinhole_cover()
+    except ValueError as exc:
+        return [f"config key '{exc}".replace(":", "':", 1)]
+    return []
 
 
 def _timing_errors(timing: dict) -> list[str]:

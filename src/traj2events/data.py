@@ -58,6 +58,12 @@ class Landing:
         return np.asarray(self._scene_attrs()["camera_matrix_px"])
 
     @property
+    def distortion_coefficients(self) -> np.ndarray:
+        """(k1, k2, p1, p2, k3): the lens's distortion, OpenCV's distCoeffs (zeros: a
+        pinhole; files written before it: zeros), from events.h5 (or frames.h5)."""
+        return np.asarray(self._scene_attrs().get("distortion_coefficients", np.zeros(5)), dtype=float)
+
+    @property
     def image_size(self) -> tuple[int, int]:
         """(width, height) in px, from events.h5 (or frames.h5)."""
         attrs = self._scene_attrs()

@@ -20,6 +20,7 @@ from typing import Iterator
 
 import numpy as np
 
+from ..geometry.distortion import Distortion
 from .atomic import atomic_output, ensure_free_space
 from .hdf5 import (
     Attributes,
@@ -36,11 +37,15 @@ from .hdf5 import (
 )
 
 
-def central_ray(height: int, width: int, focal_px: float) -> tuple[int, int, float]:
+def central_ray(height: int, width: int, focal_px: float, attrs=None) -> tuple[int, int, float]:
     """The range meter's pixel (row H/2, column W/2: half a pixel off the boresight for even
-    sizes) and its ray's length per unit depth along the boresight."""
+    sizes) and its ray's length per unit depth along the boresight, through the lens's
+    distortion where `attrs` (frames.h5's) give one."""
     i, j = height // 2, width // 2
     across, down = (j + 0.5 - width / 2) / focal_px, (i + 0.5 - height / 2) / focal_px
+    lens = Distortion(*(attrs or {}).get("distortion_coefficients", ()))
+    if not lens.is_pinhole:
+        across, down = (float(c) for c in lens.undistort(across, down))
     return i, j, float(np.sqrt(1.0 + across**2 + down**2))
 
 
@@ -90,7 +95,7 @@ class FramesWriter:
         self._frame_index: list[int] = []
         # The range meter, taken from each depth as it is written (read back it would cost
         # decompressing every frame): only where the camera's focal length is known.
-        self._ray = central_ray(height, width, float(attrs["focal_px"])) if "focal_px" in attrs else None
+        self._ray = central_ray(height, width, float(attrs["focal_px"]), attrs) if "focal_px" in attrs else None
         self._slant_range: list[float] = []
         self._sets = {
             name: self._file.create_dataset(
@@ -212,7 +217,7 @@ class FramesFile:
         without it) from the stored depth, the same values."""
         if "slant_range_m" in self._file:
             return self._file["slant_range_m"][()]
-        i, j, ray = central_ray(*self.shape[1:], float(self.attrs["focal_px"]))
+        i, j, ray = central_ray(*self.shape[1:], float(self.attrs["focal_px"]), self.attrs)
         return self.depth_at(i, j) * np.float64(ray)
 
     def radiance_chunks(self, chunk: int, buffers: int = 1) -> Iterator[tuple[np.ndarray, np.ndarray]]:

@@ -6,17 +6,21 @@ is the landing gear's contact point: it touches down at z = 0, the camera stays 
 above the ground). Image columns run
 along X and rows along Y; a pixel (column j, row i) has its centre at
     x_s = j + 0.5 - W/2,   y_s = i + 0.5 - H/2     (px, principal point at the centre)
-and projection is x_s = f X / Z, y_s = f Y / Z with f = W / (2 tan(fov/2)).
+and projection is x_s = f X / Z, y_s = f Y / Z with f = W / (2 tan(fov/2)), through the
+lens's distortion where `distortion` has one (geometry/distortion.py): x_s = f a_d with
+(a_d, b_d) = distort(X / Z, Y / Z).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from ..defaults import section
 from ..trajectory.state import ATTITUDE, BODY_RATES, CONVENTIONS, POSITION, VELOCITY, rotation_matrix
+from .distortion import MODEL, PINHOLE, Distortion, distortion_from
 
 _CAMERA = section("camera")
 
@@ -27,6 +31,7 @@ class Camera:
     height: int
     fov_deg: float  # across the width
     mount_height_m: float = _CAMERA["mount_height_m"]  # above the trajectory point, along -z_b
+    distortion: Distortion = PINHOLE
 
     def __post_init__(self) -> None:
         if self.width < 1 or self.height < 1:
@@ -35,6 +40,13 @@ class Camera:
             raise ValueError(f"camera.fov_deg: expected 0 < fov < 180, got {self.fov_deg}")
         if not 0.0 <= self.mount_height_m < 100.0:
             raise ValueError(f"camera.mount_height_m: expected 0 <= h < 100 m, got {self.mount_height_m}")
+
+    @classmethod
+    def from_settings(cls, settings: dict) -> "Camera":
+        """From the camera settings (settings/camera.py: width, height, fov_deg, mount_height_m,
+        distortion where not a pinhole)."""
+        distortion = distortion_from(settings.get("distortion"))
+        return cls(settings["width"], settings["height"], settings["fov_deg"], settings["mount_height_m"], distortion)
 
     def pose(self, state: np.ndarray) -> "CameraPose":
         """This camera's pose for one 13-state (see camera_pose)."""
@@ -51,7 +63,7 @@ class Camera:
     @property
     def matrix(self) -> np.ndarray:
         """K (3 x 3, px) in the convention of OpenCV (pixel centres at integer indices):
-        f on the diagonal, principal point (W/2 - 0.5, H/2 - 0.5); no distortion."""
+        f on the diagonal, principal point (W/2 - 0.5, H/2 - 0.5); the distortion apart."""
         return np.array(
             [[self.focal_px, 0.0, self.width / 2 - 0.5], [0.0, self.focal_px, self.height / 2 - 0.5], [0.0, 0.0, 1.0]]
         )
@@ -60,7 +72,8 @@ class Camera:
         """What a file needs to be used with this camera alone."""
         return {
             "camera_matrix_px": self.matrix,
-            "distortion": "none",
+            "distortion": "none" if self.distortion.is_pinhole else MODEL,
+            "distortion_coefficients": self.distortion.coefficients,  # OpenCV's (k1, k2, p1, p2, k3)
             "image_convention": CONVENTIONS["image"],
             "camera_mount_height_m": self.mount_height_m,
             "camera_position": "trajectory position + R_iv (0, 0, -camera_mount_height_m)",
@@ -74,18 +87,91 @@ class Camera:
         return x_s[None, :], y_s[:, None]
 
     def project(self, points_cam: np.ndarray) -> np.ndarray:
-        """Camera-frame points (..., 3) -> centred pixel coordinates (..., 2) (x_s, y_s)."""
+        """Camera-frame points (..., 3) -> centred pixel coordinates (..., 2) (x_s, y_s),
+        through the lens's distortion."""
         p = np.asarray(points_cam, dtype=float)
-        return self.focal_px * p[..., :2] / p[..., 2:3]
+        if self.distortion.is_pinhole:
+            return self.focal_px * p[..., :2] / p[..., 2:3]
+        a_d, b_d = self.distortion.distort(p[..., 0] / p[..., 2], p[..., 1] / p[..., 2])
+        return self.focal_px * np.stack([a_d, b_d], axis=-1)
 
     def back_project(self, x_s: np.ndarray, y_s: np.ndarray) -> np.ndarray:
-        """Centred pixel coordinates -> rays (..., 3) = (a, b, 1) with a = x_s / f, b = y_s / f."""
+        """Centred pixel coordinates -> rays (..., 3) = (a, b, 1): a = x_s / f, b = y_s / f
+        undistorted (NaN where the lens's model does not reach)."""
         x_s, y_s = np.broadcast_arrays(np.asarray(x_s, dtype=float), np.asarray(y_s, dtype=float))
-        return np.stack([x_s / self.focal_px, y_s / self.focal_px, np.ones_like(x_s)], axis=-1)
+        a, b = x_s / self.focal_px, y_s / self.focal_px
+        if not self.distortion.is_pinhole:
+            a, b = self.distortion.undistort(a, b)
+        return np.stack([a, b, np.ones_like(x_s)], axis=-1)
+
+    def rays(self) -> tuple[np.ndarray, np.ndarray]:
+        """Each pixel centre's ray (a, b, 1) as (a, b), (H, W) float64 each (read-only,
+        computed once per camera); a ValueError naming camera.distortion where the lens's
+        model folds over inside the image."""
+        return _rays(self)
+
+    def reach(self) -> tuple[float, float]:
+        """(max |a|, max |b|) over the rays through the image's edges (its border, not its
+        pixel centres): a point beyond them is out of view whatever the polynomial says."""
+        return _reach(self)
+
+    def pinhole_cover(self, margin_px: float = 1.0) -> "Camera":
+        """The pinhole camera of the same focal length, centred, whose image holds every
+        pixel's ray with `margin_px` to spare (what the renderer draws before the lens's
+        distortion resamples it onto the sensor); this camera when it is a pinhole."""
+        if self.distortion.is_pinhole:
+            return self
+        a_max, b_max = self.reach()
+        f = self.focal_px
+        width = 2 * int(np.ceil(f * a_max + margin_px))
+        height = 2 * int(np.ceil(f * b_max + margin_px))
+        if width > 4 * self.width or height > 4 * self.height:
+            raise ValueError(
+                f"camera.distortion: {self.distortion} needs a {width} x {height} pinhole image to cover "
+                f"the {self.width} x {self.height} sensor (more than 4x its size): a lens this strong is not modelled"
+            )
+        fov = float(np.degrees(2.0 * np.arctan(width / (2.0 * f))))
+        return Camera(width, height, fov, self.mount_height_m)
 
     def to_pixel_index(self, xy_s: np.ndarray) -> np.ndarray:
         """Centred coordinates (..., 2) -> (column, row) continuous indices (centre of pixel 0 = 0)."""
         return np.asarray(xy_s) + np.array([self.width / 2 - 0.5, self.height / 2 - 0.5])
+
+
+def _folds_error(camera: Camera) -> ValueError:
+    return ValueError(
+        f"camera.distortion: {camera.distortion} folds over inside the {camera.width} x {camera.height} image "
+        f"(fov {camera.fov_deg} deg): some pixels have no ray; expected a lens whose model is one-to-one over "
+        "the image (smaller coefficients)"
+    )
+
+
+@lru_cache(maxsize=8)
+def _reach(camera: Camera) -> tuple[float, float]:
+    w, h = camera.width / 2, camera.height / 2
+    along_w, along_h = np.linspace(-w, w, 2 * camera.width + 1), np.linspace(-h, h, 2 * camera.height + 1)
+    x_s = np.concatenate([along_w, along_w, np.full_like(along_h, -w), np.full_like(along_h, w)])
+    y_s = np.concatenate([np.full_like(along_w, -h), np.full_like(along_w, h), along_h, along_h])
+    a, b = x_s / camera.focal_px, y_s / camera.focal_px
+    if not camera.distortion.is_pinhole:
+        a, b = camera.distortion.undistort(a, b)
+        if not (np.isfinite(a).all() and camera.distortion.radially_monotonic(float(np.hypot(a, b).max()))):
+            raise _folds_error(camera)
+    return float(np.abs(a).max()), float(np.abs(b).max())
+
+
+@lru_cache(maxsize=8)
+def _rays(camera: Camera) -> tuple[np.ndarray, np.ndarray]:
+    x_s, y_s = camera.pixel_coordinates(np.float64)
+    a, b = np.broadcast_arrays(x_s / camera.focal_px, y_s / camera.focal_px)
+    if not camera.distortion.is_pinhole:
+        camera.reach()  # the border first: a lens that folds over inside the image is refused there
+        a, b = camera.distortion.undistort(a, b)
+        if not np.isfinite(a).all():
+            raise _folds_error(camera)
+    a, b = np.array(a), np.array(b)
+    a.flags.writeable = b.flags.writeable = False
+    return a, b
 
 
 @dataclass(frozen=True)

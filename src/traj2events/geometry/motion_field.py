@@ -135,7 +135,11 @@ def sphere_flow(
     camera: Camera, state: np.ndarray, radius_m: float = MOON_RADIUS_M, dtype=np.float32
 ) -> tuple[np.ndarray, np.ndarray]:
     """Instantaneous field (H, W, 2) px/s over the sphere for one 13-state, and the
-    terrain mask (H, W) (False: sky, rotation-only flow)."""
+    terrain mask (H, W) (False: sky, rotation-only flow); through the camera's lens where it
+    distorts (`lens_motion`)."""
+    if not camera.distortion.is_pinhole:
+        flow, _, status = lens_motion(camera, state, state, None, _NO_DEPTH, 0.0, radius_m, dtype)
+        return flow, status != SKY
     pose = camera.pose(state)
     normal, height = local_vertical(pose.position, pose.rotation, radius_m)
     x_s, y_s = camera.pixel_coordinates(dtype)
@@ -147,7 +151,11 @@ def sphere_flow(
 
 
 def depth_flow(camera: Camera, state: np.ndarray, depth_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Instantaneous field (H, W, 2) px/s from a depth map (metric depth along the boresight)."""
+    """Instantaneous field (H, W, 2) px/s from a depth map (metric depth along the boresight),
+    and the terrain mask; through the camera's lens where it distorts (`lens_motion`)."""
+    if not camera.distortion.is_pinhole:
+        flow, _, status = lens_motion(camera, state, state, depth_m, _NO_DEPTH, 0.0, MOON_RADIUS_M, depth_m.dtype)
+        return flow, status != SKY
     x_s, y_s = camera.pixel_coordinates(depth_m.dtype)
     h = inverse_depth_from_depth(depth_m)
     v_c, omega = camera.motion(state)
@@ -197,6 +205,8 @@ def sphere_motion(
     computed in float64), the exact displacement (H, W, 2) px to frame k+1 and each pixel's
     status (H, W) uint8 (`sphere_displacement`'s), in one compiled pass, stored as dtype
     (flow empty when not with_flow)."""
+    if not camera.distortion.is_pinhole:
+        return lens_motion(camera, state_k, state_next, None, _NO_DEPTH, 0.0, radius_m, dtype, with_flow)
     pose_k, pose_next = camera.pose(state_k), camera.pose(state_next)
     normal, height = local_vertical(pose_k.position, pose_k.rotation, radius_m)
     # Camera k+1 sees the point when it is above the point's tangent plane:
@@ -247,6 +257,8 @@ def depth_motion(
     (flow empty when not with_flow)."""
     depth = np.asarray(depth_m)
     depth_next = _NO_DEPTH if depth_next_m is None else np.asarray(depth_next_m)
+    if not camera.distortion.is_pinhole:
+        return lens_motion(camera, state_k, state_next, depth, depth_next, rel_tol, MOON_RADIUS_M, dtype, with_flow)
     pose_k, pose_next = camera.pose(state_k), camera.pose(state_next)
     rates = _rates(camera, state_k) if with_flow else None
     from .motion_pass import fused_motion
@@ -256,6 +268,59 @@ def depth_motion(
 
 _NO_DEPTH = np.empty((0, 0))
 _NO_SPHERE = np.empty(0)
+
+
+def lens_motion(
+    camera: Camera,
+    state_k: np.ndarray,
+    state_next: np.ndarray,
+    depth_m: np.ndarray | None,
+    depth_next_m: np.ndarray,
+    rel_tol: float,
+    radius_m: float,
+    dtype=np.float32,
+    with_flow: bool = True,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """`sphere_motion` (depth_m None) or `depth_motion` of a camera whose lens distorts
+    (docs/geometry.md "Lens distortion"): each pixel looks along its own ray (a, b, 1)
+    (`Camera.rays`); the flow is the pinhole's at (f a, f b) through the lens's Jacobian,
+    f J(a, b) (da/dt, db/dt); the displacement is where the point lands through the lens at
+    k+1, f distort(X/Z, Y/Z), minus the pixel's centre; a point beyond the rays the
+    sensor's lens covers at k+1 is OUT_OF_VIEW. float64 in numpy, stored as dtype."""
+    a, b = camera.rays()
+    f, lens = camera.focal_px, camera.distortion
+    pose_k, pose_next = camera.pose(state_k), camera.pose(state_next)
+    q = _NO_SPHERE
+    if depth_m is None:
+        normal, height = local_vertical(pose_k.position, pose_k.rotation, radius_m)
+        h = inverse_depth_sphere(a, b, normal, height, radius_m)
+        q = pose_next.rotation.T @ (pose_next.position - np.array([0.0, 0.0, radius_m]))  # the limb's test
+    else:
+        h = inverse_depth_from_depth(depth_m.astype(np.float64))
+    flow = np.empty((0, 0, 2), dtype)
+    if with_flow:
+        u_pinhole, v_pinhole = motion_field(f * a, f * b, f, h, *camera.motion(state_k))
+        j_aa, j_ab, j_bb = lens.jacobian(a, b)
+        flow = np.stack([j_aa * u_pinhole + j_ab * v_pinhole, j_ab * u_pinhole + j_bb * v_pinhole], axis=-1)
+    m = pose_next.rotation.T @ pose_k.rotation
+    shift = pose_next.rotation.T @ (pose_k.position - pose_next.position)
+    hit = h > 0
+    depth_k = np.where(hit, 1.0 / np.where(hit, h, 1.0), 0.0)
+    # The point relative to camera k+1 (a direction where h = 0: it moves by the rotation only).
+    directions = [m[c, 0] * a + m[c, 1] * b + m[c, 2] for c in range(3)]  # the rays in frame k+1
+    x, y, z = (np.where(hit, depth_k * d + shift[c], d) for c, d in enumerate(directions))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a_next, b_next = x / z, y / z
+    col, row = (f * c for c in lens.distort(a_next, b_next))
+    x_s, y_s = camera.pixel_coordinates(np.float64)
+    displacement = np.stack([col - x_s, row - y_s], axis=-1)
+    a_max, b_max = camera.reach()
+    reach = (np.abs(a_next) <= a_max) & (np.abs(b_next) <= b_max)
+    from .motion_pass import status_map
+
+    col_in, row_in = np.where(reach, col, np.inf), np.where(reach, row, np.inf)
+    status = status_map(h, x, y, z, col_in, row_in, q, depth_next_m, rel_tol)
+    return flow.astype(dtype), displacement.astype(dtype), status
 
 
 def _rates(camera: Camera, state: np.ndarray) -> np.ndarray:

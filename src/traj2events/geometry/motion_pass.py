@@ -87,7 +87,7 @@ def _motion_pixels(
     LLVM vectorises them (a single per-pixel loop does not vectorise); only the status loop branches.
     flow and displacement come as (H, 2 W) views, (u, v) pairs along each row."""
     width, height = a_cols.size, b_rows.size
-    from_depth, limb, from_next = depth.size > 0, q.size > 0, depth_next.size > 0
+    from_depth, from_next = depth.size > 0, depth_next.size > 0
     above = sphere.size > 0 and sphere[5] > 0.0  # camera above the sphere's surface
     vx, vy, vz, p, q_rate, r = rates[0], rates[1], rates[2], rates[3], rates[4], rates[5]
     m00, m01, m02, m10, m11, m12, m20, m21, m22 = m.ravel()
@@ -130,20 +130,65 @@ def _motion_pixels(
         if from_next:  # branch-free: whether the first pixel around the landing point is nearer
             _first_corner_nearer_row(x_cols, u_row, y_s, v_row, z_row, depth_next, rel_tol, maybe_row)
         for j in range(width):
-            h, x, y, z = h_row[j], x_row[j], y_row[j], z_row[j]
             col, row = x_cols[j] + u_row[j], y_s + v_row[j]  # centred coordinates at k+1
-            if not h > 0.0:
-                status[i, j] = SKY
-            elif not z > 0.0:
-                status[i, j] = BEHIND_CAMERA
-            elif limb and not -(x * (x + q[0]) + y * (y + q[1]) + z * (z + q[2])) > 0.0:
-                status[i, j] = OCCLUDED  # beyond the sphere's limb seen from camera k+1
-            elif from_next and maybe_row[j] > 0.0 and _behind_nearer(col, row, z, depth_next, rel_tol):
-                status[i, j] = OCCLUDED
-            elif not (abs(col) <= width / 2 and abs(row) <= height / 2):
-                status[i, j] = OUT_OF_VIEW
-            else:
-                status[i, j] = VISIBLE
+            status[i, j] = _pixel_status(
+                h_row[j],
+                x_row[j],
+                y_row[j],
+                z_row[j],
+                col,
+                row,
+                width,
+                height,
+                q,
+                maybe_row[j] > 0.0,
+                depth_next,
+                rel_tol,
+            )
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def status_map(h, x, y, z, col, row, q, depth_next, rel_tol):
+    """Each pixel's status (H, W) uint8 from its inverse depth h at k, its point (x, y, z)
+    in camera k+1's frame and where it lands there (centred col, row; inf: out of the
+    lens's reach): `_pixel_status` per pixel."""
+    status = np.empty(h.shape, np.uint8)
+    for i in range(h.shape[0]):
+        for j in range(h.shape[1]):
+            status[i, j] = _pixel_status(
+                h[i, j],
+                x[i, j],
+                y[i, j],
+                z[i, j],
+                col[i, j],
+                row[i, j],
+                h.shape[1],
+                h.shape[0],
+                q,
+                True,
+                depth_next,
+                rel_tol,
+            )
+    return status
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _pixel_status(h, x, y, z, col, row, width, height, q, maybe_hidden, depth_next, rel_tol):
+    """The first that applies of SKY, BEHIND_CAMERA, OCCLUDED (beyond the sphere's limb
+    seen from camera k+1 when q is not empty; behind nearer terrain in frame k+1's depth
+    map when that is not empty and `maybe_hidden`), OUT_OF_VIEW (centred (col, row) off
+    the width x height image), VISIBLE."""
+    if not h > 0.0:
+        return SKY
+    if not z > 0.0:
+        return BEHIND_CAMERA
+    if q.size > 0 and not -(x * (x + q[0]) + y * (y + q[1]) + z * (z + q[2])) > 0.0:
+        return OCCLUDED  # beyond the sphere's limb seen from camera k+1
+    if depth_next.size > 0 and maybe_hidden and _behind_nearer(col, row, z, depth_next, rel_tol):
+        return OCCLUDED
+    if not (abs(col) <= width / 2 and abs(row) <= height / 2):
+        return OUT_OF_VIEW
+    return VISIBLE
 
 
 @njit(cache=True, nogil=True, error_model="numpy")

@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage, special
 
+from ..geometry.distortion import PINHOLE, Distortion
 from .photocurrent import SUN_TEMPERATURE_K, planck_spectral_radiance
 
 SUBSAMPLES = 16  # points per pixel side integrating the PSF over a pixel
@@ -88,11 +89,16 @@ def psf_kernel(
     return kernel / kernel.sum()
 
 
-def vignetting(width: int, height: int, focal_px: float) -> np.ndarray:
-    """(height, width) cos^4 of each pixel's field angle (principal point at the centre)."""
+def vignetting(width: int, height: int, focal_px: float, distortion: Distortion = PINHOLE) -> np.ndarray:
+    """(height, width) cos^4 of each pixel's field angle (principal point at the centre):
+    the angle of the scene's ray that reaches it, through the lens's `distortion`."""
     x = np.arange(width) - (width - 1) / 2
     y = np.arange(height) - (height - 1) / 2
-    cos2 = focal_px**2 / (focal_px**2 + x[None, :] ** 2 + y[:, None] ** 2)
+    if distortion.is_pinhole:
+        cos2 = focal_px**2 / (focal_px**2 + x[None, :] ** 2 + y[:, None] ** 2)
+    else:
+        a, b = distortion.undistort(x[None, :] / focal_px, y[:, None] / focal_px)
+        cos2 = 1.0 / (1.0 + a * a + b * b)
     return cos2**2
 
 

@@ -21,10 +21,19 @@ from __future__ import annotations
 import copy
 
 
-def without_default_compression(settings: dict) -> dict:
-    """`settings` without `compression` where it is Blosc, the default: the key came after
-    datasets were built, and their jobs' settings (the rules' params) stay as they were."""
-    return {k: v for k, v in settings.items() if not (k == "compression" and v == "blosc")}
+def without_late_defaults(settings: dict) -> dict:
+    """`settings` without the keys that came after datasets were built where they hold
+    their default (`compression` Blosc, `distortion` none), so that those datasets' jobs'
+    settings (the rules' params) stay as they were."""
+    return {k: v for k, v in settings.items() if not _late_default(k, v)}
+
+
+def _late_default(key: str, value) -> bool:
+    if key == "compression":
+        return value == "blosc"
+    if key == "distortion":
+        return value is None or not any((value or {}).values())
+    return False
 
 
 def config_value(config: dict, path: str):

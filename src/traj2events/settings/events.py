@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from . import pick, without_default_compression
+from . import pick, without_late_defaults
 
 # events.pixel: the preset's values under the config's own keys (defaults.with_preset).
 EVENTS = {
@@ -29,7 +29,7 @@ def events_settings(config: dict) -> dict:
     model (and the preset it came from), labels, the input scale, the sensor and its readout,
     and the device it runs on (a GPU can round a crossing differently); events.h5's
     compression where it is not the default."""
-    return without_default_compression(pick(config, EVENTS))
+    return without_late_defaults(pick(config, EVENTS))
 
 
 def events_picture_settings(config: dict) -> dict:

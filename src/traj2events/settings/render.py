@@ -8,7 +8,7 @@ import random
 from dataclasses import dataclass
 
 from ..geometry.camera import horizon_distance_m
-from . import without_default_compression
+from . import without_late_defaults
 
 TIMING_MODES = ("fixed", "adaptive")
 
@@ -68,28 +68,31 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
     r, camera = config["render"], config["camera"]
     adaptive = r["timing"]["mode"] == "adaptive"
-    return {
-        "scenario": name,
-        "width": int(camera["width"]),
-        "height": int(camera["height"]),
-        "fov_deg": float(camera["fov_deg"]),
-        "mount_height_m": float(camera["mount_height_m"]),
-        "moon_radius_m": radius,
-        "terrain": dict(config["terrain"]),
-        "sun": scenario_sun(config, name, trajectory_id),
-        "earth": dict(sc["earth"]) if sc.get("earth") else None,
-        "reflectance": dict(r["reflectance"]),
-        "lod": dict(r["lod"]),
-        "scattered_light": dict(r["scattered_light"]),
-        "half_extent_m": float(reach + horizon),
-        "display_white_w_m2_sr": float(r["display_white_w_m2_sr"]),
-        "display_gamma": float(r["display_gamma"]),
-        "timing": dict(r["timing"]),
-        "stars": dict(r["stars"]),
-        # Only adaptive frames depend on the emulator's input (None: fixed renders do not
-        # rerun when the sensor settings change).
-        "emulator_input": {"input": config["events"]["input"], "sensor": dict(config["events"]["sensor"])}
-        if adaptive
-        else None,
-        **without_default_compression({"compression": config["compression"]}),  # frames.h5's
-    }
+    return without_late_defaults(
+        {
+            "scenario": name,
+            "width": int(camera["width"]),
+            "height": int(camera["height"]),
+            "fov_deg": float(camera["fov_deg"]),
+            "mount_height_m": float(camera["mount_height_m"]),
+            "distortion": dict(camera["distortion"]),
+            "moon_radius_m": radius,
+            "terrain": dict(config["terrain"]),
+            "sun": scenario_sun(config, name, trajectory_id),
+            "earth": dict(sc["earth"]) if sc.get("earth") else None,
+            "reflectance": dict(r["reflectance"]),
+            "lod": dict(r["lod"]),
+            "scattered_light": dict(r["scattered_light"]),
+            "half_extent_m": float(reach + horizon),
+            "display_white_w_m2_sr": float(r["display_white_w_m2_sr"]),
+            "display_gamma": float(r["display_gamma"]),
+            "timing": dict(r["timing"]),
+            "stars": dict(r["stars"]),
+            # Only adaptive frames depend on the emulator's input (None: fixed renders do not
+            # rerun when the sensor settings change).
+            "emulator_input": {"input": config["events"]["input"], "sensor": dict(config["events"]["sensor"])}
+            if adaptive
+            else None,
+            "compression": config["compression"],  # frames.h5's
+        }
+    )

@@ -24,6 +24,7 @@ from ..formats.events import EVENT_DTYPE, EVENT_LABELS, MAX_T_US, EventsWriter, 
 from ..formats.exports import write_elope_npz, write_faery
 from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
+from ..geometry.distortion import Distortion
 from ..progress import log
 from ..read_ahead import read_ahead
 from ..sensor.emulator import EmulatorParams, EventEmulator
@@ -65,8 +66,8 @@ class FrameSource:
 VIDEO_DECODER_CPUS = 1
 
 # frames.h5 attributes that events.h5 repeats, so that it can be used alone.
-SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "image_convention", "camera_mount_height_m",
-               "camera_position", "fps", "timing", "stars", "sun_range_m",
+SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "distortion_coefficients", "image_convention",
+               "camera_mount_height_m", "camera_position", "fps", "timing", "stars", "sun_range_m",
                "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "earth", "reflectance", "terrain",
                "scattered_light", "moon_radius_m", "scenario", "id")  # fmt: skip
 
@@ -169,7 +170,8 @@ def _lens(sensor: SensorParams, attrs, width: int, height: int) -> tuple[np.ndar
     """(PSF kernel, vignetting or None) of the sensor's lens on frames.h5's camera."""
     kernel = psf_kernel(sensor.pixel_pitch_m, sensor.f_number, sensor.band_m, sensor.psf_diffraction,
                         sensor.lens_blur_um)  # fmt: skip
-    falloff = vignetting(width, height, float(attrs["focal_px"])) if sensor.vignetting else None
+    lens = Distortion(*attrs.get("distortion_coefficients", ()))  # older frames.h5: none, a pinhole
+    falloff = vignetting(width, height, float(attrs["focal_px"]), lens) if sensor.vignetting else None
     return kernel, falloff
 
 

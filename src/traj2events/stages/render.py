@@ -19,9 +19,11 @@ from .. import __version__
 from ..formats.frames import FramesWriter
 from ..formats.trajectory import read_trajectory
 from ..geometry.camera import Camera
+from ..geometry.distortion import distortion_from
 from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
 from ..renderer.draw import TerrainRenderer
+from ..renderer.lens import LensRenderer, lens_renderer
 from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField
@@ -29,7 +31,7 @@ from ..scene.sun import Sun
 from ..scene.terrain import ProceduralTerrain, TerrainParams, load_elevation_grid
 from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
-from ..settings import without_default_compression
+from ..settings import without_late_defaults
 from ..settings.render import render_settings
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.state import POSE
@@ -61,6 +63,7 @@ class RenderSettings:
     stars: dict
     emulator_input: dict | None  # adaptive timing: events.input and events.sensor (its log's scale)
     compression: str = "blosc"  # frames.h5's images (formats.hdf5.COMPRESSIONS)
+    distortion: dict | None = None  # camera.distortion (None: a pinhole)
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
@@ -75,7 +78,7 @@ class RenderSettings:
         return emulator_white_w_m2_sr(self.emulator_input, self.display_white_w_m2_sr)
 
     def to_json(self) -> str:
-        return json.dumps(without_default_compression(self.__dict__), sort_keys=True)
+        return json.dumps(without_late_defaults(self.__dict__), sort_keys=True)
 
     @classmethod
     def from_json(cls, text: str) -> "RenderSettings":
@@ -92,7 +95,7 @@ class RenderSettings:
         azimuths = int(self.scattered_light["azimuths"])
         tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache, azimuths)
         return (
-            Camera(self.width, self.height, self.fov_deg, self.mount_height_m),
+            Camera(self.width, self.height, self.fov_deg, self.mount_height_m, distortion_from(self.distortion)),
             tiles,
             sun,
             ReflectanceParams(**self.reflectance),
@@ -135,7 +138,7 @@ class RenderSettings:
 
 
 def render_between(
-    renderer: TerrainRenderer,
+    renderer: TerrainRenderer | LensRenderer,
     camera: Camera,
     states: ReintegratedStates,
     frame,
@@ -203,7 +206,7 @@ class TrajectoryRender:
         start = time.perf_counter()
         triangles = reused = added = 0
         with (
-            TerrainRenderer(
+            lens_renderer(
                 tiles, camera, self.sun, self.reflectance, stars=s.star_field(), backend=backend,
                 earth=s.earth_light(),
             ) as renderer,
@@ -298,6 +301,7 @@ FRAME_ATTR_ORDER = (
     "traj2events_version",
     "camera_matrix_px",
     "distortion",
+    "distortion_coefficients",
     "image_convention",
     "camera_mount_height_m",
     "camera_position",

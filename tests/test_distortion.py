@@ -1,0 +1,128 @@
+"""Lens distortion: the published formula, OpenCV's projection, round trips, Jacobian,
+folds refused, the pinhole cover, the resampling onto the sensor."""
+
+import cv2
+import numpy as np
+import pytest
+
+from traj2events.config import load_config
+from traj2events.geometry.camera import Camera
+from traj2events.geometry.distortion import Distortion, distortion_from
+from traj2events.renderer.lens import LensResampling
+
+LENSES = {
+    "barrel": Distortion(k1=-0.28, k2=0.07, k3=-0.005),
+    "pincushion": Distortion(k1=0.15, k2=0.02),
+    "decentred": Distortion(k1=-0.1, k2=0.01, p1=0.002, p2=-0.0015, k3=0.001),
+}
+
+
+def test_distort_matches_the_formula_worked_by_hand():
+    """(a, b) = (0.3, -0.2), r^2 = 0.13: radial = 1 + 0.1 r^2 + 0.01 r^4 + 0.001 r^6 = 1.013171197;
+    a_d = 0.3 radial + 2 (0.001)(0.3)(-0.2) + 0.002 (0.13 + 0.18) = 0.3044513591,
+    b_d = -0.2 radial + 0.001 (0.13 + 0.08) + 2 (0.002)(0.3)(-0.2) = -0.2026642394."""
+    lens = Distortion(k1=0.1, k2=0.01, p1=0.001, p2=0.002, k3=0.001)
+    a_d, b_d = lens.distort(np.array(0.3), np.array(-0.2))
+    assert a_d == pytest.approx(0.3044513591, abs=1e-10) and b_d == pytest.approx(-0.2026642394, abs=1e-10)
+
+
+@pytest.mark.parametrize("lens", LENSES.values(), ids=LENSES)
+def test_camera_projects_as_opencv_does(lens):
+    """cv2.projectPoints with distCoeffs (k1, k2, p1, p2, k3) and K = camera_matrix_px: the
+    same pixel (OpenCV's indices are centred coordinates plus (W/2 - 0.5, H/2 - 0.5))."""
+    camera = Camera(640, 480, 70.0, 0.0, lens)
+    rng = np.random.default_rng(3)
+    points = np.column_stack([rng.uniform(-4, 4, 200), rng.uniform(-3, 3, 200), rng.uniform(8, 20, 200)])
+    ours = camera.to_pixel_index(camera.project(points))
+    theirs, _ = cv2.projectPoints(points, np.zeros(3), np.zeros(3), camera.matrix, lens.coefficients)
+    np.testing.assert_allclose(ours, theirs[:, 0, :], atol=1e-9)
+    assert camera.intrinsics_attrs()["distortion"] == "radial-tangential"
+    np.testing.assert_array_equal(camera.intrinsics_attrs()["distortion_coefficients"], lens.coefficients)
+
+
+@pytest.mark.parametrize("lens", LENSES.values(), ids=LENSES)
+def test_every_pixels_ray_projects_back_onto_its_centre(lens):
+    """The round trip pixel -> ray -> pixel over a 512^2 sensor, to 1e-9 px."""
+    camera = Camera(512, 512, 60.0, 0.0, lens)
+    a, b = camera.rays()
+    x_s, y_s = camera.pixel_coordinates()
+    back = camera.project(np.stack([a, b, np.ones_like(a)], axis=-1))
+    assert np.abs(back[..., 0] - x_s).max() < 1e-9 and np.abs(back[..., 1] - y_s).max() < 1e-9
+    rays = camera.back_project(back[..., 0], back[..., 1])
+    assert np.abs(rays[..., 0] - a).max() * camera.focal_px < 1e-9
+
+
+def test_undistortion_agrees_with_opencv():
+    lens = LENSES["decentred"]
+    camera = Camera(640, 480, 70.0, 0.0, lens)
+    corners = np.array([[0.0, 0.0], [639.0, 0.0], [0.0, 479.0], [639.0, 479.0], [320.0, 240.0]])
+    theirs = cv2.undistortPoints(corners[:, None, :], camera.matrix, lens.coefficients,
+                                 criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-15))  # fmt: skip
+    ours = camera.back_project(*(corners - [319.5, 239.5]).T)[:, :2]
+    np.testing.assert_allclose(ours, theirs[:, 0, :], atol=1e-7)  # OpenCV's fixed-point iteration stops there
+
+
+@pytest.mark.parametrize("lens", LENSES.values(), ids=LENSES)
+def test_jacobian_matches_finite_differences(lens):
+    rng = np.random.default_rng(1)
+    a, b = rng.uniform(-0.6, 0.6, 50), rng.uniform(-0.6, 0.6, 50)
+    eps = 1e-6
+    j_aa, j_ab, j_bb = lens.jacobian(a, b)
+    da = [(p - m) / (2 * eps) for p, m in zip(lens.distort(a + eps, b), lens.distort(a - eps, b))]
+    db = [(p - m) / (2 * eps) for p, m in zip(lens.distort(a, b + eps), lens.distort(a, b - eps))]
+    for ours, numeric in ((j_aa, da[0]), (j_ab, db[0]), (j_ab, da[1]), (j_bb, db[1])):
+        np.testing.assert_allclose(ours, numeric, atol=1e-8)
+
+
+def test_a_lens_that_folds_over_inside_the_image_is_refused_naming_the_key(tmp_path):
+    """r (1 + k1 r^2) peaks at r = 1 / sqrt(-3 k1) = 0.41 for k1 = -2: inside a 45 deg image's
+    corner (r = 0.59); the config check says so before any job starts."""
+    with pytest.raises(ValueError, match=r"camera\.distortion: .* folds over"):
+        Camera(128, 128, 45.0, 0.0, Distortion(k1=-2.0)).rays()
+    config = tmp_path / "lens.yaml"
+    config.write_text("camera: {distortion: {k1: -2.0, k2: 0, p1: 0, p2: 0, k3: 0}}\n")
+    with pytest.raises(ValueError, match=r"config key 'camera\.distortion': .* folds over"):
+        load_config(config)
+    with pytest.raises(ValueError, match=r"camera\.distortion: unknown keys \['k4'\]"):
+        distortion_from({"k4": 0.1})
+
+
+@pytest.mark.parametrize("lens", LENSES.values(), ids=LENSES)
+def test_pinhole_cover_holds_every_ray_at_the_same_focal_length(lens):
+    camera = Camera(200, 150, 60.0, 0.0, lens)
+    cover = camera.pinhole_cover()
+    assert cover.distortion.is_pinhole and cover.focal_px == pytest.approx(camera.focal_px, rel=1e-12)
+    a, b = camera.rays()
+    assert np.abs(a).max() * cover.focal_px + 1 <= cover.width / 2
+    assert np.abs(b).max() * cover.focal_px + 1 <= cover.height / 2
+    barrel = lens.k1 < 0  # it shows more than the pinhole: its cover is larger; pincushion less
+    assert (cover.width > camera.width) == barrel
+
+
+def test_resampling_is_exact_on_a_plane():
+    """Radiance linear in the image and a plane's inverse depth (affine in the image: exact
+    under bilinear interpolation) come out as the ray of each sensor pixel says."""
+    camera = Camera(96, 64, 60.0, 0.0, LENSES["decentred"])
+    cover = camera.pinhole_cover()
+    x_c, y_c = cover.pixel_coordinates()
+    radiance = (3.0 + 0.01 * x_c - 0.02 * y_c).astype(np.float32) * np.ones((cover.height, 1), np.float32)
+    normal, height = np.array([0.1, -0.3, 0.95]), 40.0  # the plane n . P = height, camera frame
+    inverse = (normal[0] * x_c / cover.focal_px + normal[1] * y_c / cover.focal_px + normal[2]) / height
+    resampling = LensResampling(camera, cover)
+    a, b = camera.rays()
+    f = camera.focal_px
+    np.testing.assert_allclose(resampling.radiance(radiance), 3.0 + 0.01 * f * a - 0.02 * f * b, rtol=1e-6)
+    expected_depth = height / (normal[0] * a + normal[1] * b + normal[2])
+    np.testing.assert_allclose(resampling.depth((1.0 / inverse).astype(np.float32)), expected_depth, rtol=1e-5)
+
+
+def test_resampled_depth_keeps_sky_where_most_of_the_samples_are_sky():
+    camera = Camera(40, 30, 60.0, 0.0, LENSES["barrel"])
+    cover = camera.pinhole_cover()
+    depth = np.full((cover.height, cover.width), 50.0, np.float32)
+    depth[: cover.height // 2] = 0.0  # the upper half is sky
+    out = LensResampling(camera, cover).depth(depth)
+    _, b = camera.rays()
+    row = b * cover.focal_px + cover.height / 2 - 0.5  # continuous row in the cover
+    sky_side = row < cover.height // 2 - 0.5  # nearer the sky's last row than the ground's first
+    assert np.all(out[sky_side] == 0) and np.all(out[~sky_side] == pytest.approx(50.0))
