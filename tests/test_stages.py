@@ -83,6 +83,36 @@ def test_camera_poses_run_at_the_frame_rate_and_land(built):
     assert abs(tr.state[-1, 2]) < 0.5 and tr.attrs["id"] == 0 and tr.attrs["fps"] == 5.0
 
 
+def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
+    """camera_poses with the trajectory's divert (as the workflow draws it): the poses end
+    at the new site, trajectory.h5 says when and where, the index shows it; one out of
+    reach keeps the nominal flight and says so."""
+    import h5py as h5
+
+    from traj2events.settings.poses import scenario_divert
+
+    ranges = {"time_fraction": [0.5, 0.6], "offset_m": [40.0, 60.0], "direction_deg": [0.0, 90.0]}
+    divert = scenario_divert(resolve_config({**CONFIG_OVERLAY, "scenarios": {"descent": {"divert": ranges}}}),
+                             "descent", "0000")  # fmt: skip
+    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "trajectory.h5", divert)
+    tr = read_trajectory(tmp_path / "trajectory.h5")
+    assert tr.attrs["divert"].startswith("re-targeted") and tr.attrs["divert_success"]
+    np.testing.assert_allclose(tr.attrs["divert_new_site_m"], divert["site_m"])
+    np.testing.assert_allclose(tr.state[-1, :2], divert["site_m"], atol=0.5)  # the last pose, within a frame of it
+    assert tr.attrs["tf_s"] == tr.t_nodes[-1] and tr.attrs["N"] == len(tr.t_nodes)
+    assert tr.attrs["error_position_m"] <= config["ocp"]["accept_error_m"]
+    assert 0 < tr.attrs["divert_time_s"] < tr.t[-1] and tr.attrs["divert_acceleration_added_max_m_s2"] > 0
+    far = {**divert, "time_fraction": 0.9, "offset_m": 5e5, "site_m": [5e5, 0.0]}
+    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "far" / "trajectory.h5", far)
+    with h5.File(tmp_path / "far" / "trajectory.h5") as f, h5.File(built / "trajectory.h5") as nominal:
+        assert f.attrs["divert"].startswith("failed: ") and not f.attrs["divert_success"]
+        np.testing.assert_array_equal(f["poses/state"][()], nominal["poses/state"][()])
+    index = dataset_index([tmp_path / "trajectory.h5", tmp_path / "far" / "trajectory.h5", built / "trajectory.h5"],
+                          tmp_path / "index.csv")  # fmt: skip
+    assert list(index["divert"].str.split(" ").str[0]) == ["re-targeted", "failed:", "none"]
+    assert index["divert_offset_m"][0] == pytest.approx(divert["offset_m"]) and np.isnan(index["divert_time_s"][2])
+
+
 def test_a_failed_sample_is_refused_by_camera_poses(built, tmp_path):
     with pytest.raises(ValueError, match="no trajectory 7: 2 of 2 samples of 'descent' solved in 2 draws"):
         camera_poses(built / "solutions.h5", 7, 5.0, "reintegrate", tmp_path / "t.h5")

@@ -15,7 +15,7 @@ import sys
 from . import __version__, missing_dependency
 from .defaults import section
 from .memory import keep_freed_memory
-from .options import add_settings, inline_or_file, settings_from
+from .options import add_settings, inline_or_file, json_or_null, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
 from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE, EXPORT_SUFFIX
 from .settings.imu import IMU
@@ -162,9 +162,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--id", type=int, required=True, help="sample index")
     add_settings(p, POSES, "the frame rate and upsampling")
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
-    p.set_defaults(
-        func=_calls("camera_poses", "poses_command", "solutions", "id", lambda a: settings_from(a, POSES), "output")
-    )
+    p.add_argument("--divert", type=json_or_null, help="the trajectory's divert, JSON (or @file); default: none")
+    poses = lambda a: settings_from(a, POSES)  # noqa: E731
+    p.set_defaults(func=_calls("camera_poses", "poses_command", "solutions", "id", poses, "output", "divert"))
 
     p = sub.add_parser("imu", help="imu.h5: the IMU's specific force and body rates, and the altitude, noise-free")
     p.add_argument("trajectory", help="trajectory.h5 (its nodes are re-integrated at the IMU's rate)")

@@ -103,7 +103,12 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
         )
     sun = [(f"sun.{k}", sc["sun"][k]) for k in ("azimuth_deg", "elevation_deg") if isinstance(sc["sun"][k], list)]
-    for key, (lo, hi) in [(key, sc[key]) for key in RANGE_KEYS] + sun:
+    divert = [(f"divert.{k}", v) for k, v in (sc.get("divert") or {}).items()]
+    if divert and config["upsampling"]["method"] != "reintegrate":
+        errors.append(f"config key 'scenarios.{name}.divert': a divert's controls jump at the re-target, which the "
+                      f"cubic spline cannot follow: expected upsampling.method: reintegrate, got "
+                      f"{config['upsampling']['method']}")  # fmt: skip
+    for key, (lo, hi) in [(key, sc[key]) for key in RANGE_KEYS] + sun + divert:
         if lo > hi:
             errors.append(f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}")
     tilt = config["vehicle"]["tilt_max_deg"]

@@ -100,6 +100,11 @@ def inline_or_file(value: str) -> str:
     return Path(value[1:]).read_text() if value.startswith("@") else value
 
 
+def json_or_null(value: str):
+    """An option's JSON value (inline or @file): an object, or null."""
+    return json.loads(inline_or_file(value))
+
+
 def _json_object(option: str, value: str) -> dict:
     text = inline_or_file(value)
     try:

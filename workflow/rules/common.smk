@@ -21,6 +21,7 @@ from traj2events.settings.events import events_picture_settings as events_pictur
 from traj2events.settings.events import events_settings as events_settings_of
 from traj2events.settings.imu import imu_settings as imu_settings_of
 from traj2events.settings.poses import pose_settings as pose_settings_of
+from traj2events.settings.poses import scenario_divert
 from traj2events.settings.render import render_settings as render_settings_of
 from traj2events.settings.solve import solve_settings
 
@@ -98,6 +99,11 @@ def scenario_settings(wildcards):
 def render_settings(wildcards):
     """Everything one trajectory's frames depend on, as JSON (camera, terrain, its Sun, reflectance, LOD)."""
     return json.dumps(render_settings_of(config, wildcards.scenario, wildcards.id), sort_keys=True)
+
+
+def trajectory_divert(wildcards):
+    """The trajectory's divert, as JSON (null: none; drawn from the config, as its Sun)."""
+    return json.dumps(scenario_divert(config, wildcards.scenario, wildcards.id), sort_keys=True)
 
 
 def elevation_grid(wildcards):

@@ -18,7 +18,8 @@ The procedural surface is a sum of
   - a landing pad around the site, level at the lander's scale so that the trajectories'
     touchdown point (z = 0) lies on the surface: craters and the roughness longer than
     `pad_relief_wavelength_max_m` fade out over it, the shorter roughness (regolith
-    texture, cm high) stays, so the last seconds of a landing see texture.
+    texture, cm high) stays, so the last seconds of a landing see texture; a divert's
+    new site (`divert_sites_m`) gets the same pad;
 Evaluation takes the grid spacing: craters narrower than two spacings and roughness
 shorter than two spacings are left out, which is the level of detail (a coarse tile is
 a low-pass version of the fine one, not a different surface).
@@ -71,8 +72,12 @@ class TerrainParams:
     boulder_diameter_min_m: float = _TERRAIN["boulder_diameter_min_m"]
     boulder_diameter_max_m: float = _TERRAIN["boulder_diameter_max_m"]
     boulder_ejecta_factor: float = _TERRAIN["boulder_ejecta_factor"]
+    # Sites diverts re-target to, (x, y) m: each gets a pad as the site's (the render
+    # settings add a trajectory's; not a config key).
+    divert_sites_m: tuple = ()
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "divert_sites_m", tuple((float(x), float(y)) for x, y in self.divert_sites_m))
         if not 0 < self.crater_diameter_min_m <= self.crater_diameter_max_m:
             raise ValueError("terrain.crater_diameter_min_m/max_m: expected 0 < min <= max")
         if not 0 <= self.fresh_fraction <= 1:
@@ -185,7 +190,10 @@ class ProceduralTerrain:
 
     def identity(self) -> dict:
         """What the heights depend on (the tile cache's key): the parameters, seed included."""
-        return {"procedural": asdict(self.params)}
+        params = asdict(self.params)
+        if not params["divert_sites_m"]:  # the key came later: tiles cached before keep theirs
+            del params["divert_sites_m"]
+        return {"procedural": params}
 
     def craters_in(
         self, x_range: tuple[float, float], y_range: tuple[float, float], min_diameter_m: float = 0.0
@@ -344,6 +352,8 @@ class ProceduralTerrain:
             + self.roughness_m(x_m, y_m, spacing_m, short=False)
         )
         pad = site_pad_weight(x_m, y_m, self.params.site_radius_m)
+        for site_x, site_y in self.params.divert_sites_m:
+            pad = pad * site_pad_weight(x_m - site_x, y_m - site_y, self.params.site_radius_m)
         return long * pad + self.roughness_m(x_m, y_m, spacing_m, short=True)
 
 

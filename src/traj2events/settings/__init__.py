@@ -19,6 +19,8 @@ into its model's objects (`trajectory.scenarios.ScenarioSettings`, `stages.rende
 from __future__ import annotations
 
 import copy
+import hashlib
+import random
 
 
 def without_late_defaults(settings: dict) -> dict:
@@ -46,3 +48,11 @@ def config_value(config: dict, path: str):
 def pick(config: dict, keys: dict[str, str]) -> dict:
     """{setting: the config's value at its dotted key} (copies)."""
     return {name: copy.deepcopy(config_value(config, path)) for name, path in keys.items()}
+
+
+def trajectory_rng(config: dict, scenario: str, trajectory_id: str, stream: str) -> random.Random:
+    """A draw of one trajectory's own (its Sun, its divert): seeded by the dataset's seed,
+    the scenario, the trajectory's id and the stream's name alone (the same config, the
+    same draws, whatever else changes)."""
+    key = f"{config['seed']}/{scenario}/{trajectory_id}/{stream}".encode()
+    return random.Random(int(hashlib.sha256(key).hexdigest()[:16], 16))

@@ -3,12 +3,11 @@ when to render (`render.timing`)."""
 
 from __future__ import annotations
 
-import hashlib
-import random
 from dataclasses import dataclass
 
 from ..geometry.camera import horizon_distance_m
-from . import without_late_defaults
+from . import trajectory_rng, without_late_defaults
+from .poses import scenario_divert
 
 TIMING_MODES = ("fixed", "adaptive")
 
@@ -48,8 +47,7 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
     if ranges and trajectory_id is None:
         return {**sun, **{k: 0.5 * (sun[k][0] + sun[k][1]) for k in ranges}}
     if ranges:
-        key = f"{config['seed']}/{name}/{trajectory_id}/sun".encode()
-        rng = random.Random(int(hashlib.sha256(key).hexdigest()[:16], 16))
+        rng = trajectory_rng(config, name, trajectory_id, "sun")
         sun.update({k: rng.uniform(*sun[k]) for k in ranges})
     return sun
 
@@ -68,6 +66,10 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
     r, camera = config["render"], config["camera"]
     adaptive = r["timing"]["mode"] == "adaptive"
+    terrain = dict(config["terrain"])
+    divert = scenario_divert(config, name, trajectory_id)
+    if divert:  # a landing pad at the new site as at the old (scene/terrain.py)
+        terrain["divert_sites_m"] = [divert["site_m"]]
     return without_late_defaults(
         {
             "scenario": name,
@@ -77,7 +79,7 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
             "mount_height_m": float(camera["mount_height_m"]),
             "distortion": dict(camera["distortion"]),
             "moon_radius_m": radius,
-            "terrain": dict(config["terrain"]),
+            "terrain": terrain,
             "sun": scenario_sun(config, name, trajectory_id),
             "earth": dict(sc["earth"]) if sc.get("earth") else None,
             "reflectance": dict(r["reflectance"]),

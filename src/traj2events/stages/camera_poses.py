@@ -5,9 +5,12 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
+
 from .. import __version__
 from ..formats.trajectory import read_solution_set, vehicle_attrs, write_trajectory
 from ..progress import log
+from ..trajectory.divert import Divert, DivertedFlight, divert_flight, manoeuvre_m_s2
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.scenarios import ScenarioSettings
 from ..trajectory.upsample import upsample
@@ -18,10 +21,17 @@ SOLVE_ATTRS = ("initial_state", "final_state", "transcription", "N", "solver_sta
 
 
 def camera_poses(
-    solutions: str | os.PathLike, sample_id: int, fps: float, method: str, output: str | os.PathLike
+    solutions: str | os.PathLike,
+    sample_id: int,
+    fps: float,
+    method: str,
+    output: str | os.PathLike,
+    divert: dict | None = None,
 ) -> None:
     """Write trajectory.h5 (nodes and poses) of trajectory `sample_id` of solutions.h5 (the
-    sample-th solved draw)."""
+    sample-th solved draw); with `divert` (settings.poses.scenario_divert's), the flight
+    re-targeted to its new site (trajectory/divert.py), or the nominal one, recorded as
+    such, where that does not solve."""
     data = read_solution_set(solutions)
     s = ScenarioSettings.from_json(data["attrs"]["settings"])
     sample = next((x for x in data["samples"].values() if x.get("id") == sample_id), None)
@@ -41,11 +51,26 @@ def camera_poses(
             "Check the scenario's ranges and the vehicle in the config."
         )
     t, state, control = sample["t"], sample["state"], sample["control"]
+    solve_attrs = {k: sample[k] for k in SOLVE_ATTRS}
+    divert_attrs = {"divert": "none"}
+    if divert is not None:
+        drawn = Divert(**{**divert, "site_m": tuple(divert["site_m"])})
+        flight = divert_flight(s.vehicle, s.ocp, (t, state, control), drawn)
+        divert_attrs = divert_record(flight)
+        if flight.success:
+            t, state, control = flight.t, flight.state, flight.control
+            solve_attrs.update(N=len(t), tf_s=float(t[-1]), error_position_m=flight.error_position_m,
+                               error_velocity_m_s=flight.error_velocity_m_s)  # fmt: skip
+        log(f"{s.scenario.name}/{sample_id:04d}: divert {divert_attrs['divert']}")
     poses = upsample(Dynamics(s.vehicle), t, state, control, fps, method)
+    if divert is not None and flight.success:
+        nominal = upsample(Dynamics(s.vehicle), sample["t"], sample["state"], sample["control"], fps, method)
+        divert_attrs["divert_acceleration_added_max_m_s2"] = manoeuvre_m_s2(poses[0], poses[1], nominal[1])
     log(f"{s.scenario.name}/{sample_id:04d}: {len(poses[0])} poses at {fps:g} fps ({method})")
     attrs = {
         **vehicle_attrs(s.vehicle),
-        **{k: sample[k] for k in SOLVE_ATTRS},
+        **solve_attrs,
+        **divert_attrs,
         "fps": fps,
         "upsampling": method,
         "scenario": s.scenario.name,
@@ -60,6 +85,27 @@ def camera_poses(
     write_trajectory(output, (t, state, control), poses, attrs)
 
 
-def poses_command(solutions: str | os.PathLike, sample_id: int, settings: dict, output: str | os.PathLike) -> None:
-    """The camera_poses stage as the command runs it: settings.poses (fps, method)."""
-    camera_poses(solutions, sample_id, settings["fps"], settings["method"], output)
+def divert_record(flight: DivertedFlight) -> dict:
+    """trajectory.h5's divert attributes: what was drawn, when it started, how it went."""
+    d, r = flight.divert, flight.result
+    status = f"re-targeted ({r.method})" if flight.success else f"failed: {r.reason}; the nominal flight is kept"
+    return {
+        "divert": status,
+        "divert_success": flight.success,
+        "divert_time_s": flight.t_divert_s,
+        "divert_time_fraction": d.time_fraction,
+        "divert_offset_m": d.offset_m,
+        "divert_direction_deg": d.direction_deg,
+        "divert_old_site_m": np.zeros(2),
+        "divert_new_site_m": np.asarray(d.site_m, dtype=float),
+        "divert_solve_iterations": r.total_iterations,
+        "divert_solve_time_s": r.total_time_s,
+    }
+
+
+def poses_command(
+    solutions: str | os.PathLike, sample_id: int, settings: dict, output: str | os.PathLike, divert: dict | None = None
+) -> None:
+    """The camera_poses stage as the command runs it: settings.poses (fps, method), and
+    the trajectory's divert (None: none)."""
+    camera_poses(solutions, sample_id, settings["fps"], settings["method"], output, divert)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from ..formats.atomic import atomic_output
@@ -28,7 +29,13 @@ def index_row(path: str | os.PathLike) -> dict:
         "final_mass_kg": float(tr.state_nodes[-1, MASS]),
         "continuation": a["continuation"],
         "error_position_m": float(a["error_position_m"]),
+        # The divert flown (trajectory.h5's divert_*; "none" in files from before diverts).
+        "divert": a.get("divert", "none"),
+        **{f"divert_{k}": float(a.get(f"divert_{k}", np.nan)) for k in DIVERT_COLUMNS},
     }
+
+
+DIVERT_COLUMNS = ("time_s", "offset_m", "direction_deg", "acceleration_added_max_m_s2")
 
 
 class NoSolvedSampleError(ValueError):
@@ -58,4 +65,11 @@ def dataset_index(
     with atomic_output(output) as tmp:
         table.to_csv(tmp, index=False, float_format="%.9g")
     log(f"{output}: {len(rows)} trajectories")
+    diverted = table[table["divert"] != "none"] if rows else table
+    if len(diverted):
+        flown = diverted[diverted["divert"].str.startswith("re-targeted")]
+        offset, at, peak = (flown[f"divert_{k}"] for k in ("offset_m", "time_s", "acceleration_added_max_m_s2"))
+        log(f"  diverts: {len(flown)} flown, {len(diverted) - len(flown)} failed (nominal flight kept); re-targeted "
+            f"{offset.median():.0f} m (median) at {at.median():.1f} s, adding up to {peak.median():.2f} m/s^2 "
+            f"(median; {peak.max():.2f} max) to the nominal's horizontal acceleration")  # fmt: skip
     return table

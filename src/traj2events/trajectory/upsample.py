@@ -77,6 +77,9 @@ class ReintegratedStates:
         f = dynamics.casadi
         for k in range(len(t_nodes) - 1):
             t_a, t_b = t_nodes[k], t_nodes[k + 1]
+            if t_b == t_a:  # a node given twice (a divert's: the controls jump there): nothing to integrate
+                self._pieces.append(_Held(state.copy()))
+                continue
             u_a, du = control_nodes[k], (control_nodes[k + 1] - control_nodes[k]) / (t_b - t_a)
 
             def rhs(t, x, u_a=u_a, du=du, t_a=t_a):
@@ -99,6 +102,16 @@ class ReintegratedStates:
             out[at] = self._pieces[k](t[at]).T
         out[t == self.t_nodes[0]] = self._state0
         return out
+
+
+class _Held:
+    """The dense output of an interval of zero length: its one state."""
+
+    def __init__(self, state: np.ndarray) -> None:
+        self.state = state
+
+    def __call__(self, t: np.ndarray) -> np.ndarray:
+        return np.repeat(self.state[:, None], np.size(t), axis=1)
 
 
 def spline_states(t_nodes: np.ndarray, state_nodes: np.ndarray, t: np.ndarray) -> np.ndarray:
