@@ -46,6 +46,12 @@ class Landing:
         tr = read_trajectory(self.folder / "trajectory.h5")
         return tr.t, tr.state
 
+    def divert(self) -> dict:
+        """The divert flown, trajectory.h5's `divert` and `divert_*` attributes (names
+        without the prefix: time_s, new_site_m, ...); {"divert": "none"} without one."""
+        attrs = read_trajectory(self.folder / "trajectory.h5").attrs
+        return {k.removeprefix("divert_"): attrs[k] for k in attrs if k.startswith("divert")} or {"divert": "none"}
+
     def imu(self) -> dict[str, np.ndarray]:
         """imu.h5's streams: t (n,) s, specific_force_b (n, 3) m/s^2, angular_rate_b (n, 3)
         rad/s, their *_measured with an IMU's errors and its biases, altitude_m (n,) m
