@@ -117,7 +117,7 @@ def test_a_divert_needs_the_reintegrated_poses_and_ordered_ranges(tmp_path):
     config = tmp_path / "divert.yaml"
     divert = "scenarios: {descent: {divert: {time_fraction: [0.4, 0.6], offset_m: [10, 20], direction_deg: [0, 90]}}}\n"
     config.write_text("upsampling: {method: spline}\n" + divert)
-    with pytest.raises(ValueError, match=r"'scenarios\.descent\.divert': a divert's controls jump"):
+    with pytest.raises(ValueError, match=r"'scenarios\.descent\.divert': its controls jump"):
         load_config(config)
     config.write_text(divert.replace("[0.4, 0.6]", "[0.6, 0.4]"))
     with pytest.raises(ValueError, match=r"'scenarios\.descent\.divert\.time_fraction': expected \[min, max\]"):

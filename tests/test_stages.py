@@ -94,7 +94,7 @@ def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
     ranges = {"time_fraction": [0.5, 0.6], "offset_m": [40.0, 60.0], "direction_deg": [0.0, 90.0]}
     divert = scenario_divert(resolve_config({**CONFIG_OVERLAY, "scenarios": {"descent": {"divert": ranges}}}),
                              "descent", "0000")  # fmt: skip
-    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "trajectory.h5", divert)
+    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "trajectory.h5", {"divert": divert})
     tr = read_trajectory(tmp_path / "trajectory.h5")
     assert tr.attrs["divert"].startswith("re-targeted") and tr.attrs["divert_success"]
     np.testing.assert_allclose(tr.attrs["divert_new_site_m"], divert["site_m"])
@@ -103,7 +103,7 @@ def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
     assert tr.attrs["error_position_m"] <= config["ocp"]["accept_error_m"]
     assert 0 < tr.attrs["divert_time_s"] < tr.t[-1] and tr.attrs["divert_acceleration_added_max_m_s2"] > 0
     far = {**divert, "time_fraction": 0.9, "offset_m": 5e5, "site_m": [5e5, 0.0]}
-    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "far" / "trajectory.h5", far)
+    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "far" / "trajectory.h5", {"divert": far})
     with h5.File(tmp_path / "far" / "trajectory.h5") as f, h5.File(built / "trajectory.h5") as nominal:
         assert f.attrs["divert"].startswith("failed: ") and not f.attrs["divert_success"]
         np.testing.assert_array_equal(f["poses/state"][()], nominal["poses/state"][()])
@@ -111,6 +111,26 @@ def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
                           tmp_path / "index.csv")  # fmt: skip
     assert list(index["divert"].str.split(" ").str[0]) == ["re-targeted", "failed:", "none"]
     assert index["divert_offset_m"][0] == pytest.approx(divert["offset_m"]) and np.isnan(index["divert_time_s"][2])
+
+
+def test_a_drawn_hover_is_flown_recorded_and_indexed(built, tmp_path):
+    from traj2events.settings.poses import scenario_manoeuvre
+
+    ranges = {"altitude_m": [60.0, 80.0], "duration_s": [4.0, 6.0], "offset_m": [20.0, 30.0],
+              "direction_deg": [0.0, 90.0]}  # fmt: skip
+    manoeuvre = scenario_manoeuvre(resolve_config({**CONFIG_OVERLAY, "scenarios": {"descent": {"hover": ranges}}}),
+                                   "descent", "0000")  # fmt: skip
+    camera_poses(built / "solutions.h5", 0, 5.0, "reintegrate", tmp_path / "trajectory.h5", manoeuvre)
+    tr = read_trajectory(tmp_path / "trajectory.h5")
+    hover = manoeuvre["hover"]
+    assert tr.attrs["hover"].startswith("flown") and tr.attrs["divert"] == "none"
+    assert tr.attrs["hover_end_s"] - tr.attrs["hover_start_s"] == pytest.approx(hover["duration_s"])
+    during = (tr.t >= tr.attrs["hover_start_s"]) & (tr.t <= tr.attrs["hover_end_s"])
+    np.testing.assert_allclose(tr.state[during][:, :3], [[*hover["point_m"], -hover["altitude_m"]]] * during.sum(),
+                               atol=0.1)  # fmt: skip
+    assert tr.attrs["hover_drift_m"] < 0.01 and abs(tr.state[-1, 2]) < 0.5
+    index = dataset_index([tmp_path / "trajectory.h5"], tmp_path / "index.csv")
+    assert index["hover_duration_s"][0] == pytest.approx(hover["duration_s"]) and index["divert"][0] == "none"
 
 
 def test_a_failed_sample_is_refused_by_camera_poses(built, tmp_path):

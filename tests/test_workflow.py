@@ -181,7 +181,7 @@ def test_the_loader_reads_the_built_dataset(built):
     assert np.array_equal(t_range, t) and slant.dtype == np.float32 and 0 < slant[5] < 2 * depth[16, 16]
     np.testing.assert_allclose(landing.camera_matrix[0, 0], attrs["focal_px"])
     assert (landing.distortion_coefficients == 0).all()  # the default: a pinhole
-    assert landing.divert() == {"divert": "none"}  # the default: no divert
+    assert landing.manoeuvre() == {"divert": "none", "hover": "none"}  # the default: neither
     windows = EventWindows(dataset, 0.5)
     assert len(windows) == sum(int(x.poses()[0][-1] / 0.5 + 1e-9) for x in dataset)
     events, start, owner = windows[3]

@@ -162,9 +162,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--id", type=int, required=True, help="sample index")
     add_settings(p, POSES, "the frame rate and upsampling")
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
-    p.add_argument("--divert", type=json_or_null, help="the trajectory's divert, JSON (or @file); default: none")
+    p.add_argument("--manoeuvre", type=json_or_null, help="its divert or hover, JSON (or @file); default: none")
     poses = lambda a: settings_from(a, POSES)  # noqa: E731
-    p.set_defaults(func=_calls("camera_poses", "poses_command", "solutions", "id", poses, "output", "divert"))
+    p.set_defaults(func=_calls("camera_poses", "poses_command", "solutions", "id", poses, "output", "manoeuvre"))
 
     p = sub.add_parser("imu", help="imu.h5: the IMU's specific force and body rates, and the altitude, noise-free")
     p.add_argument("trajectory", help="trajectory.h5 (its nodes are re-integrated at the IMU's rate)")

@@ -103,12 +103,16 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
         )
     sun = [(f"sun.{k}", sc["sun"][k]) for k in ("azimuth_deg", "elevation_deg") if isinstance(sc["sun"][k], list)]
-    divert = [(f"divert.{k}", v) for k, v in (sc.get("divert") or {}).items()]
-    if divert and config["upsampling"]["method"] != "reintegrate":
-        errors.append(f"config key 'scenarios.{name}.divert': a divert's controls jump at the re-target, which the "
-                      f"cubic spline cannot follow: expected upsampling.method: reintegrate, got "
+    manoeuvres = [(f"{kind}.{k}", v) for kind in ("divert", "hover") for k, v in (sc.get(kind) or {}).items()]
+    kinds = [kind for kind in ("divert", "hover") if sc.get(kind)]
+    if kinds and config["upsampling"]["method"] != "reintegrate":
+        errors.append(f"config key 'scenarios.{name}.{kinds[0]}': its controls jump between legs, which the cubic "
+                      f"spline cannot follow: expected upsampling.method: reintegrate, got "
                       f"{config['upsampling']['method']}")  # fmt: skip
-    for key, (lo, hi) in [(key, sc[key]) for key in RANGE_KEYS] + sun + divert:
+    if len(kinds) > 1:
+        errors.append(f"config key 'scenarios.{name}.hover': a scenario flies a divert or a hover, not both "
+                      "(make two scenarios)")  # fmt: skip
+    for key, (lo, hi) in [(key, sc[key]) for key in RANGE_KEYS] + sun + manoeuvres:
         if lo > hi:
             errors.append(f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}")
     tilt = config["vehicle"]["tilt_max_deg"]

@@ -46,11 +46,11 @@ class Landing:
         tr = read_trajectory(self.folder / "trajectory.h5")
         return tr.t, tr.state
 
-    def divert(self) -> dict:
-        """The divert flown, trajectory.h5's `divert` and `divert_*` attributes (names
-        without the prefix: time_s, new_site_m, ...); {"divert": "none"} without one."""
+    def manoeuvre(self) -> dict:
+        """The divert or hover flown: trajectory.h5's `divert`, `hover` ("none" where none was
+        flown) and `divert_*` or `hover_*` attributes (docs/dataset.md)."""
         attrs = read_trajectory(self.folder / "trajectory.h5").attrs
-        return {k.removeprefix("divert_"): attrs[k] for k in attrs if k.startswith("divert")} or {"divert": "none"}
+        return {"divert": "none", "hover": "none"} | {k: attrs[k] for k in attrs if k.startswith(("divert", "hover"))}
 
     def imu(self) -> dict[str, np.ndarray]:
         """imu.h5's streams: t (n,) s, specific_force_b (n, 3) m/s^2, angular_rate_b (n, 3)

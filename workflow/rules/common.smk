@@ -21,7 +21,7 @@ from traj2events.settings.events import events_picture_settings as events_pictur
 from traj2events.settings.events import events_settings as events_settings_of
 from traj2events.settings.imu import imu_settings as imu_settings_of
 from traj2events.settings.poses import pose_settings as pose_settings_of
-from traj2events.settings.poses import scenario_divert
+from traj2events.settings.poses import scenario_manoeuvre
 from traj2events.settings.render import render_settings as render_settings_of
 from traj2events.settings.solve import solve_settings
 
@@ -101,9 +101,9 @@ def render_settings(wildcards):
     return json.dumps(render_settings_of(config, wildcards.scenario, wildcards.id), sort_keys=True)
 
 
-def trajectory_divert(wildcards):
-    """The trajectory's divert, as JSON (null: none; drawn from the config, as its Sun)."""
-    return json.dumps(scenario_divert(config, wildcards.scenario, wildcards.id), sort_keys=True)
+def trajectory_manoeuvre(wildcards):
+    """The trajectory's divert or hover, as JSON (null: none; drawn from the config, as its Sun)."""
+    return json.dumps(scenario_manoeuvre(config, wildcards.scenario, wildcards.id), sort_keys=True)
 
 
 def elevation_grid(wildcards):

@@ -57,11 +57,11 @@ rule camera_poses:
         ENV
     params:
         settings=as_json(pose_settings_of),
-        divert=trajectory_divert,
+        manoeuvre=trajectory_manoeuvre,
         code=code("camera_poses"),
     shell:
         "traj2events upsample --solutions {input} --id {wildcards.id} --settings {params.settings:q} "
-        "--divert {params.divert:q} --output {output} 2> {log}"
+        "--manoeuvre {params.manoeuvre:q} --output {output} 2> {log}"
 
 
 rule imu:

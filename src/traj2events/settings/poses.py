@@ -1,5 +1,5 @@
 """Settings of the camera poses at the frame rate (one trajectory's trajectory.h5), and
-the divert a trajectory flies (drawn per trajectory, as its Sun)."""
+the manoeuvre a trajectory flies, a divert or a hover (drawn per trajectory, as its Sun)."""
 
 from __future__ import annotations
 
@@ -27,3 +27,26 @@ def scenario_divert(config: dict, name: str, trajectory_id: str | None) -> dict 
     drawn = {k: rng.uniform(*ranges[k]) for k in ("time_fraction", "offset_m", "direction_deg")}
     azimuth = math.radians(drawn["direction_deg"])
     return {**drawn, "site_m": [drawn["offset_m"] * math.cos(azimuth), drawn["offset_m"] * math.sin(azimuth)]}
+
+
+def scenario_hover(config: dict, name: str, trajectory_id: str | None) -> dict | None:
+    """The hover of one trajectory of scenario `name` (scenarios.<name>.hover; None: none):
+    its altitude, duration, offset and direction drawn as `scenario_divert`'s, and the
+    point (x, y) m it hovers over."""
+    ranges = config["scenarios"][name].get("hover")
+    if not ranges or trajectory_id is None:
+        return None
+    rng = trajectory_rng(config, name, trajectory_id, "hover")
+    drawn = {k: rng.uniform(*ranges[k]) for k in ("altitude_m", "duration_s", "offset_m", "direction_deg")}
+    azimuth = math.radians(drawn["direction_deg"])
+    return {**drawn, "point_m": [drawn["offset_m"] * math.cos(azimuth), drawn["offset_m"] * math.sin(azimuth)]}
+
+
+def scenario_manoeuvre(config: dict, name: str, trajectory_id: str | None) -> dict | None:
+    """The trajectory's manoeuvre, {"divert": ...} or {"hover": ...} (a scenario has at most
+    one kind), or None."""
+    for kind, draw in (("divert", scenario_divert), ("hover", scenario_hover)):
+        drawn = draw(config, name, trajectory_id)
+        if drawn:
+            return {kind: drawn}
+    return None

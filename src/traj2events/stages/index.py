@@ -29,13 +29,16 @@ def index_row(path: str | os.PathLike) -> dict:
         "final_mass_kg": float(tr.state_nodes[-1, MASS]),
         "continuation": a["continuation"],
         "error_position_m": float(a["error_position_m"]),
-        # The divert flown (trajectory.h5's divert_*; "none" in files from before diverts).
-        "divert": a.get("divert", "none"),
-        **{f"divert_{k}": float(a.get(f"divert_{k}", np.nan)) for k in DIVERT_COLUMNS},
+        # The manoeuvre flown (trajectory.h5's divert_*, hover_*; "none" in files from before them).
+        **{kind: a.get(kind, "none") for kind in MANOEUVRE_COLUMNS},
+        **{f"{kind}_{k}": float(a.get(f"{kind}_{k}", np.nan)) for kind, ks in MANOEUVRE_COLUMNS.items() for k in ks},
     }
 
 
-DIVERT_COLUMNS = ("time_s", "offset_m", "direction_deg", "acceleration_added_max_m_s2")
+MANOEUVRE_COLUMNS = {
+    "divert": ("time_s", "offset_m", "direction_deg", "acceleration_added_max_m_s2"),
+    "hover": ("start_s", "duration_s", "altitude_m", "offset_m", "drift_m"),
+}
 
 
 class NoSolvedSampleError(ValueError):
@@ -65,11 +68,21 @@ def dataset_index(
     with atomic_output(output) as tmp:
         table.to_csv(tmp, index=False, float_format="%.9g")
     log(f"{output}: {len(rows)} trajectories")
-    diverted = table[table["divert"] != "none"] if rows else table
-    if len(diverted):
-        flown = diverted[diverted["divert"].str.startswith("re-targeted")]
-        offset, at, peak = (flown[f"divert_{k}"] for k in ("offset_m", "time_s", "acceleration_added_max_m_s2"))
-        log(f"  diverts: {len(flown)} flown, {len(diverted) - len(flown)} failed (nominal flight kept); re-targeted "
-            f"{offset.median():.0f} m (median) at {at.median():.1f} s, adding up to {peak.median():.2f} m/s^2 "
-            f"(median; {peak.max():.2f} max) to the nominal's horizontal acceleration")  # fmt: skip
+    if rows:
+        log_manoeuvres(table)
     return table
+
+
+def log_manoeuvres(table: pd.DataFrame) -> None:
+    """The scenario's diverts and hovers in a line each: how many flew, their statistics."""
+    for kind, flown_as, stats in (
+        ("divert", "re-targeted", (("offset_m", "m offset"), ("acceleration_added_max_m_s2", "m/s^2 added"))),
+        ("hover", "flown", (("duration_s", "s held"), ("altitude_m", "m up"), ("drift_m", "m drift"))),
+    ):
+        tried = table[table[kind] != "none"]
+        if not len(tried):
+            continue
+        flown = tried[tried[kind].str.startswith(flown_as)]
+        figures = ", ".join(f"{flown[f'{kind}_{k}'].median():.3g} {unit}" for k, unit in stats)
+        log(f"  {kind}s: {len(flown)} flown, {len(tried) - len(flown)} failed (the sample's flight kept); "
+            f"medians {figures}")  # fmt: skip
