@@ -2,6 +2,7 @@
 equals a local run's results, and a rerun has nothing to do. The test installs Debian's
 slurm-wlm and munge when they are missing (root only) and stops the daemons it started."""
 
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -25,12 +26,29 @@ def cluster(tmp_path_factory):
         pytest.skip(f"no single-node SLURM for this test: {exc}")
 
 
+# Loaded by the test's Snakemake (PYTHONPATH): the SLURM plugin polled every 2 s throughout.
+# Its wait grows by 10 s after each check that finds no job finished (a real cluster's
+# courtesy, hard-coded), which on this 2-core node spent most of a run waiting.
+STEADY_POLLING = """import sys
+if sys.argv and sys.argv[0].endswith("snakemake"):
+    try:
+        from snakemake_executor_plugin_slurm import Executor
+    except ImportError:
+        pass
+    else:
+        Executor.next_seconds_between_status_checks = property(lambda self: 2, lambda self, value: None)
+"""
+
+
 def on_slurm(workdir: Path, cluster, *args, profile: str = "slurm") -> subprocess.CompletedProcess:
-    # A 2-core node, polled every 2 s at first instead of the profile's 10 (a real cluster's
-    # courtesy): the plugin's wait grows by 10 s per check that finds nothing finished.
+    # A 2-core node, polled every 2 s instead of the profile's 10 growing by 10 (STEADY_POLLING).
     profile = ["--profile", str(ROOT / "profiles" / profile), "--set-threads", "sample_trajectories=2",
                "--slurm-init-seconds-before-status-checks", "2"]  # fmt: skip
-    return snakemake(workdir, *profile, *args, env=cluster.env, check=False)
+    polling = workdir.parent / f"{workdir.name}-polling"
+    polling.mkdir(exist_ok=True)
+    (polling / "sitecustomize.py").write_text(STEADY_POLLING)
+    path = os.pathsep.join(filter(None, [str(polling), cluster.env.get("PYTHONPATH")]))
+    return snakemake(workdir, *profile, *args, env={**cluster.env, "PYTHONPATH": path}, check=False)
 
 
 @pytest.fixture(scope="module")
