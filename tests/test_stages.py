@@ -111,6 +111,8 @@ def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
                           tmp_path / "index.csv")  # fmt: skip
     assert list(index["divert"].str.split(" ").str[0]) == ["re-targeted", "failed:", "none"]
     assert index["divert_offset_m"][0] == pytest.approx(divert["offset_m"]) and np.isnan(index["divert_time_s"][2])
+    np.testing.assert_allclose(index.loc[0, ["divert_new_site_x_m", "divert_new_site_y_m"]].to_numpy(float),
+                               divert["site_m"])  # fmt: skip
 
 
 def test_a_drawn_hover_is_flown_recorded_and_indexed(built, tmp_path):

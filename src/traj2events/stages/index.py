@@ -32,6 +32,8 @@ def index_row(path: str | os.PathLike) -> dict:
         # The manoeuvre flown (trajectory.h5's divert_*, hover_*; "none" in files from before them).
         **{kind: a.get(kind, "none") for kind in MANOEUVRE_COLUMNS},
         **{f"{kind}_{k}": float(a.get(f"{kind}_{k}", np.nan)) for kind, ks in MANOEUVRE_COLUMNS.items() for k in ks},
+        # Where a divert re-targeted to (the old site is the origin).
+        **dict(zip(("divert_new_site_x_m", "divert_new_site_y_m"), a.get("divert_new_site_m", [np.nan, np.nan]))),
     }
 
 
