@@ -18,6 +18,18 @@ def test_frames_and_fields_follow_the_final_time_and_rates():
     assert plan.disk_bytes["video.mkv"] == pytest.approx(BYTES_PER_PX["video.mkv"] * 64 * 32 * 303)
 
 
+def test_a_hover_or_a_divert_lengthens_the_planned_flights():
+    """A 20 s hold plans 20 + 30 s more flight (costs.yaml), a divert 35 s: what
+    bench/manoeuvres.py measured them adding (+26-28 s beyond the hold; +10-35 s)."""
+    base = {**ONE, "camera": {"fps": 10.0, "width": 64, "height": 32}}
+    hover = {"altitude_m": [50.0, 100.0], "duration_s": [5.0, 20.0], "offset_m": [10.0, 20.0], "direction_deg": [0, 90]}
+    divert = {"time_fraction": [0.4, 0.6], "offset_m": [10.0, 20.0], "direction_deg": [0, 90]}
+    plain = dataset_plan(resolve_config(base)).frames_per_trajectory_max
+    for manoeuvre, extra_s in (({"hover": hover}, 50.0), ({"divert": divert}, 35.0)):
+        config = resolve_config({**base, "scenarios": {"descent": {**ONE["scenarios"]["descent"], **manoeuvre}}})
+        assert dataset_plan(config).frames_per_trajectory_max == plain + extra_s * 10
+
+
 def test_kept_frames_count_and_temporary_ones_do_not():
     kept = dataset_plan(resolve_config({**ONE, "render": {"keep_frames": True}}))
     temporary = dataset_plan(resolve_config({**ONE, "render": {"keep_frames": False}}))

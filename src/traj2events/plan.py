@@ -1,9 +1,9 @@
 """The planned size of a dataset, before any job runs: frames, disk per output kind and
 CPU time, from the config alone. Solved final times are not known yet, so each
-trajectory is taken to last its scenario's `tf_guess_s`. The cost rates come from one
-table, costs.yaml beside this module (measured with the benches it names; the workflow's
-jobs record their own costs, which `bench/job_costs.py` sets beside the table): estimates,
-not bounds.
+trajectory is taken to last its scenario's `tf_guess_s`, plus what its divert or hover
+adds. The cost rates come from one table, costs.yaml beside this module (measured with
+the benches it names; the workflow's jobs record their own costs, which
+`bench/job_costs.py` sets beside the table): estimates, not bounds.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ RENDER_S = tuple(COSTS["cpu_s"]["render_per_frame"])  # (per frame, per pixel), 
 PREVIEW_S_PER_PX = COSTS["cpu_s"]["preview_per_px"]  # of RENDER_S: the preview's encoder
 EVENTS_S = tuple(COSTS["cpu_s"]["events_per_frame"])  # (per frame, per pixel): decoding, emulation, writing
 FIELD_S_PER_PX = COSTS["cpu_s"]["motion_field_per_px"]
+MANOEUVRE_S = COSTS["manoeuvre_s"]  # seconds of flight a hover (beyond its hold) or a divert adds
 STAR_S = COSTS["cpu_s"]["star_in_view"]  # per star a frame projects (scene.stars.stars_in_view)
 MEMORY_MB = {stage: tuple(v) for stage, v in COSTS["memory_mb"].items()}  # (fixed, per pixel)
 ADAPTIVE_EXTRA = tuple(COSTS["adaptive_extra"])  # (a, p, q): see rendered_per_frame
@@ -56,7 +57,7 @@ class Plan:
             f"planned: {self.trajectories} trajectories, {self.frames:,} frames (at most "
             f"{self.frames_per_trajectory_max:,} per trajectory), {self.fields:,} motion fields; "
             f"disk ~{_size(self.total_disk_bytes)} ({disk}); CPU ~{self.total_core_hours:.3g} core-hours ({hours}); "
-            f"each frames.h5 up to {_size(self.frames_h5_live_bytes_max)}. Estimates (t_f = tf_guess_s)."
+            f"each frames.h5 up to {_size(self.frames_h5_live_bytes_max)}. Estimates (t_f = tf_guess_s + manoeuvres)."
         )
 
 
@@ -70,6 +71,17 @@ def _size(n_bytes: float) -> str:
 def _frames(tf_s: float, fps: float) -> int:
     """Frames of a trajectory of t_f seconds: k / fps for k = 0 .. floor(t_f fps)."""
     return int(tf_s * fps) + 1
+
+
+def planned_flight_s(scenario: dict) -> float:
+    """A trajectory's planned duration: tf_guess_s, plus the longest hold and the legs of a
+    hover, or what a divert adds (costs.yaml's manoeuvre_s)."""
+    extra = 0.0
+    if scenario.get("hover"):
+        extra = scenario["hover"]["duration_s"][1] + MANOEUVRE_S["hover_legs"]
+    elif scenario.get("divert"):
+        extra = MANOEUVRE_S["divert"]
+    return scenario["tf_guess_s"] + extra
 
 
 def _fields(frames: int, every_n_frames: int) -> int:
@@ -114,7 +126,7 @@ def dataset_plan(config: dict) -> Plan:
     """The planned size of the (validated) config's dataset."""
     camera, every = config["camera"], config["motion_field"]["every_n_frames"]
     pixels = camera["width"] * camera["height"]
-    per_trajectory = {name: _frames(sc["tf_guess_s"], camera["fps"]) for name, sc in config["scenarios"].items()}
+    per_trajectory = {name: _frames(planned_flight_s(sc), camera["fps"]) for name, sc in config["scenarios"].items()}
     trajectories = sum(sc["n_trajectories"] for sc in config["scenarios"].values())
     frames = sum(n * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
     fields = sum(_fields(n, every) * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
