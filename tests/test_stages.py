@@ -83,6 +83,7 @@ def test_camera_poses_run_at_the_frame_rate_and_land(built):
     assert abs(tr.state[-1, 2]) < 0.5 and tr.attrs["id"] == 0 and tr.attrs["fps"] == 5.0
 
 
+@pytest.mark.slow  # a render, solves or a whole motion field: the full suite's
 def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
     """camera_poses with the trajectory's divert (as the workflow draws it): the poses end
     at the new site, trajectory.h5 says when and where, the index shows it; one out of
@@ -115,6 +116,7 @@ def test_a_drawn_divert_is_flown_recorded_and_indexed(built, config, tmp_path):
                                divert["site_m"])  # fmt: skip
 
 
+@pytest.mark.slow  # a render, solves or a whole motion field: the full suite's
 def test_a_drawn_hover_is_flown_recorded_and_indexed(built, tmp_path):
     from traj2events.settings.poses import scenario_manoeuvre
 
@@ -440,6 +442,7 @@ def test_render_and_emulate_in_one_job_gives_the_two_jobs_files(built, config, t
         events_command(tmp_path / "frames.h5", tmp_path / "x.h5", settings, 5)
 
 
+@pytest.mark.slow  # a render, solves or a whole motion field: the full suite's
 def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(built, config, tmp_path):
     """camera.distortion: frames.h5 rendered through the lens, the motion field's rays and
     the range meter's through it, and every file saying which lens."""
