@@ -454,6 +454,27 @@ def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
     assert sky.max() * np.cos(np.radians(32)) ** 3 / camera.focal_px**2 <= stars.irradiance_w_m2.max()
 
 
+def test_stars_through_a_lens_are_points_on_the_sensor_with_each_frame_its_own_pose():
+    """Behind a lens the stars are not resampled: each frame is the starless one plus the
+    stars projected through the lens (stars.add_stars, tested against the pixels' solid
+    angles), also when frames are drawn one ahead (each with its own pose)."""
+    from traj2events.scene.stars import StarField, add_stars
+
+    camera = Camera(64, 64, 45.0, distortion=Distortion(k1=-0.3, k2=0.05))
+    poses = [camera_pose(state(x=-5000.0, altitude=2000.0, pitch=p)) for p in (80.0, 78.0)]
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), SUN.direction, R_MOON, 140e3, QUICK)
+    stars = StarField.draw(5.0, seed=1)
+    with lens_renderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend="osmesa") as renderer:
+        ahead = list(renderer.render_sequence(poses))
+        alone = [renderer.render(pose) for pose in poses]
+    with lens_renderer(tiles, camera, SUN, ReflectanceParams(), backend="osmesa") as renderer:
+        plain = [renderer.render(pose) for pose in poses]
+    for k, pose in enumerate(poses):
+        expected = add_stars(plain[k].radiance, plain[k].depth_m, stars, camera, pose)
+        assert np.count_nonzero(expected != plain[k].radiance) > 4  # stars in the sky
+        assert np.array_equal(alone[k].radiance, expected) and np.array_equal(ahead[k].radiance, expected)
+
+
 def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
     """render_sequence keeps a frame in flight while the caller works: with render() calls
     in between and tiles evicted (slots refilled) while a frame is in flight, every frame

@@ -62,6 +62,43 @@ def test_an_off_axis_star_keeps_its_power_with_the_pixel_solid_angle():
     assert image.sum() * np.cos(angle) ** 3 / camera.focal_px**2 == pytest.approx(1.0e-8, rel=1e-6)
 
 
+def _solid_angle_of_pixel(camera, i, j):
+    """The solid angle (sr) of pixel (row i, column j): its four corners' rays through the
+    lens (camera.back_project), the spherical quadrilateral's area as two triangles
+    (Van Oosterom & Strackee) - independent of the lens's Jacobian."""
+    corners = [(j - camera.width / 2 + dx, i - camera.height / 2 + dy) for dx, dy in ((0, 0), (1, 0), (1, 1), (0, 1))]
+    rays = [camera.back_project(x, y) for x, y in corners]
+    rays = [r / np.linalg.norm(r) for r in rays]
+
+    def triangle(a, b, c):
+        return 2 * np.arctan2(abs(np.dot(a, np.cross(b, c))), 1 + a @ b + b @ c + c @ a)
+
+    return triangle(rays[0], rays[1], rays[2]) + triangle(rays[0], rays[2], rays[3])
+
+
+def test_a_star_through_a_distorting_lens_lands_where_the_lens_puts_it_with_its_power():
+    """Barrel distortion: the star's splat is centred where the lens projects it and its
+    radiance times each pixel's solid angle (from the pixel's corner rays) sums to its
+    irradiance."""
+    from traj2events.geometry.distortion import Distortion
+
+    camera = Camera(64, 64, 60.0, 0.0, Distortion(k1=-0.3, k2=0.05, p1=0.002))
+    angle = np.radians(25.0)
+    direction = np.array([np.cos(angle), np.sin(angle) * np.cos(0.4), np.sin(angle) * np.sin(0.4)])
+    stars = StarField(direction[None], np.array([1.0e-8]))
+    pose = _looking_down_x()
+    image = star_radiance(stars, camera, pose)
+    lit = np.argwhere(image > 0)
+    weights = image[image > 0]
+    seen = (lit * weights[:, None]).sum(axis=0) / weights.sum()  # (row, column)
+    expected = camera.to_pixel_index(camera.project(pose.to_camera(direction)))[::-1]
+    assert seen == pytest.approx(expected, abs=0.05)
+    power = sum(image[i, j] * _solid_angle_of_pixel(camera, i, j) for i, j in lit)
+    assert power == pytest.approx(1.0e-8, rel=2e-3)
+    pinhole = star_radiance(stars, Camera(64, 64, 60.0, 0.0), pose)
+    assert np.abs(np.argwhere(pinhole > 0).mean(axis=0) - seen).max() > 1.0  # the lens moved it
+
+
 def test_terrain_hides_stars_and_stars_behind_the_camera_are_not_drawn():
     camera = Camera(8, 6, 45.0, 0.0)
     stars = StarField(np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]]), np.array([1e-8, 1e-8]))

@@ -2,7 +2,8 @@
 focal length whose image covers every sensor pixel's ray (`Camera.pinhole_cover`), then
 resampled onto the sensor's grid, each pixel at its own ray (`Camera.rays`), so that
 frames.h5 holds what the sensor behind that lens records (docs/geometry.md "Lens
-distortion").
+distortion"). Stars, points, are not resampled: each is projected through the lens onto
+the sensor's sky pixels afterwards (stars.add_stars with the lens's camera).
 
 Radiance: bilinear between the four pinhole samples around the ray. Depth (along the
 boresight): bilinear in inverse depth, which is exact on a plane (1/Z is affine in the
@@ -11,11 +12,13 @@ image), over the terrain samples only; a pixel whose four samples are mostly sky
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Iterable, Iterator
 
 import numpy as np
 
 from ..geometry.camera import Camera, CameraPose
+from ..scene.stars import StarField, add_stars
 from .draw import Frame, TerrainRenderer
 
 
@@ -62,25 +65,36 @@ class LensResampling:
 
 
 class LensRenderer:
-    """A TerrainRenderer drawing the pinhole cover of `camera`, its frames resampled onto
-    `camera`'s sensor (`render`, `render_sequence`, `backend`, `gl_renderer` as the
-    renderer's); it owns the renderer it wraps."""
+    """A TerrainRenderer drawing the pinhole cover of `camera` (without stars), its frames
+    resampled onto `camera`'s sensor and `stars` (None: none) added through the lens
+    (`render`, `render_sequence`, `backend`, `gl_renderer` as the renderer's); it owns the
+    renderer it wraps."""
 
-    def __init__(self, renderer: TerrainRenderer, camera: Camera):
-        self.renderer, self.camera = renderer, camera
+    def __init__(self, renderer: TerrainRenderer, camera: Camera, stars: StarField | None = None):
+        self.renderer, self.camera, self.stars = renderer, camera, stars
         self.resampling = LensResampling(camera, renderer.camera)
         self.backend, self.gl_renderer = renderer.backend, renderer.gl_renderer
 
-    def _onto_sensor(self, frame: Frame) -> Frame:
+    def _onto_sensor(self, frame: Frame, pose: CameraPose) -> Frame:
         r = self.resampling
-        return Frame(r.radiance(frame.radiance), r.depth(frame.depth_m), frame.n_tiles, frame.n_triangles)
+        radiance, depth = r.radiance(frame.radiance), r.depth(frame.depth_m)
+        if self.stars is not None:
+            radiance = add_stars(radiance, depth, self.stars, self.camera, pose)
+        return Frame(radiance, depth, frame.n_tiles, frame.n_triangles)
 
     def render(self, pose: CameraPose) -> Frame:
-        return self._onto_sensor(self.renderer.render(pose))
+        return self._onto_sensor(self.renderer.render(pose), pose)
 
     def render_sequence(self, poses: Iterable[CameraPose]) -> Iterator[Frame]:
-        for frame in self.renderer.render_sequence(poses):
-            yield self._onto_sensor(frame)
+        drawn = deque()  # the poses handed to the renderer, whose frames come back in order
+
+        def remembered():
+            for pose in poses:
+                drawn.append(pose)
+                yield pose
+
+        for frame in self.renderer.render_sequence(remembered()):
+            yield self._onto_sensor(frame, drawn.popleft())
 
     def close(self) -> None:
         self.renderer.close()
@@ -97,4 +111,5 @@ def lens_renderer(tiles, camera: Camera, *args, **kwargs) -> TerrainRenderer | L
     renderer itself for a pinhole, else a LensRenderer around a renderer of its pinhole cover."""
     if camera.distortion.is_pinhole:
         return TerrainRenderer(tiles, camera, *args, **kwargs)
-    return LensRenderer(TerrainRenderer(tiles, camera.pinhole_cover(), *args, **kwargs), camera)
+    stars = kwargs.pop("stars", None)
+    return LensRenderer(TerrainRenderer(tiles, camera.pinhole_cover(), *args, **kwargs), camera, stars)

@@ -99,7 +99,7 @@ class StarField:
 def star_splat(stars: StarField, camera: Camera, pose: CameraPose) -> tuple[np.ndarray, np.ndarray]:
     """The stars in view as (flat pixel indices, radiance W m^-2 sr^-1) pairs, four per
     star (bilinear), before any masking; an index may repeat."""
-    stars = stars.in_view(camera, pose)
+    stars = stars.in_view(camera.pinhole_cover(), pose)  # a lens's sensor sees its cover's cone at most
     d_cam = stars.directions @ pose.rotation  # inertial -> camera (rotation is camera -> inertial)
     d_cam = d_cam[d_cam[:, 2] > 1e-6]
     irradiance = stars.irradiance_w_m2[stars.directions @ pose.rotation[:, 2] > 1e-6]
@@ -107,9 +107,17 @@ def star_splat(stars: StarField, camera: Camera, pose: CameraPose) -> tuple[np.n
     inside = (
         (col_row[:, 0] > -1) & (col_row[:, 0] < camera.width) & (col_row[:, 1] > -1) & (col_row[:, 1] < camera.height)
     )
+    lens = camera.distortion
+    if not lens.is_pinhole:  # beyond the rays through the image's edges the polynomial folds back
+        a_max, b_max = camera.reach()
+        inside &= (np.abs(d_cam[:, 0] / d_cam[:, 2]) <= a_max + 1 / camera.focal_px) & (
+            np.abs(d_cam[:, 1] / d_cam[:, 2]) <= b_max + 1 / camera.focal_px
+        )
     col_row, irradiance, d = col_row[inside], irradiance[inside], d_cam[inside]
     cos_theta = d[:, 2] / np.linalg.norm(d, axis=1)
     radiance = irradiance * camera.focal_px**2 / cos_theta**3  # E / Omega_px
+    if not lens.is_pinhole:  # a pixel behind the lens spans 1 / det J of a pinhole's solid angle
+        radiance = radiance * lens.determinant(d[:, 0] / d[:, 2], d[:, 1] / d[:, 2])
     j0, i0 = np.floor(col_row[:, 0]).astype(np.int64), np.floor(col_row[:, 1]).astype(np.int64)
     fx, fy = col_row[:, 0] - j0, col_row[:, 1] - i0
     index, value = [], []
