@@ -221,14 +221,9 @@ def _lens_errors(camera: dict) -> list[str]:
     """A distortion whose model folds over inside the image, or needs a pinhole image more
     than 4x the sensor's to cover it (Camera.pinhole_cover), before any job starts."""
     from .geometry.camera import Camera
-    from .geometry.distortion import distortion_from
 
-    distortion = distortion_from(camera["distortion"])
-    if distortion.is_pinhole:
-        return []
     try:
-        size = (camera["width"], camera["height"], camera["fov_deg"], camera["mount_height_m"])
-        Camera(*size, distortion).pinhole_cover()
+        Camera.from_settings(camera).pinhole_cover()  # a pinhole: itself, nothing to check
     except ValueError as exc:
         return [f"config key '{exc}".replace(":", "':", 1)]
     return []

@@ -20,26 +20,27 @@ def scenario_divert(config: dict, name: str, trajectory_id: str | None) -> dict 
     flies none): its time fraction, offset and direction drawn uniformly from their ranges
     by the dataset's seed, the scenario and `trajectory_id`, and the new site (x, y) m;
     without an id (a scenario's settings), none."""
-    ranges = config["scenarios"][name].get("divert")
-    if not ranges or trajectory_id is None:
-        return None
-    rng = trajectory_rng(config, name, trajectory_id, "divert")
-    drawn = {k: rng.uniform(*ranges[k]) for k in ("time_fraction", "offset_m", "direction_deg")}
-    azimuth = math.radians(drawn["direction_deg"])
-    return {**drawn, "site_m": [drawn["offset_m"] * math.cos(azimuth), drawn["offset_m"] * math.sin(azimuth)]}
+    return _drawn(config, name, trajectory_id, "divert", ("time_fraction", "offset_m", "direction_deg"), "site_m")
 
 
 def scenario_hover(config: dict, name: str, trajectory_id: str | None) -> dict | None:
     """The hover of one trajectory of scenario `name` (scenarios.<name>.hover; None: none):
     its altitude, duration, offset and direction drawn as `scenario_divert`'s, and the
     point (x, y) m it hovers over."""
-    ranges = config["scenarios"][name].get("hover")
+    keys = ("altitude_m", "duration_s", "offset_m", "direction_deg")
+    return _drawn(config, name, trajectory_id, "hover", keys, "point_m")
+
+
+def _drawn(config: dict, name: str, trajectory_id: str | None, kind: str, keys: tuple, point_key: str) -> dict | None:
+    """scenarios.<name>.<kind>'s `keys` drawn uniformly in that order from the trajectory's
+    own stream, and the point `offset_m` from the site towards `direction_deg` (x, y) m."""
+    ranges = config["scenarios"][name].get(kind)
     if not ranges or trajectory_id is None:
         return None
-    rng = trajectory_rng(config, name, trajectory_id, "hover")
-    drawn = {k: rng.uniform(*ranges[k]) for k in ("altitude_m", "duration_s", "offset_m", "direction_deg")}
+    rng = trajectory_rng(config, name, trajectory_id, kind)
+    drawn = {k: rng.uniform(*ranges[k]) for k in keys}
     azimuth = math.radians(drawn["direction_deg"])
-    return {**drawn, "point_m": [drawn["offset_m"] * math.cos(azimuth), drawn["offset_m"] * math.sin(azimuth)]}
+    return {**drawn, point_key: [drawn["offset_m"] * math.cos(azimuth), drawn["offset_m"] * math.sin(azimuth)]}
 
 
 def scenario_manoeuvre(config: dict, name: str, trajectory_id: str | None) -> dict | None:

@@ -19,7 +19,6 @@ from .. import __version__
 from ..formats.frames import FramesWriter
 from ..formats.trajectory import read_trajectory
 from ..geometry.camera import Camera
-from ..geometry.distortion import distortion_from
 from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
 from ..renderer.draw import TerrainRenderer
@@ -95,7 +94,7 @@ class RenderSettings:
         azimuths = int(self.scattered_light["azimuths"])
         tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache, azimuths)
         return (
-            Camera(self.width, self.height, self.fov_deg, self.mount_height_m, distortion_from(self.distortion)),
+            Camera.from_settings(vars(self)),
             tiles,
             sun,
             ReflectanceParams(**self.reflectance),

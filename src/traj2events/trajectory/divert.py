@@ -17,10 +17,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .dynamics import Dynamics, Vehicle
-from .legs import Nodes, fly_leg, joined, position_shift
+from .legs import Nodes, fly_leg, joined, landing_miss
 from .ocp import OcpSettings
 from .scenarios import SampleResult
-from .state import POSITION, VELOCITY
+from .state import VELOCITY
 from .upsample import ReintegratedStates, final_state_error
 
 
@@ -83,9 +83,7 @@ def divert_flight(
         errors = final_state_error(dynamics, t, state, control)
         return DivertedFlight(t, state, control, divert, float(t[k]), result, *errors)
     nodes = joined((t[: k + 1], state[: k + 1], control[: k + 1]), leg)
-    miss = ReintegratedStates(dynamics, nodes[0], nodes[1][0], nodes[2]).final_state - position_shift(site)
-    return DivertedFlight(*nodes, divert, float(t[k]), result, float(np.linalg.norm(miss[POSITION])),
-                          float(np.linalg.norm(miss[VELOCITY])))  # fmt: skip
+    return DivertedFlight(*nodes, divert, float(t[k]), result, *landing_miss(dynamics, nodes, site))
 
 
 def horizontal_acceleration_m_s2(t: np.ndarray, state: np.ndarray) -> np.ndarray:

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .dynamics import Dynamics, Vehicle
-from .legs import Nodes, fly_leg, joined
+from .legs import Nodes, fly_leg, joined, landing_miss
 from .ocp import OcpSettings
 from .scenarios import SampleResult
-from .state import MASS, POSITION, VELOCITY, Z
+from .state import MASS, POSITION, Z
 from .upsample import ReintegratedStates, final_state_error
 
 HOVER_NODE_S = 1.0  # spacing of the hover's nodes (its thrust is linear between them)
@@ -99,10 +99,8 @@ def hover_flight(vehicle: Vehicle, settings: OcpSettings, sample: Nodes, hover: 
         errors = final_state_error(dynamics, t, state, control)
         return HoverFlight(t, state, control, hover, np.nan, np.nan, results, *errors)
     nodes = joined(leg_1, held, leg_3)
-    flown = ReintegratedStates(dynamics, nodes[0], nodes[1][0], nodes[2]).final_state
-    start = float(leg_1[0][-1])
-    return HoverFlight(*nodes, hover, start, start + hover.duration_s, results,
-                       float(np.linalg.norm(flown[POSITION])), float(np.linalg.norm(flown[VELOCITY])))  # fmt: skip
+    start, miss = float(leg_1[0][-1]), landing_miss(dynamics, nodes, np.zeros(3))
+    return HoverFlight(*nodes, hover, start, start + hover.duration_s, results, *miss)
 
 
 def hover_drift_m(t: np.ndarray, state: np.ndarray, start_s: float, end_s: float) -> tuple[float, float]:

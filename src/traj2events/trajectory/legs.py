@@ -18,8 +18,8 @@ import numpy as np
 from .dynamics import N_STATE, Dynamics, Vehicle
 from .ocp import BoundaryConditions, LandingProblem, OcpSettings, Solution
 from .scenarios import Acceptance, SampleResult, solve_by_continuation
-from .state import MASS, POSITION, YAW
-from .upsample import ShootingCheck
+from .state import MASS, POSITION, VELOCITY, YAW
+from .upsample import ReintegratedStates, ShootingCheck
 
 Nodes = tuple[np.ndarray, np.ndarray, np.ndarray]  # t (N,) s, state (N, 13), control (N, 4)
 COLD_DURATION_S = 30.0  # a leg's duration guess without nodes to start from
@@ -85,6 +85,13 @@ def joined(*legs: Nodes) -> Nodes:
         state.append(leg[1])
         control.append(leg[2])
     return np.concatenate(t), np.concatenate(state), np.concatenate(control)
+
+
+def landing_miss(dynamics: Dynamics, nodes: Nodes, target_m: np.ndarray) -> tuple[float, float]:
+    """(m, m/s): the whole flight re-integrated from its first state with its controls,
+    its final position's distance from `target_m` and its final speed."""
+    flown = ReintegratedStates(dynamics, nodes[0], nodes[1][0], nodes[2]).final_state
+    return float(np.linalg.norm(flown[POSITION] - target_m)), float(np.linalg.norm(flown[VELOCITY]))
 
 
 def _solution(t: np.ndarray, state: np.ndarray, control: np.ndarray, settings: OcpSettings) -> Solution:
