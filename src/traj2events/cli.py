@@ -31,9 +31,7 @@ def _settings(kind, value: str):
 
 
 def _camera(settings: dict):
-    from .geometry.camera import Camera
-
-    return Camera.from_settings(settings)
+    return importlib.import_module(".geometry.camera", __package__).Camera.from_settings(settings)
 
 
 def cmd_check_config(args) -> int:
@@ -41,9 +39,9 @@ def cmd_check_config(args) -> int:
     from .plan import dataset_plan
 
     config = load_config(*args.config)
-    n = sum(sc["n_trajectories"] for sc in config["scenarios"].values())
-    print(f"{', '.join(args.config)}: valid ({len(config['scenarios'])} scenarios, {n} trajectories)")
-    print(dataset_plan(config).summary())
+    plan = dataset_plan(config)
+    print(f"{', '.join(args.config)}: valid ({len(config['scenarios'])} scenarios, {plan.trajectories} trajectories)")
+    print(plan.summary())
     return 0
 
 
@@ -144,8 +142,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--settings", required=True, help=settings_help)
     p.add_argument("--output", "-o", required=True, help="base.h5 (nodes only)")
     p.add_argument("--record-failure", action="store_true", help="if the problem does not solve, write base.h5 "
-                   "recording it (solver_success 0) and exit 0 (the workflow does, so that the failure reaches "
-                   "summary.csv); default: exit 1 and write nothing")  # fmt: skip
+                   "recording it, exit 0 (the workflow does: summary.csv says so); default: exit 1")  # fmt: skip
     p.set_defaults(func=cmd_base)
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
@@ -166,8 +163,17 @@ def build_parser() -> argparse.ArgumentParser:
     poses = lambda a: settings_from(a, POSES)  # noqa: E731
     p.set_defaults(func=_calls("camera_poses", "poses_command", "solutions", "id", poses, "output", "manoeuvre"))
 
+    p = sub.add_parser("poses", help="camera poses at the frame rate from a pose file or SPICE kernels (a scenario's "
+                       "`poses`, docs/trajectories.md \"External poses\")")  # fmt: skip
+    p.add_argument("source", help="CSV or HDF5 of time, position, attitude; a trajectory.h5; a SPICE meta-kernel (.tm)")
+    p.add_argument("--id", type=int, default=0, help="the trajectory's id (default 0)")
+    p.add_argument("--settings", type=json_or_null, required=True, help="JSON (or @file): fps, mount_height_m, "
+                   "moon_radius_m, g_m_s2, scenario, seed, spice (settings.poses.external_pose_settings)")  # fmt: skip
+    p.add_argument("--output", "-o", required=True, help="trajectory.h5")
+    p.set_defaults(func=_calls("external_poses", "external_poses", "source", "id", "settings", "output"))
+
     p = sub.add_parser("imu", help="imu.h5: the IMU's specific force and body rates, and the altitude, noise-free")
-    p.add_argument("trajectory", help="trajectory.h5 (its nodes are re-integrated at the IMU's rate)")
+    p.add_argument("trajectory", help="trajectory.h5 (its flight is sampled at the IMU's rate)")
     add_settings(p, IMU, "the IMU's rate and the sphere")
     p.add_argument("--output", "-o", required=True, help="imu.h5")
     p.add_argument("--seed", type=int, default=0, help="the IMU errors' seed (default 0)")
@@ -201,14 +207,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--flo-dir", required=True, help="folder for the Middlebury .flo displacements")
     p.set_defaults(func=cmd_motion_field)
 
-    p = sub.add_parser(
-        "events",
-        help="emulate an event camera on a video, a folder of images or frames.h5",
-        description="Turn frames into the event stream of an event camera (the pixel model of "
-        "docs/events.md). INPUT: frames.h5 from `traj2events render` (linear radiance, the HDR "
-        "path), any video ffmpeg reads (8-bit grey, as v2e), or a folder of images (8-bit grey, "
-        "sorted by name; needs --fps). Writes events.h5 in the DSEC layout.",
-    )
+    p = sub.add_parser("events", help="emulate an event camera on a video, a folder of images or frames.h5",
+                       description="Turn frames into the event stream of an event camera (the pixel model of "
+                       "docs/events.md). INPUT: frames.h5 from `traj2events render` (linear radiance, the HDR path), "
+                       "any video ffmpeg reads (8-bit grey, as v2e), or a folder of images (8-bit grey, sorted by "
+                       "name; needs --fps). Writes events.h5 in the DSEC layout.")  # fmt: skip
     p.add_argument("input", help="frames.h5, a video file, or a folder of images")
     p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc)")
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
@@ -242,7 +245,7 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--trajectory", help="trajectory.h5: its end time and title (default: events.h5's end, its name)")
     add_settings(q, EVENTS_PICTURE, "the window")
     q = kinds.add_parser("dataset", help="trajectories.png: height and pitch of every scenario")
-    q.add_argument("solutions", nargs="+", help="solutions.h5 of each scenario")
+    q.add_argument("solutions", nargs="*", help="solutions.h5 of each solved scenario")
     for q in kinds.choices.values():
         q.add_argument("--output", "-o", required=True, help="PNG")
     p.set_defaults(func=cmd_picture)
@@ -254,8 +257,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_calls("index", "dataset_index", "trajectories", "output", "samples"))
 
     p = sub.add_parser("summary", help="one CSV row per scenario: counts, failures, final mass, t_f, errors")
-    p.add_argument("--solutions", nargs="+", required=True, help="solutions.h5 of each scenario")
-    p.add_argument("--tables", nargs="+", required=True, help="samples.csv of each scenario, same order")
+    p.add_argument("--solutions", nargs="*", required=True, help="solutions.h5 of each solved scenario")
+    p.add_argument("--tables", nargs="*", required=True, help="samples.csv of each, same order")
     p.add_argument("--output", "-o", required=True, help="summary.csv")
     p.set_defaults(func=_calls("summary", "dataset_summary", "solutions", "tables", "output"))
 
@@ -286,11 +289,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run() -> None:
-    """The process's entry point (the `traj2events` script, `python -m traj2events`): main,
-    then exit with its status. Every object left is frozen out of the garbage collector
-    first: with numba's kernels loaded, the interpreter's shutdown otherwise takes a
-    noticeable part of a short events job. Outputs are closed by then;
-    reference counts still free what they can."""
+    """The entry point (`traj2events`, `python -m traj2events`): main, then exit with its status. Objects left
+    are frozen out of the garbage collector first: with numba loaded, shutdown takes much of a short job."""
     status = main()
     gc.freeze()
     sys.exit(status)

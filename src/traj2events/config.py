@@ -11,6 +11,7 @@ job runs; `validate_config` turns the first problem into one line such as
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -103,6 +104,8 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
         )
     sun = [(f"sun.{k}", sc["sun"][k]) for k in ("azimuth_deg", "elevation_deg") if isinstance(sc["sun"][k], list)]
+    if sc.get("poses"):
+        return errors + _external_errors(config, name, sc, sun)
     manoeuvres = [(f"{kind}.{k}", v) for kind in ("divert", "hover") for k, v in (sc.get(kind) or {}).items()]
     kinds = [kind for kind in ("divert", "hover") if sc.get(kind)]
     if kinds and config["upsampling"]["method"] != "reintegrate":
@@ -137,6 +140,39 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
     if sc["altitude_m"][0] <= 0:
         errors.append(f"config key 'scenarios.{name}.altitude_m': expected a start above the ground (> 0 m), "
                       f"got {sc['altitude_m']}")  # fmt: skip
+    return errors
+
+
+def _external_errors(config: dict, name: str, sc: dict, sun: list) -> list[str]:
+    """An external scenario (scenarios.<name>.poses): no OCP key beside it, SPICE settings
+    for its meta-kernels, every file read now (settings.poses.external_extents: a file that
+    cannot be used stops the run before any job), at least 2 frames per flight."""
+    from .formats.poses import FORMATS
+    from .settings.poses import OCP_SCENARIO_KEYS, external_extents
+
+    errors = [f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}"
+              for key, (lo, hi) in sun if lo > hi]  # fmt: skip
+    ocp_keys = [k for k in OCP_SCENARIO_KEYS if k in sc and sc[k] is not None]
+    if ocp_keys:
+        return errors + [f"config key 'scenarios.{name}.poses': a scenario flies its files' poses or the OCP's, not "
+                         f"both: it also has {ocp_keys[0]!r} (a default scenario's name brings its keys: choose a "
+                         "new name)"]  # fmt: skip
+    for i, path in enumerate(sc["poses"]["files"]):
+        suffix = os.path.splitext(path)[1].lower()
+        if suffix not in FORMATS:
+            return errors + [f"config key 'scenarios.{name}.poses.files[{i}]': expected a file ending in one of "
+                             f"{sorted(FORMATS)}, got {path!r}"]  # fmt: skip
+        if FORMATS[suffix] == "spice" and not sc["poses"].get("spice"):
+            return errors + [f"config key 'scenarios.{name}.poses.spice': {path} is a SPICE meta-kernel: expected "
+                             "{target, camera_frame} to read it, got null"]  # fmt: skip
+    try:
+        extents = external_extents(config, name)
+    except (ValueError, OSError) as exc:
+        return errors + [f"config key 'scenarios.{name}.poses.files': {exc}"]
+    for path, extent in zip(sc["poses"]["files"], extents):
+        if extent["tf_s"] * config["camera"]["fps"] < 1:
+            errors.append(f"config key 'camera.fps': expected at least 2 frames per trajectory, {path} lasts "
+                          f"{extent['tf_s']:.3g} s")  # fmt: skip
     return errors
 
 
@@ -184,10 +220,16 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append(f"config key 'terrain.boulder_density_k': boulders would cover {covered:.0%} of the ground "
                       f"(pi/4 of D^2 summed over N(>D) = K D^-slope from the smallest to the largest); "
                       f"expected at most 50 %, got K = {terrain['boulder_density_k']}")  # fmt: skip
-    flight_ms = 1000 * min(sc["tf_guess_s"] for sc in config["scenarios"].values())
+    for name, sc in config["scenarios"].items():
+        errors += _scenario_errors(config, name, sc)
+    if errors:
+        return errors
+    from .plan import planned_flight_s
+
+    flight_ms = 1000 * min(planned_flight_s(config, name, shortest=True) for name in config["scenarios"])
     if config["events"]["window_ms"] > flight_ms:
         errors.append(f"config key 'events.window_ms': expected at most the shortest flight, {flight_ms:g} ms "
-                      f"(scenarios' tf_guess_s), got {config['events']['window_ms']}")  # fmt: skip
+                      f"(tf_guess_s, pose files' durations), got {config['events']['window_ms']}")  # fmt: skip
     pixel = config["events"]["pixel"]
     if pixel["hot_pixel_fraction"] > 0 and not pixel["hot_pixel_hz"] > 0:
         errors.append("config key 'events.pixel.hot_pixel_hz': expected > 0 when events.pixel.hot_pixel_fraction > 0")
@@ -212,8 +254,6 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
     errors += _display_errors(config) + _lens_errors(config["camera"])
-    for name, sc in config["scenarios"].items():
-        errors += _scenario_errors(config, name, sc)
     return errors or _elevation_grid_error(terrain)
 
 

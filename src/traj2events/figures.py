@@ -65,9 +65,11 @@ MIN_SAMPLES_FOR_BAND = 3  # a standard deviation of fewer samples says nothing
 def dataset_figure(solution_sets: list[dict]) -> plt.Figure:
     """Height and pitch against normalised time per scenario: one sample, mean, and the
     +-3 sigma band (with at least MIN_SAMPLES_FOR_BAND samples; height clipped at the ground)."""
-    fig, axes = plt.subplots(
-        2, len(solution_sets), figsize=(4.2 * len(solution_sets), 6), squeeze=False, sharex=True, layout="constrained"
-    )
+    columns = max(len(solution_sets), 1)
+    fig, axes = plt.subplots(2, columns, figsize=(4.2 * columns, 6), squeeze=False, sharex=True, layout="constrained")
+    if not solution_sets:  # every scenario flies pose files (scenarios.<name>.poses)
+        axes[0, 0].set_title("no scenario solved by the OCP")
+        return fig
     for col, data in enumerate(solution_sets):
         solved = solved_samples(data)
         name = data["attrs"]["scenario"]

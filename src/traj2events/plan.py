@@ -1,9 +1,10 @@
 """The planned size of a dataset, before any job runs: frames, disk per output kind and
 CPU time, from the config alone. Solved final times are not known yet, so each
 trajectory is taken to last its scenario's `tf_guess_s`, plus what its divert or hover
-adds. The cost rates come from one table, costs.yaml beside this module (measured with
-the benches it names; the workflow's jobs record their own costs, which
-`bench/job_costs.py` sets beside the table): estimates, not bounds.
+adds; an external scenario's, its pose file's duration. The cost rates come from one
+table, costs.yaml beside this module (measured with the benches it names; the workflow's
+jobs record their own costs, which `bench/job_costs.py` sets beside the table):
+estimates, not bounds.
 """
 
 from __future__ import annotations
@@ -73,15 +74,32 @@ def _frames(tf_s: float, fps: float) -> int:
     return int(tf_s * fps) + 1
 
 
-def planned_flight_s(scenario: dict) -> float:
-    """A trajectory's planned duration: tf_guess_s, plus the longest hold and the legs of a
-    hover, or what a divert adds (costs.yaml's manoeuvre_s)."""
+def planned_flight_s(config: dict, name: str, shortest: bool = False) -> float:
+    """A trajectory of scenario `name`'s planned duration: tf_guess_s, plus the longest hold
+    and the legs of a hover, or what a divert adds (costs.yaml's manoeuvre_s); an external
+    scenario's longest file (`shortest`: its shortest; a solved one's tf_guess_s alone)."""
+    from .settings.poses import external_extents
+
+    scenario = config["scenarios"][name]
+    if scenario.get("poses"):
+        durations = [extent["tf_s"] for extent in external_extents(config, name)]
+        return min(durations) if shortest else max(durations)
     extra = 0.0
-    if scenario.get("hover"):
+    if scenario.get("hover") and not shortest:
         extra = scenario["hover"]["duration_s"][1] + MANOEUVRE_S["hover_legs"]
-    elif scenario.get("divert"):
+    elif scenario.get("divert") and not shortest:
         extra = MANOEUVRE_S["divert"]
     return scenario["tf_guess_s"] + extra
+
+
+def trajectory_frames(config: dict, name: str) -> list[int]:
+    """Planned frames of each trajectory of scenario `name`."""
+    from .settings.poses import external_extents, scenario_count
+
+    fps = config["camera"]["fps"]
+    if config["scenarios"][name].get("poses"):
+        return [_frames(extent["tf_s"], fps) for extent in external_extents(config, name)]
+    return [_frames(planned_flight_s(config, name), fps)] * scenario_count(config, name)
 
 
 def _fields(frames: int, every_n_frames: int) -> int:
@@ -126,10 +144,9 @@ def dataset_plan(config: dict) -> Plan:
     """The planned size of the (validated) config's dataset."""
     camera, every = config["camera"], config["motion_field"]["every_n_frames"]
     pixels = camera["width"] * camera["height"]
-    per_trajectory = {name: _frames(planned_flight_s(sc), camera["fps"]) for name, sc in config["scenarios"].items()}
-    trajectories = sum(sc["n_trajectories"] for sc in config["scenarios"].values())
-    frames = sum(n * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
-    fields = sum(_fields(n, every) * config["scenarios"][name]["n_trajectories"] for name, n in per_trajectory.items())
+    per_trajectory = [n for name in config["scenarios"] for n in trajectory_frames(config, name)]
+    trajectories = len(per_trajectory)
+    frames, fields = sum(per_trajectory), sum(_fields(n, every) for n in per_trajectory)
     px_frames, px_fields = float(pixels) * frames, float(pixels) * fields
     rendered = rendered_per_frame(config)  # frames.h5 and the emulator get the adaptive frames too
     disk = {
@@ -150,8 +167,8 @@ def dataset_plan(config: dict) -> Plan:
         "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels) / 3600,
         "motion field": px_fields * FIELD_S_PER_PX / 3600,
     }
-    return Plan(trajectories, frames, max(per_trajectory.values()), fields, disk,
-                BYTES_PER_PX["frames.h5"] * pixels * max(per_trajectory.values()) * rendered, hours)  # fmt: skip
+    return Plan(trajectories, frames, max(per_trajectory), fields, disk,
+                BYTES_PER_PX["frames.h5"] * pixels * max(per_trajectory) * rendered, hours)  # fmt: skip
 
 
 def too_large(plan: Plan) -> str | None:
@@ -182,10 +199,8 @@ def job_resources(config: dict, stage: str, scenario: str | None, threads: int =
         return {key: sum(part[key] for part in parts) for key in ("mem_mb", "runtime")}
     camera = config["camera"]
     pixels = camera["width"] * camera["height"]
-    if scenario is None:
-        tf = max(sc["tf_guess_s"] for sc in config["scenarios"].values())
-    else:
-        tf = config["scenarios"][scenario]["tf_guess_s"]
+    names = list(config["scenarios"]) if scenario is None else [scenario]
+    tf = max(planned_flight_s(config, name) for name in names)
     frames = _frames(tf, camera["fps"])
     fields = _fields(frames, config["motion_field"]["every_n_frames"])
     rendered = rendered_per_frame(config)

@@ -20,6 +20,7 @@ from traj2events.settings.camera import motion_field_settings as motion_field_se
 from traj2events.settings.events import events_picture_settings as events_picture_settings_of
 from traj2events.settings.events import events_settings as events_settings_of
 from traj2events.settings.imu import imu_settings as imu_settings_of
+from traj2events.settings.poses import external_pose_settings, is_external, scenario_count, trajectory_source
 from traj2events.settings.poses import pose_settings as pose_settings_of
 from traj2events.settings.poses import scenario_manoeuvre
 from traj2events.settings.render import render_settings as render_settings_of
@@ -72,7 +73,15 @@ else:
     # (e.g. .venv/bin), so that `.venv/bin/snakemake` works without activating the venv.
     shell.prefix(f'set -euo pipefail; export PATH={shlex.quote(str(Path(sys.executable).parent))}:"$PATH"; ')
 SCENARIOS = list(config["scenarios"])
+# Solved by the OCP (base, samples, summary), or flown from pose files (scenarios.<name>.poses).
+SOLVED = [name for name in SCENARIOS if not is_external(config, name)]
+EXTERNAL = [name for name in SCENARIOS if is_external(config, name)]
 ENV = "../../envs/trajectories.yaml"
+
+
+def one_of(names):
+    """A wildcard constraint matching exactly these names (none: nothing)."""
+    return "|".join(names) if names else "(?!)"
 
 
 wildcard_constraints:
@@ -184,8 +193,24 @@ def trajectory_seed(wildcards):
 
 def trajectory_ids(scenario):
     """The trajectories of a scenario, 0000 .. n-1: known from the config (failed samples
-    are drawn again), so the whole DAG is static and per-trajectory jobs can be grouped."""
-    return [f"{i:04d}" for i in range(config["scenarios"][scenario]["n_trajectories"])]
+    are drawn again; one per pose file), so the whole DAG is static and per-trajectory jobs
+    can be grouped."""
+    return [f"{i:04d}" for i in range(scenario_count(config, scenario))]
+
+
+def pose_file(wildcards):
+    """An external trajectory's pose file (so that editing it rebuilds the trajectory)."""
+    return trajectory_source(config, wildcards.scenario, wildcards.id)
+
+
+def external_settings(wildcards):
+    """Everything an external trajectory's poses depend on, as JSON."""
+    return json.dumps(external_pose_settings(config, wildcards.scenario), sort_keys=True)
+
+
+def sample_table(wildcards):
+    """The index's samples.csv: a solved scenario's (none for an external one)."""
+    return [] if is_external(config, wildcards.scenario) else [f"results/{wildcards.scenario}/samples.csv"]
 
 
 PER_TRAJECTORY = [

@@ -78,7 +78,7 @@ rule events_picture:
 
 rule dataset_picture:
     input:
-        expand("results/{scenario}/solutions.h5", scenario=SCENARIOS),
+        expand("results/{scenario}/solutions.h5", scenario=SOLVED),
     output:
         report(
             "results/figures/trajectories.png",

@@ -53,6 +53,8 @@ rule camera_poses:
         "results/logs/{scenario}/{id}/camera_poses.log",
     benchmark:
         "results/benchmarks/{scenario}/{id}/camera_poses.tsv"
+    wildcard_constraints:
+        scenario=one_of(SOLVED),
     conda:
         ENV
     params:
@@ -62,6 +64,26 @@ rule camera_poses:
     shell:
         "traj2events upsample --solutions {input} --id {wildcards.id} --settings {params.settings:q} "
         "--manoeuvre {params.manoeuvre:q} --output {output} 2> {log}"
+
+
+rule external_poses:
+    input:
+        pose_file,
+    output:
+        "results/{scenario}/{id}/trajectory.h5",
+    log:
+        "results/logs/{scenario}/{id}/external_poses.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/external_poses.tsv"
+    wildcard_constraints:
+        scenario=one_of(EXTERNAL),
+    conda:
+        ENV
+    params:
+        settings=external_settings,
+        code=code("external_poses"),
+    shell:
+        "traj2events poses {input} --id {wildcards.id} --settings {params.settings:q} --output {output} 2> {log}"
 
 
 rule imu:
@@ -86,7 +108,7 @@ rule imu:
 rule dataset_index:
     input:
         trajectories=scenario_outputs,
-        samples="results/{scenario}/samples.csv",
+        samples=sample_table,
     output:
         "results/{scenario}/index.csv",
     log:
@@ -96,15 +118,16 @@ rule dataset_index:
     conda:
         ENV
     params:
+        samples=lambda wildcards, input: f"--samples {input.samples}" if input.samples else "",
         code=code("index"),
     shell:
-        "traj2events index {input.trajectories} --samples {input.samples} --output {output} 2> {log}"
+        "traj2events index {input.trajectories} {params.samples} --output {output} 2> {log}"
 
 
 rule trajectory_summary:
     input:
-        solutions=expand("results/{scenario}/solutions.h5", scenario=SCENARIOS),
-        tables=expand("results/{scenario}/samples.csv", scenario=SCENARIOS),
+        solutions=expand("results/{scenario}/solutions.h5", scenario=SOLVED),
+        tables=expand("results/{scenario}/samples.csv", scenario=SOLVED),
     output:
         report(
             "results/summary.csv",

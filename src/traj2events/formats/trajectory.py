@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
-from ..trajectory.state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, STATE_NAMES, STATE_UNITS
+from ..trajectory.state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, MASS, STATE_NAMES, STATE_UNITS
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, plain, set_attrs, write_dataset
 
@@ -44,14 +44,16 @@ def solution_attrs(solution, bc) -> dict:
     }
 
 
-def _write_nodes(group: h5py.Group, t: np.ndarray, state: np.ndarray, control: np.ndarray) -> None:
+def _write_nodes(group: h5py.Group, t: np.ndarray, state: np.ndarray, control: np.ndarray | None) -> None:
+    """t, state and (where the flight has them: not an external one's) control."""
     write_dataset(group, "t", t)
     write_dataset(group, "state", state)
-    write_dataset(group, "control", control)
     group.attrs["state_names"] = list(STATE_NAMES)
-    group.attrs["control_names"] = list(CONTROL_NAMES)
     group.attrs["state_units"] = list(STATE_UNITS)
-    group.attrs["control_units"] = list(CONTROL_UNITS)
+    if control is not None:
+        write_dataset(group, "control", control)
+        group.attrs["control_names"] = list(CONTROL_NAMES)
+        group.attrs["control_units"] = list(CONTROL_UNITS)
 
 
 def write_trajectory(
@@ -60,7 +62,8 @@ def write_trajectory(
     poses: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
     attrs: dict,
 ) -> None:
-    """One trajectory: nodes/{t,state,control}, optional poses/{t,state,control}, attrs."""
+    """One trajectory: nodes/{t,state,control}, optional poses/{t,state,control}, attrs
+    (control None: an external flight's, which has none)."""
     with atomic_output(path) as tmp, create(tmp) as f:
         _write_nodes(f.create_group("nodes"), *nodes)
         if poses is not None:
@@ -72,7 +75,7 @@ def write_trajectory(
 class Trajectory:
     t_nodes: np.ndarray
     state_nodes: np.ndarray
-    control_nodes: np.ndarray
+    control_nodes: np.ndarray | None  # None: an external flight's
     t: np.ndarray | None
     state: np.ndarray | None
     control: np.ndarray | None
@@ -90,10 +93,13 @@ class Trajectory:
 
 def read_trajectory(path: str | os.PathLike) -> Trajectory:
     with open_file(path, "a trajectory file (nodes and poses)") as f:
-        poses = [f[f"poses/{k}"][()] for k in ("t", "state", "control")] if "poses" in f else [None] * 3
-        tr = Trajectory(
-            f["nodes/t"][()], f["nodes/state"][()], f["nodes/control"][()], *poses, Attributes(path, f.attrs)
-        )
+
+        def group(name: str) -> list:
+            return [f[f"{name}/{k}"][()] if f"{name}/{k}" in f else None for k in ("t", "state", "control")]
+
+        if "nodes/t" not in f or "nodes/state" not in f:
+            raise FileFormatError(f"{path}: expected the groups nodes (t, state) and poses of a trajectory file")
+        tr = Trajectory(*group("nodes"), *group("poses"), Attributes(path, f.attrs))
     for group, t, state in (("nodes", tr.t_nodes, tr.state_nodes), ("poses", tr.t, tr.state)):
         if t is None:
             continue
@@ -101,7 +107,8 @@ def read_trajectory(path: str | os.PathLike) -> Trajectory:
             raise FileFormatError(
                 f"{path}: {group}/state has shape {state.shape}, expected ({len(t)}, {len(STATE_NAMES)})"
             )
-        if not (np.isfinite(t).all() and np.isfinite(state).all()):
+        # The mass may be NaN: not known (an external flight's).
+        if not (np.isfinite(t).all() and np.isfinite(state[:, :MASS]).all()):
             raise FileFormatError(f"{path}: {group} holds NaN or infinite times or states")
     return tr
 

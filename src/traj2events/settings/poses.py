@@ -1,9 +1,15 @@
-"""Settings of the camera poses at the frame rate (one trajectory's trajectory.h5), and
-the manoeuvre a trajectory flies, a divert or a hover (drawn per trajectory, as its Sun)."""
+"""Settings of the camera poses at the frame rate (one trajectory's trajectory.h5), the
+manoeuvre a trajectory flies, a divert or a hover (drawn per trajectory, as its Sun), and
+an external scenario's pose files (scenarios.<name>.poses)."""
 
 from __future__ import annotations
 
+import functools
+import json
 import math
+import os
+
+import numpy as np
 
 from . import pick, trajectory_rng
 
@@ -51,3 +57,65 @@ def scenario_manoeuvre(config: dict, name: str, trajectory_id: str | None) -> di
         if drawn:
             return {kind: drawn}
     return None
+
+
+# An external scenario (scenarios.<name>.poses) flies its files' poses: none of these.
+OCP_SCENARIO_KEYS = ("n_trajectories", "tf_guess_s", "downrange_m", "crossrange_m", "altitude_m", "speed_forward_m_s",
+                     "speed_cross_m_s", "speed_down_m_s", "roll_deg", "pitch_deg", "yaw_deg", "pitch_decreasing",
+                     "divert", "hover")  # fmt: skip
+SPICE_DEFAULTS = {"observer": "MOON", "body_frame": "IAU_MOON", "step_s": 0.1, "site": None}
+
+
+def is_external(config: dict, name: str) -> bool:
+    """Whether scenario `name` takes its poses from files (scenarios.<name>.poses)."""
+    return bool(config["scenarios"][name].get("poses"))
+
+
+def scenario_count(config: dict, name: str) -> int:
+    """The scenario's trajectories: n_trajectories, or one per pose file."""
+    sc = config["scenarios"][name]
+    return len(sc["poses"]["files"]) if sc.get("poses") else int(sc["n_trajectories"])
+
+
+def trajectory_source(config: dict, name: str, trajectory_id: str | int) -> str:
+    """The pose file of an external scenario's trajectory."""
+    return config["scenarios"][name]["poses"]["files"][int(trajectory_id)]
+
+
+def external_pose_settings(config: dict, name: str) -> dict:
+    """What an external trajectory's poses depend on: the frame rate, the camera's mount
+    (the trajectory point lies under it), the sphere (the altitude check), the gravity the
+    IMU takes away, the SPICE reading (with its defaults), the scenario and seed."""
+    spice = config["scenarios"][name]["poses"].get("spice")
+    return {
+        "fps": float(config["camera"]["fps"]),
+        "mount_height_m": float(config["camera"]["mount_height_m"]),
+        "moon_radius_m": float(config["motion_field"]["moon_radius_m"]),
+        "g_m_s2": float(config["vehicle"]["g_m_s2"]),
+        "spice": {**SPICE_DEFAULTS, **spice} if spice else None,
+        "scenario": name,
+        "seed": int(config["seed"]),
+    }
+
+
+def external_extents(config: dict, name: str) -> list[dict]:
+    """Per file of an external scenario: its duration `tf_s`, how far it goes from the site
+    horizontally `reach_m` and how high `top_m` (read once per file and settings); a file
+    that cannot be used raises ValueError naming it."""
+    settings = external_pose_settings(config, name)
+    files = config["scenarios"][name]["poses"]["files"]
+    return [_extent(path, _modified(path), json.dumps(settings, sort_keys=True)) for path in files]
+
+
+def _modified(path: str) -> float:
+    return os.stat(path).st_mtime if os.path.exists(path) else -1.0
+
+
+@functools.lru_cache(maxsize=256)
+def _extent(path: str, modified: float, settings_json: str) -> dict:
+    from ..stages.external_poses import external_samples
+
+    samples, _ = external_samples(path, json.loads(settings_json))
+    p = samples.position_m
+    return {"tf_s": float(samples.t_s[-1]), "reach_m": float(np.hypot(p[:, 0], p[:, 1]).max()),
+            "top_m": float(-p[:, 2].min())}  # fmt: skip

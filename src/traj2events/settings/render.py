@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ..geometry.camera import horizon_distance_m
 from . import trajectory_rng, without_late_defaults
-from .poses import scenario_divert
+from .poses import external_extents, scenario_divert
 
 TIMING_MODES = ("fixed", "adaptive")
 
@@ -62,8 +62,13 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     radius = float(config["motion_field"]["moon_radius_m"])
     # Out to the horizon of the scenario's highest camera (with a margin for climbs and
     # relief), from the farthest start point.
-    reach = max(abs(v) for v in sc["downrange_m"]) + max(abs(v) for v in sc["crossrange_m"])
-    horizon = horizon_distance_m(1.2 * max(sc["altitude_m"]) + 100.0, 500.0, radius)
+    if sc.get("poses"):  # an external scenario: how far and high its files' flights go
+        extents = external_extents(config, name)
+        reach, top = max(e["reach_m"] for e in extents), max(e["top_m"] for e in extents)
+    else:
+        reach = max(abs(v) for v in sc["downrange_m"]) + max(abs(v) for v in sc["crossrange_m"])
+        top = max(sc["altitude_m"])
+    horizon = horizon_distance_m(1.2 * top + 100.0, 500.0, radius)
     r, camera = config["render"], config["camera"]
     adaptive = r["timing"]["mode"] == "adaptive"
     terrain = dict(config["terrain"])

@@ -1,5 +1,6 @@
-"""The IMU and altitude streams of one trajectory (imu.h5): the re-integrated dynamics
-sampled at the IMU's rate, the same integration the camera poses come from."""
+"""The IMU and altitude streams of one trajectory (imu.h5): its flight sampled at the IMU's
+rate, the same the camera poses come from (the re-integrated dynamics of a solved flight,
+the interpolation of an external one: trajectory/flight.py)."""
 
 from __future__ import annotations
 
@@ -11,9 +12,8 @@ from .. import __version__
 from ..formats.imu import write_imu
 from ..formats.trajectory import read_trajectory
 from ..progress import log
-from ..trajectory.dynamics import Dynamics
-from ..trajectory.imu import ImuNoise, altitude_above_sphere, angular_rate_body, measured, specific_force_body
-from ..trajectory.upsample import ReintegratedStates, interpolate_controls
+from ..trajectory.flight import flight_of
+from ..trajectory.imu import ImuNoise, altitude_above_sphere, angular_rate_body, measured, specific_force
 
 
 def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settings: dict, seed: int = 0) -> None:
@@ -25,13 +25,12 @@ def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settin
     if seed < 0:
         raise ValueError(f"imu: seed: expected a value >= 0, got {seed}")
     tr = read_trajectory(trajectory)
-    dynamics = Dynamics(tr.vehicle)
+    flight, g = flight_of(tr), float(tr.attrs["g_m_s2"])
     t = np.arange(int(np.floor(float(tr.t_nodes[-1]) * rate + 1e-9)) + 1) / rate
-    states = ReintegratedStates(dynamics, tr.t_nodes, tr.state_nodes[0], tr.control_nodes).states(t)
-    controls = interpolate_controls(tr.t_nodes, tr.control_nodes, t)
+    states = flight.states(t)
     noise = ImuNoise.from_config(settings["noise"])
     rng = np.random.Generator(np.random.PCG64([seed, 0x1A0]))  # its own stream of the trajectory's seed
-    force, rates = specific_force_body(dynamics, states, controls), angular_rate_body(states)
+    force, rates = specific_force(states, flight.acceleration(t), g), angular_rate_body(states)
     force_measured, accel_bias = measured(force, noise.accel_random_walk_m_s_sqrt_s, noise.accel_bias_m_s2,
                                           noise.bias_walk_time_s, rate, rng)  # fmt: skip
     rates_measured, gyro_bias = measured(rates, noise.gyro_random_walk_rad_sqrt_s, noise.gyro_bias_rad_s,
@@ -49,7 +48,7 @@ def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settin
     attrs = {
         "rate_hz": rate,
         "moon_radius_m": float(settings["moon_radius_m"]),
-        "g_m_s2": tr.vehicle.g_m_s2,
+        "g_m_s2": g,
         "seed": seed,
         **{f"noise_{k}": v for k, v in settings["noise"].items()},
         "imu_position": "the centre of mass (the body frame's origin)",

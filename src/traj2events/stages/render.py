@@ -32,9 +32,9 @@ from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
 from ..settings import without_late_defaults
 from ..settings.render import render_settings
-from ..trajectory.dynamics import Dynamics
+from ..trajectory.external import ExternalFlight
+from ..trajectory.flight import SolvedFlight, flight_of
 from ..trajectory.state import POSE
-from ..trajectory.upsample import ReintegratedStates
 from ..video import VideoWriter, display_frame
 
 
@@ -139,7 +139,7 @@ class RenderSettings:
 def render_between(
     renderer: TerrainRenderer | LensRenderer,
     camera: Camera,
-    states: ReintegratedStates,
+    states: SolvedFlight | ExternalFlight,
     frame,
     state: np.ndarray,
     t_s: float,
@@ -198,10 +198,10 @@ class TrajectoryRender:
             f"{self.trajectory}: rendering {n} frames of {s.width} x {s.height} (Sun az {self.sun.azimuth_deg} deg, "
             f"el {self.sun.elevation_deg} deg, {s.reflectance['model']}; {timing.mode} timing)"
         )
-        # Adaptive frames need poses between the fixed ones: the same re-integration, kept dense.
+        # Adaptive frames need poses between the fixed ones: the same flight (re-integration, kept dense).
         states = None
         if timing.mode == "adaptive":
-            states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+            states = flight_of(tr)
         start = time.perf_counter()
         triangles = reused = added = 0
         with (

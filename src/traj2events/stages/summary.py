@@ -65,7 +65,12 @@ def summary_table(
                 "max_error_velocity_m_s": ok["error_velocity_m_s"].max(),
             }
         )
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
+
+
+SUMMARY_COLUMNS = ("scenario", "wanted", "base_status", "draws", "solved", "failed", "missing", "solved_first_try",
+                   "refined", "final_mass_min_kg", "final_mass_mean_kg", "final_mass_max_kg", "tf_min_s", "tf_max_s",
+                   "max_error_position_m", "max_error_velocity_m_s")  # fmt: skip
 
 
 def dataset_summary(

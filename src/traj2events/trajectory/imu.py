@@ -29,11 +29,16 @@ def rotations_body_to_inertial(states: np.ndarray) -> np.ndarray:
     return np.moveaxis(np.array(rotation_body_to_inertial(phi, theta, psi)), -1, 0)
 
 
+def specific_force(states: np.ndarray, acceleration_m_s2: np.ndarray, g_m_s2: float) -> np.ndarray:
+    """(n, 3) accelerometer reading, m/s^2, body axes: R_iv^T (a_i - g_i) of the states'
+    attitudes and their inertial accelerations (n, 3)."""
+    gravity = np.array([0.0, 0.0, g_m_s2])
+    return np.einsum("nji,nj->ni", rotations_body_to_inertial(states), np.asarray(acceleration_m_s2) - gravity)
+
+
 def specific_force_body(dynamics: Dynamics, states: np.ndarray, controls: np.ndarray) -> np.ndarray:
     """(n, 3) accelerometer reading, m/s^2, body axes, from the states and controls."""
-    acceleration = dynamics(states, controls)[:, VELOCITY]
-    gravity = np.array([0.0, 0.0, dynamics.vehicle.g_m_s2])
-    return np.einsum("nji,nj->ni", rotations_body_to_inertial(states), acceleration - gravity)
+    return specific_force(states, dynamics(states, controls)[:, VELOCITY], dynamics.vehicle.g_m_s2)
 
 
 def angular_rate_body(states: np.ndarray) -> np.ndarray:
