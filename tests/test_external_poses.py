@@ -254,3 +254,62 @@ def test_a_spice_target_without_coverage_is_refused_naming_the_kernel(tmp_path):
 def test_the_settings_json_round_trips(tmp_path):
     # What the workflow passes on the command line is what the stage reads.
     assert json.loads(json.dumps(SETTINGS)) == SETTINGS
+
+
+def flown_config(tmp_path, files) -> dict:
+    sun = {"range_m": 1.496e11, "azimuth_deg": 105.0, "elevation_deg": 7.0}
+    return {"camera": {"fps": 10.0, "width": 32, "height": 32}, "render": {"lod": {"shading_levels": 1}},
+            "scenarios": {"flown": {"poses": {"files": [str(f) for f in files]}, "sun": sun}}}  # fmt: skip
+
+
+def landing_csv(path, problem, vehicle, last_s: float = 20.0) -> PoseSamples:
+    """The camera poses of a solved landing's last `last_s` seconds at 5 Hz, as a CSV."""
+    sol = problem.solve(landing_bc())
+    t, states, _ = upsample(Dynamics(vehicle), sol.t, sol.state, sol.control, 5.0)
+    keep = t >= t[-1] - last_s
+    samples = camera_samples(t[keep], states[keep], 3.0, True)
+    write_csv(path, samples)
+    return samples
+
+
+def test_an_external_scenario_is_checked_and_planned_from_its_files(tmp_path, problem30, vehicle):
+    from traj2events.config import ConfigError, resolve_config
+    from traj2events.plan import dataset_plan
+
+    landing_csv(tmp_path / "a.csv", problem30, vehicle)
+    config = resolve_config(flown_config(tmp_path, [tmp_path / "a.csv"] * 3))
+    plan = dataset_plan(config)
+    assert plan.trajectories == 3 and plan.frames == 3 * 201  # 20 s at 10 fps, both ends
+    with pytest.raises(ConfigError, match=r"'scenarios.flown.poses.files': .*missing.csv: pose file not found"):
+        resolve_config(flown_config(tmp_path, [tmp_path / "missing.csv"]))
+    both = flown_config(tmp_path, [tmp_path / "a.csv"])
+    both["scenarios"]["flown"]["tf_guess_s"] = 30.0
+    with pytest.raises(ConfigError, match="flies its files' poses or the OCP's, not both: it also has 'tf_guess_s'"):
+        resolve_config(both)
+    (tmp_path / "k.tm").write_text("\\begindata\n\\begintext\n")
+    with pytest.raises(ConfigError, match=r"'scenarios.flown.poses.spice': .*k.tm is a SPICE meta-kernel"):
+        resolve_config(flown_config(tmp_path, [tmp_path / "k.tm"]))
+
+
+@pytest.mark.slow
+def test_the_workflow_builds_an_external_scenario_and_reruns_it_when_its_file_changes(tmp_path, problem30, vehicle):
+    import yaml
+
+    from test_workflow import jobs_in_dry_run, snakemake
+
+    samples = landing_csv(tmp_path / "landing.csv", problem30, vehicle)
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(flown_config(tmp_path, [tmp_path / "landing.csv"])))
+    snakemake(tmp_path)
+    folder = tmp_path / "results" / "flown" / "0000"
+    for name in ("trajectory.h5", "imu.h5", "video.mkv", "frames.png", "motion_field.h5", "events.h5", "events.png"):
+        assert (folder / name).is_file(), name
+    tr = read_trajectory(folder / "trajectory.h5")
+    assert tr.attrs["source"] == "external" and tr.attrs["source_file"] == "landing.csv" and len(tr.t) == 201
+    assert camera_pose(tr.state[-1], 3.0).position == pytest.approx(samples.position_m[-1], abs=1e-9)
+    index = pd.read_csv(tmp_path / "results" / "flown" / "index.csv")
+    assert index.loc[0, "continuation"] == "external" and index.loc[0, "N"] == len(samples.t_s)
+    assert pd.read_csv(tmp_path / "results" / "summary.csv").empty  # no solve
+    assert jobs_in_dry_run(tmp_path) == {}
+    write_csv(tmp_path / "landing.csv", PoseSamples(samples.t_s, samples.position_m + [1.0, 0.0, 0.0],
+                                                     samples.quaternion_wxyz, samples.velocity_m_s))  # fmt: skip
+    assert jobs_in_dry_run(tmp_path).get("external_poses") == 1
