@@ -313,3 +313,22 @@ def test_the_workflow_builds_an_external_scenario_and_reruns_it_when_its_file_ch
     write_csv(tmp_path / "landing.csv", PoseSamples(samples.t_s, samples.position_m + [1.0, 0.0, 0.0],
                                                      samples.quaternion_wxyz, samples.velocity_m_s))  # fmt: skip
     assert jobs_in_dry_run(tmp_path).get("external_poses") == 1
+
+
+def test_the_point_under_a_turning_camera_accelerates_as_a_rigid_body_says():
+    # A camera held still while pitching at a constant angular acceleration alpha: the
+    # trajectory point 3 m below it along z_b moves on a circle about it, so its acceleration
+    # is R (alpha x m + omega x (omega x m)), m = (0, 0, 3) m (worked here in closed form:
+    # tangential 3 alpha, centripetal 3 omega^2 towards the camera).
+    alpha, t = 0.02, np.linspace(0.0, 10.0, 1001)
+    pitch = alpha * t**2 / 2
+    q = np.column_stack([np.cos(pitch / 2), 0 * t, np.sin(pitch / 2), 0 * t])  # about y_b
+    flight = ExternalFlight(PoseSamples(t, np.tile([0.0, 0.0, -50.0], (len(t), 1)), q), 3.0)
+    tm = np.array([2.5, 7.5])
+    theta, omega = alpha * tm**2 / 2, alpha * tm
+    # In the site frame: the point at c + 3 (sin theta, 0, cos theta) (R_y(theta) applied to z_b).
+    tangential = 3 * alpha * np.column_stack([np.cos(theta), 0 * tm, -np.sin(theta)])
+    centripetal = -3 * omega[:, None] ** 2 * np.column_stack([np.sin(theta), 0 * tm, np.cos(theta)])
+    # Slerp's rate within a 10 ms interval is its mean: omega off by up to alpha dt / 2.
+    assert flight.acceleration(tm) == pytest.approx(tangential + centripetal, abs=2e-4)
+    assert np.abs(flight.acceleration(tm) - tangential - centripetal).max() < 0.01 * np.abs(tangential).max()

@@ -113,6 +113,11 @@ class ExternalFlight:
         self._rotations = samples.rotations
         steps = self._rotations[:-1].inv() * self._rotations[1:]
         self._rates = steps.as_rotvec() / np.diff(self.t_nodes)[:, None]  # body frame, rad/s
+        # The angular acceleration slerp leaves out (its rates step at the samples): the
+        # change of the intervals' rates between their midpoints, linear in time.
+        middles = (self.t_nodes[1:] + self.t_nodes[:-1]) / 2
+        self._alpha_t = self.t_nodes[1:-1]
+        self._alpha = np.diff(self._rates, axis=0) / np.diff(middles)[:, None] if len(middles) > 1 else np.zeros((1, 3))
 
     def _interval(self, t: np.ndarray) -> np.ndarray:
         if len(t) and (t.min() < self.t_nodes[0] - 1e-9 or t.max() > self.t_nodes[-1] + 1e-9):
@@ -139,14 +144,21 @@ class ExternalFlight:
         out[:, MASS] = np.nan
         return out
 
+    def angular_acceleration(self, t: np.ndarray) -> np.ndarray:
+        """(len(t), 3) rad/s^2, body frame: the intervals' rates differenced between their
+        midpoints, interpolated linearly (held beyond the first and last)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if len(self._alpha_t) == 0:
+            return np.zeros((len(t), 3))
+        return np.column_stack([np.interp(t, self._alpha_t, a) for a in self._alpha.T])
+
     def acceleration(self, t: np.ndarray) -> np.ndarray:
-        """(len(t), 3) the trajectory point's acceleration, m/s^2: the camera's plus the
-        centripetal R (omega x (omega x (0, 0, h))) (slerp turns at a constant rate within
-        an interval)."""
+        """(len(t), 3) the trajectory point's acceleration, m/s^2, site frame: the camera's
+        plus R (alpha x m + omega x (omega x m)), m = (0, 0, h) from the camera to the point."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         rotation, rates = self.attitude(t)
-        centripetal = np.cross(rates, np.cross(rates, self.mount_b))
-        return self._camera(t, 2) + np.einsum("nij,nj->ni", rotation.as_matrix(), centripetal)
+        lever = np.cross(self.angular_acceleration(t), self.mount_b) + np.cross(rates, np.cross(rates, self.mount_b))
+        return self._camera(t, 2) + np.einsum("nij,nj->ni", rotation.as_matrix(), lever)
 
 
 def site_axes(latitude_deg: float, longitude_deg: float, heading_deg: float) -> np.ndarray:
