@@ -309,6 +309,10 @@ def test_the_workflow_builds_an_external_scenario_and_reruns_it_when_its_file_ch
     index = pd.read_csv(tmp_path / "results" / "flown" / "index.csv")
     assert index.loc[0, "continuation"] == "external" and index.loc[0, "N"] == len(samples.t_s)
     assert pd.read_csv(tmp_path / "results" / "summary.csv").empty  # no solve
+    from traj2events.data import open_dataset
+
+    landing = open_dataset(tmp_path / "results").find("flown", 0)
+    assert landing.source()["source_file"] == "landing.csv" and landing.imu()["t"][-1] == pytest.approx(20.0)
     assert jobs_in_dry_run(tmp_path) == {}
     write_csv(tmp_path / "landing.csv", PoseSamples(samples.t_s, samples.position_m + [1.0, 0.0, 0.0],
                                                      samples.quaternion_wxyz, samples.velocity_m_s))  # fmt: skip

@@ -170,7 +170,7 @@ def test_the_loader_reads_the_built_dataset(built):
     expected = everything[(everything["t"] >= 1_000_000) & (everything["t"] < 1_500_000)]
     assert len(window) > 0 and window.tobytes() == expected.tobytes()
     t, state = landing.poses()
-    assert state.shape == (len(t), 13) and np.allclose(np.diff(t), 0.1)
+    assert state.shape == (len(t), 13) and np.allclose(np.diff(t), 0.1) and landing.source() == {"source": "ocp"}
     field = landing.motion_field(2)
     assert field["frame_index"] == 2 and field["displacement_terrain"].shape == (32, 32, 2)
     assert field["status_terrain"].dtype == np.uint8

@@ -7,6 +7,7 @@
     events = landing.events(1.0, 1.01)       # structured x, y, t (us), p in [1.00, 1.01) s
     events, labels = landing.labelled_events(1.0, 1.01)  # and each event's cause
     t, state = landing.poses()               # (K,) s, (K, 13) in the units of state_units
+    landing.source()                         # {"source": "ocp"}, or a pose file's (external poses)
     fields = landing.motion_field(3)         # the 4th field written: arrays by name
     t, slant = landing.range_meter()         # the range meter at every pose (s, m)
     radiance, depth = landing.frame(100)     # frames.h5, when kept
@@ -51,6 +52,13 @@ class Landing:
         flown) and `divert_*` or `hover_*` attributes (docs/dataset.md)."""
         attrs = read_trajectory(self.folder / "trajectory.h5").attrs
         return {"divert": "none", "hover": "none"} | {k: attrs[k] for k in attrs if k.startswith(("divert", "hover"))}
+
+    def source(self) -> dict:
+        """Where the poses came from: {"source": "ocp"} for a solved flight, or an external
+        one's `source`, `source_file`, `source_format`, `source_t0_s`, `interpolation` and,
+        from SPICE, `site_*` attributes (docs/dataset.md)."""
+        attrs = read_trajectory(self.folder / "trajectory.h5").attrs
+        return {"source": "ocp"} | {k: attrs[k] for k in attrs if k.startswith(("source", "site_", "interpolation"))}
 
     def imu(self) -> dict[str, np.ndarray]:
         """imu.h5's streams: t (n,) s, specific_force_b (n, 3) m/s^2, angular_rate_b (n, 3)
