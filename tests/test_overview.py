@@ -40,7 +40,9 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
         (folder / "trajectory.h5").write_bytes(b"t" * 1000)
         folders.append(folder)
     index = pd.DataFrame({"scenario": "descent", "id": [0, 1], "path": [str(f / "trajectory.h5") for f in folders],
-                          "tf_s": [1.0, 1.0], "n_poses": [11, 11]})  # fmt: skip
+                          "tf_s": [1.0, 1.0], "n_poses": [11, 11], "continuation": ["warm", "external"],
+                          "divert": ["re-targeted (warm)", "none"], "divert_offset_m": [42.0, np.nan],
+                          "divert_acceleration_added_max_m_s2": [0.75, np.nan], "hover": "none"})  # fmt: skip
     index.to_csv(tmp_path / "index.csv", index=False)
     pd.DataFrame({"scenario": ["descent"], "wanted": [2], "solved": [2]}).to_csv(tmp_path / "summary.csv", index=False)
     config = {"camera": {"width": 4, "height": 2}, "seed": 7}
@@ -50,7 +52,10 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
     # Mean rate over the recorded second; per pixel over its 8 pixels; peak: 10 ms bins.
     assert "<td>2000</td>" in page and "<td>250</td>" in page and "<td>2000</td>\n      <td>2000</td>" in page
     assert "<td>descent</td>\n      <td>2</td>\n      <td>22</td>" in page  # the scenario's row
-    assert "&quot;seed&quot;: 7" in page and page.count("<table") == 4
+    assert "&quot;seed&quot;: 7" in page and page.count("<table") == 5
+    # The diverts' table: one flown, none failed, its offset and added acceleration.
+    assert "<td>divert</td>\n      <td>1</td>\n      <td>0</td>\n      <td>42</td>\n      <td>42</td>" in page
+    assert "<td>0.75</td>" in page and "<td>file</td>" in page and "<td>OCP</td>" in page
     again = tmp_path / "again.html"
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), again)
     assert again.read_bytes() == (tmp_path / "o.html").read_bytes()

@@ -75,16 +75,34 @@ def dataset_index(
     return table
 
 
-def log_manoeuvres(table: pd.DataFrame) -> None:
-    """The scenario's diverts and hovers in a line each: how many flew, their statistics."""
-    for kind, flown_as, stats in (
-        ("divert", "re-targeted", (("offset_m", "m offset"), ("acceleration_added_max_m_s2", "m/s^2 added"))),
-        ("hover", "flown", (("duration_s", "s held"), ("altitude_m", "m up"), ("drift_m", "m drift"))),
-    ):
-        tried = table[table[kind] != "none"]
+# Per kind: what its status says when flown, and the statistics to show (column, unit).
+MANOEUVRE_STATS = {
+    "divert": ("re-targeted", (("offset_m", "m offset"), ("acceleration_added_max_m_s2", "m/s^2 added"))),
+    "hover": ("flown", (("duration_s", "s held"), ("altitude_m", "m up"), ("drift_m", "m drift"))),
+}
+
+
+def manoeuvre_stats(table: pd.DataFrame) -> list[dict]:
+    """Per manoeuvre kind a scenario's index tried: {kind, flown, failed, median <column>
+    and max <column> of each statistic over the flown ones}."""
+    rows = []
+    for kind, (flown_as, stats) in MANOEUVRE_STATS.items():
+        tried = table[table[kind].fillna("none") != "none"] if kind in table else table.iloc[:0]
         if not len(tried):
             continue
         flown = tried[tried[kind].str.startswith(flown_as)]
-        figures = ", ".join(f"{flown[f'{kind}_{k}'].median():.3g} {unit}" for k, unit in stats)
-        log(f"  {kind}s: {len(flown)} flown, {len(tried) - len(flown)} failed (the sample's flight kept); "
+        row = {"kind": kind, "flown": len(flown), "failed": len(tried) - len(flown)}
+        for column, _ in stats:
+            row[f"median_{column}"] = flown[f"{kind}_{column}"].median()
+            row[f"max_{column}"] = flown[f"{kind}_{column}"].max()
+        rows.append(row)
+    return rows
+
+
+def log_manoeuvres(table: pd.DataFrame) -> None:
+    """The scenario's diverts and hovers in a line each: how many flew, their statistics."""
+    for row in manoeuvre_stats(table):
+        stats = MANOEUVRE_STATS[row["kind"]][1]
+        figures = ", ".join(f"{row[f'median_{k}']:.3g} {unit}" for k, unit in stats)
+        log(f"  {row['kind']}s: {row['flown']} flown, {row['failed']} failed (the sample's flight kept); "
             f"medians {figures}")  # fmt: skip

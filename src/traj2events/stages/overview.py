@@ -1,7 +1,7 @@
 """The dataset's overview page (results/overview.html, the report's "Dataset" page): what was
 built, in numbers and one figure. Per scenario and per trajectory: frames, flight time,
-events and their rate, bytes on disk; the event rate over each flight; bytes per kind of
-file; summary.csv as a table; the code version and the resolved config. One
+events and their rate, bytes on disk; the event rate over each flight; the diverts and
+hovers flown; bytes per kind of file; summary.csv as a table; the code version and the resolved config. One
 self-contained HTML file (the figure embedded), the same bytes for the same dataset."""
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from .. import __version__
 from ..figures import event_rate_figure, png_bytes
 from ..formats.atomic import atomic_output
 from ..formats.hdf5 import open_file
+from .index import manoeuvre_stats
 
 RATE_BIN_MS = 10  # the event rate's bin: the paper's event-frame window
 
@@ -63,10 +64,16 @@ def _table(frame: pd.DataFrame) -> str:
 
 
 def overview_html(
-    trajectories: pd.DataFrame, summary: pd.DataFrame, sizes: pd.DataFrame, figure_png: bytes, config: dict
+    trajectories: pd.DataFrame,
+    summary: pd.DataFrame,
+    sizes: pd.DataFrame,
+    figure_png: bytes,
+    config: dict,
+    manoeuvres: pd.DataFrame | None = None,
 ) -> str:
-    """The page: per-scenario and per-trajectory tables, the rate figure, bytes per kind of
-    file, summary.csv, the version and the config."""
+    """The page: per-scenario and per-trajectory tables, the rate figure, the diverts and
+    hovers flown (where any was tried), bytes per kind of file, summary.csv, the version
+    and the config."""
     per_scenario = trajectories.groupby("scenario", sort=False).agg(
         trajectories=("id", "size"), frames=("frames", "sum"), flight_s=("t_f_s", "sum"), events=("events", "sum"),
         peak_events_per_s=("peak_events_per_s", "max"), MB=("MB", "sum"),
@@ -90,6 +97,9 @@ def overview_html(
         f"<p>Events per second in {RATE_BIN_MS} ms bins (the paper's event-frame window) against the flight's "
         "normalised time, one line per trajectory; bins without events drawn at 1.</p>",
         "<h2>Per trajectory</h2>", _table(trajectories),
+        *(["<h2>Diverts and hovers</h2><p>Per scenario and kind: flown, failed (the sample's flight kept), and the "
+           "median and largest of each statistic over the flown ones (index.csv's columns, docs/dataset.md).</p>",
+           _table(manoeuvres)] if manoeuvres is not None and len(manoeuvres) else []),
         "<h2>Bytes on disk per kind of file</h2>", _table(sizes),
         "<h2>Solves (summary.csv)</h2>", _table(summary),
         "<h2>Configuration</h2><p>The resolved config (defaults.yaml with the overlays), as the jobs got it.</p>",
@@ -107,15 +117,20 @@ def dataset_overview(
     """overview.html from each scenario's index.csv (the trajectories and their folders),
     summary.csv and the resolved config (JSON). Every file and folder in a trajectory's
     folder is counted on disk (frames.h5 where kept: a temporary one is gone by then)."""
-    rows, curves, sizes = [], [], []
+    rows, curves, sizes, manoeuvres = [], [], [], []
     for index in indexes:
-        for row in pd.read_csv(index).itertuples():
+        listed = pd.read_csv(index)
+        manoeuvres += [{"scenario": name, **row} for name in listed["scenario"].unique()[:1]
+                       for row in manoeuvre_stats(listed)]  # fmt: skip
+        for row in listed.itertuples():
             folder = Path(row.path).parent
             stats = trajectory_stats(folder, sorted(p.name for p in folder.iterdir()))
             curves.append((row.scenario, stats["rate"]))
             sizes.append(stats["bytes"])
             rows.append({
-                "scenario": row.scenario, "id": int(row.id), "t_f_s": float(row.tf_s), "frames": int(row.n_poses),
+                "scenario": row.scenario, "id": int(row.id),
+                "poses": "file" if getattr(row, "continuation", "") == "external" else "OCP",
+                "t_f_s": float(row.tf_s), "frames": int(row.n_poses),
                 "events": stats["events"], "mean_events_per_s": stats["mean_rate"],
                 "peak_events_per_s": stats["peak_rate"],
                 "events_per_pixel_s": stats["mean_rate"] / stats["pixels"],
@@ -128,6 +143,6 @@ def dataset_overview(
     kinds = pd.DataFrame({"file": by_kind.index, "MB": by_kind.values / 1e6, "MB_per_trajectory": by_kind.values / 1e6
                           / len(rows), "share": by_kind.values / max(by_kind.sum(), 1)})  # fmt: skip
     figure = png_bytes(event_rate_figure(curves, RATE_BIN_MS), dpi=100)
-    page = overview_html(table, pd.read_csv(summary), kinds, figure, json.loads(config_json))
+    page = overview_html(table, pd.read_csv(summary), kinds, figure, json.loads(config_json), pd.DataFrame(manoeuvres))
     with atomic_output(output) as tmp:
         Path(tmp).write_text(page)
