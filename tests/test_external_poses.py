@@ -297,14 +297,14 @@ def test_the_workflow_builds_an_external_scenario_and_reruns_it_when_its_file_ch
 
     from test_workflow import jobs_in_dry_run, snakemake
 
-    samples = landing_csv(tmp_path / "landing.csv", problem30, vehicle)
+    samples = landing_csv(tmp_path / "landing.csv", problem30, vehicle, last_s=10.0)
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(flown_config(tmp_path, [tmp_path / "landing.csv"])))
     snakemake(tmp_path)
     folder = tmp_path / "results" / "flown" / "0000"
     for name in ("trajectory.h5", "imu.h5", "video.mkv", "frames.png", "motion_field.h5", "events.h5", "events.png"):
         assert (folder / name).is_file(), name
     tr = read_trajectory(folder / "trajectory.h5")
-    assert tr.attrs["source"] == "external" and tr.attrs["source_file"] == "landing.csv" and len(tr.t) == 201
+    assert tr.attrs["source"] == "external" and tr.attrs["source_file"] == "landing.csv" and len(tr.t) == 101
     assert camera_pose(tr.state[-1], 3.0).position == pytest.approx(samples.position_m[-1], abs=1e-9)
     index = pd.read_csv(tmp_path / "results" / "flown" / "index.csv")
     assert index.loc[0, "continuation"] == "external" and index.loc[0, "N"] == len(samples.t_s)
@@ -312,7 +312,7 @@ def test_the_workflow_builds_an_external_scenario_and_reruns_it_when_its_file_ch
     from traj2events.data import open_dataset
 
     landing = open_dataset(tmp_path / "results").find("flown", 0)
-    assert landing.source()["source_file"] == "landing.csv" and landing.imu()["t"][-1] == pytest.approx(20.0)
+    assert landing.source()["source_file"] == "landing.csv" and landing.imu()["t"][-1] == pytest.approx(10.0)
     assert jobs_in_dry_run(tmp_path) == {}
     write_csv(tmp_path / "landing.csv", PoseSamples(samples.t_s, samples.position_m + [1.0, 0.0, 0.0],
                                                      samples.quaternion_wxyz, samples.velocity_m_s))  # fmt: skip
