@@ -44,26 +44,26 @@ float phase_term(float cos_g)
     return clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
 }
 
-// The reflectance factor per unit mu0 = cos(incidence), r_F / mu0, of a surface with unit
-// normal n seen along unit to_camera (toward the camera) under sun_dir, given phase_term
-// of their phase angle; 0 where the surface faces away from the camera. Both laws are
-// mu0 times a factor smooth in mu0 (at mu0 <= 0 taken at 0): a pixel whose texels face the
-// Sun differently takes the mean of lit * mu0 over its footprint times this factor
+// The reflectance factor per unit mu0 = cos(incidence), r_F / mu0, at the cosines mu0 >= 0
+// and mu > 0 (emission), given phase_term of the phase angle. Both laws are mu0 times a
+// factor smooth in mu0 (at mu0 <= 0 taken at 0): a pixel whose texels face the Sun
+// differently takes the mean of lit * mu0 over its footprint times this factor
 // (terrain_textured.frag), the law's linear part averaged exactly.
+float law_per_mu0(float mu0, float mu, float phase)
+{
+    if (model == 0) {
+        float multiple = chandrasekhar_h(mu0) * chandrasekhar_h(mu) - 1.0;
+        return 0.25 * w / (mu0 + mu) * (phase + multiple);
+    }
+    return albedo * (2.0 * phase / (mu0 + mu) + (1.0 - phase));
+}
+
+// The same of a surface with unit normal n seen along unit to_camera (toward the camera)
+// under sun_dir; 0 where the surface faces away from the camera.
 float reflectance_per_mu0(vec3 n, vec3 to_camera, float phase)
 {
-    float mu0 = max(dot(n, sun_dir), 0.0);
     float mu = dot(n, to_camera);
-    float per_mu0 = 0.0;
-    if (mu > 0.0) {
-        if (model == 0) {
-            float multiple = chandrasekhar_h(mu0) * chandrasekhar_h(mu) - 1.0;
-            per_mu0 = 0.25 * w / (mu0 + mu) * (phase + multiple);
-        } else {
-            per_mu0 = albedo * (2.0 * phase / (mu0 + mu) + (1.0 - phase));
-        }
-    }
-    return per_mu0;
+    return mu > 0.0 ? law_per_mu0(max(dot(n, sun_dir), 0.0), mu, phase) : 0.0;
 }
 
 // Reflectance factor r_F (radiance = r_F * irradiance / PI) of a surface with unit normal

@@ -16,11 +16,21 @@ out vec4 frag_color;             // (radiance, depth, -, -): only R and G are st
 
 #include "reflectance.glsl"
 
+const float MU_LIMB = 1e-4;      // cos(emission) of relief seen edge-on
+
 void main()
 {
     // Over the pixel's footprint: the mean normal, and the mean of lit * mu0 (footprint.py).
     vec4 texel = texture(shading, vec3(frag_uv, frag_layer));
-    float per_mu0 = reflectance_per_mu0(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);
+    vec3 normal = normalize(texel.xyz);
+    // The triangle drawn here faces the camera; relief in its texture that faces away is
+    // seen edge-on (its limb, mu -> 0), not black: a cut to 0 at mu = 0 flickered between
+    // the limb's radiance and none as the view turned (docs/rendering.md "Seen edge-on").
+    // Its incidence at least the footprint's mean lit mu0: a mean normal the Sun barely
+    // lights over lit texels would make the law's 1 / (mu0 + mu) unbounded at the limb.
+    float mu = max(dot(normal, normalize(frag_to_camera_m)), MU_LIMB);
+    float mu0 = max(dot(normal, sun_dir), clamp(texel.w, 0.0, 1.0));
+    float per_mu0 = law_per_mu0(mu0, mu, frag_phase);
     float direct = per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI;
     float earthshine = earthshine_radiance(normalize(texel.xyz));
     float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);
