@@ -17,8 +17,6 @@ import numpy as np
 from ..trajectory.external import PoseSamples, in_site_frame
 from .hdf5 import FileFormatError
 
-SPICE_DEFAULTS = {"observer": "MOON", "body_frame": "IAU_MOON", "step_s": 0.1, "site": None}
-
 
 def read_spice_samples(
     metakernel: str | os.PathLike,
