@@ -11,7 +11,6 @@ job runs; `validate_config` turns the first problem into one line such as
 from __future__ import annotations
 
 import math
-import os
 from pathlib import Path
 from typing import Any
 
@@ -147,7 +146,8 @@ def _external_errors(config: dict, name: str, sc: dict, sun: list) -> list[str]:
     """An external scenario (scenarios.<name>.poses): no OCP key beside it, SPICE settings
     for its meta-kernels, every file read now (settings.poses.external_extents: a file that
     cannot be used stops the run before any job), at least 2 frames per flight."""
-    from .formats.poses import FORMATS
+    from .formats.hdf5 import FileFormatError
+    from .formats.poses import pose_format
     from .settings.poses import OCP_SCENARIO_KEYS, external_extents
 
     errors = [f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}"
@@ -158,11 +158,11 @@ def _external_errors(config: dict, name: str, sc: dict, sun: list) -> list[str]:
                          f"both: it also has {ocp_keys[0]!r} (a default scenario's name brings its keys: choose a "
                          "new name)"]  # fmt: skip
     for i, path in enumerate(sc["poses"]["files"]):
-        suffix = os.path.splitext(path)[1].lower()
-        if suffix not in FORMATS:
-            return errors + [f"config key 'scenarios.{name}.poses.files[{i}]': expected a file ending in one of "
-                             f"{sorted(FORMATS)}, got {path!r}"]  # fmt: skip
-        if FORMATS[suffix] == "spice" and not sc["poses"].get("spice"):
+        try:
+            kind = pose_format(path)
+        except FileFormatError as exc:
+            return errors + [f"config key 'scenarios.{name}.poses.files[{i}]': {exc}"]
+        if kind == "spice" and not sc["poses"].get("spice"):
             return errors + [f"config key 'scenarios.{name}.poses.spice': {path} is a SPICE meta-kernel: expected "
                              "{target, camera_frame} to read it, got null"]  # fmt: skip
     try:

@@ -78,10 +78,10 @@ def planned_flight_s(config: dict, name: str, shortest: bool = False) -> float:
     """A trajectory of scenario `name`'s planned duration: tf_guess_s, plus the longest hold
     and the legs of a hover, or what a divert adds (costs.yaml's manoeuvre_s); an external
     scenario's longest file (`shortest`: its shortest; a solved one's tf_guess_s alone)."""
-    from .settings.poses import external_extents
+    from .settings.poses import external_extents, is_external
 
     scenario = config["scenarios"][name]
-    if scenario.get("poses"):
+    if is_external(config, name):
         durations = [extent["tf_s"] for extent in external_extents(config, name)]
         return min(durations) if shortest else max(durations)
     extra = 0.0
@@ -94,10 +94,10 @@ def planned_flight_s(config: dict, name: str, shortest: bool = False) -> float:
 
 def trajectory_frames(config: dict, name: str) -> list[int]:
     """Planned frames of each trajectory of scenario `name`."""
-    from .settings.poses import external_extents, scenario_count
+    from .settings.poses import external_extents, is_external, scenario_count
 
     fps = config["camera"]["fps"]
-    if config["scenarios"][name].get("poses"):
+    if is_external(config, name):
         return [_frames(extent["tf_s"], fps) for extent in external_extents(config, name)]
     return [_frames(planned_flight_s(config, name), fps)] * scenario_count(config, name)
 

@@ -63,7 +63,6 @@ def scenario_manoeuvre(config: dict, name: str, trajectory_id: str | None) -> di
 OCP_SCENARIO_KEYS = ("n_trajectories", "tf_guess_s", "downrange_m", "crossrange_m", "altitude_m", "speed_forward_m_s",
                      "speed_cross_m_s", "speed_down_m_s", "roll_deg", "pitch_deg", "yaw_deg", "pitch_decreasing",
                      "divert", "hover")  # fmt: skip
-SPICE_DEFAULTS = {"observer": "MOON", "body_frame": "IAU_MOON", "step_s": 0.1, "site": None}
 
 
 def is_external(config: dict, name: str) -> bool:
@@ -74,7 +73,7 @@ def is_external(config: dict, name: str) -> bool:
 def scenario_count(config: dict, name: str) -> int:
     """The scenario's trajectories: n_trajectories, or one per pose file."""
     sc = config["scenarios"][name]
-    return len(sc["poses"]["files"]) if sc.get("poses") else int(sc["n_trajectories"])
+    return len(sc["poses"]["files"]) if is_external(config, name) else int(sc["n_trajectories"])
 
 
 def trajectory_source(config: dict, name: str, trajectory_id: str | int) -> str:
@@ -85,14 +84,15 @@ def trajectory_source(config: dict, name: str, trajectory_id: str | int) -> str:
 def external_pose_settings(config: dict, name: str) -> dict:
     """What an external trajectory's poses depend on: the frame rate, the camera's mount
     (the trajectory point lies under it), the sphere (the altitude check), the gravity the
-    IMU takes away, the SPICE reading (with its defaults), the scenario and seed."""
+    IMU takes away, the SPICE reading (formats.spice.read_spice_samples's defaults for the
+    keys it leaves out), the scenario and seed."""
     spice = config["scenarios"][name]["poses"].get("spice")
     return {
         "fps": float(config["camera"]["fps"]),
         "mount_height_m": float(config["camera"]["mount_height_m"]),
         "moon_radius_m": float(config["motion_field"]["moon_radius_m"]),
         "g_m_s2": float(config["vehicle"]["g_m_s2"]),
-        "spice": {**SPICE_DEFAULTS, **spice} if spice else None,
+        "spice": dict(spice) if spice else None,
         "scenario": name,
         "seed": int(config["seed"]),
     }

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ..geometry.camera import horizon_distance_m
 from . import trajectory_rng, without_late_defaults
-from .poses import external_extents, scenario_divert
+from .poses import external_extents, is_external, scenario_divert
 
 TIMING_MODES = ("fixed", "adaptive")
 
@@ -62,7 +62,7 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     radius = float(config["motion_field"]["moon_radius_m"])
     # Out to the horizon of the scenario's highest camera (with a margin for climbs and
     # relief), from the farthest start point.
-    if sc.get("poses"):  # an external scenario: how far and high its files' flights go
+    if is_external(config, name):  # an external scenario: how far and high its files' flights go
         extents = external_extents(config, name)
         reach, top = max(e["reach_m"] for e in extents), max(e["top_m"] for e in extents)
     else:

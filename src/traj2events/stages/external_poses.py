@@ -14,7 +14,7 @@ from ..formats.hdf5 import FileFormatError
 from ..formats.poses import pose_format, read_pose_samples
 from ..formats.trajectory import write_trajectory
 from ..progress import log
-from ..trajectory.external import ExternalFlight, PoseSamples, sample_problems
+from ..trajectory.external import ExternalFlight, PoseSamples, interpolation_record, sample_problems
 
 
 def external_samples(source: str | os.PathLike, settings: dict) -> tuple[PoseSamples, dict]:
@@ -25,13 +25,6 @@ def external_samples(source: str | os.PathLike, settings: dict) -> tuple[PoseSam
     if problems:
         raise FileFormatError(f"{source}: {problems[0]}")
     return samples.shifted(), {**record, "source_t0_s": float(samples.t_s[0])}
-
-
-def interpolation_record(samples: PoseSamples) -> str:
-    """How the poses between samples were made (trajectory.h5's `interpolation`)."""
-    hermite = samples.velocity_m_s is not None
-    position = "cubic Hermite (the source's velocities)" if hermite else "not-a-knot cubic spline"
-    return f"position: {position}; attitude: slerp, body rates constant between samples"
 
 
 def external_poses(source: str | os.PathLike, trajectory_id: int, settings: dict, output: str | os.PathLike) -> None:

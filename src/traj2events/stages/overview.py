@@ -1,8 +1,9 @@
 """The dataset's overview page (results/overview.html, the report's "Dataset" page): what was
 built, in numbers and one figure. Per scenario and per trajectory: frames, flight time,
 events and their rate, bytes on disk; the event rate over each flight; the diverts and
-hovers flown; bytes per kind of file; summary.csv as a table; the code version and the resolved config. One
-self-contained HTML file (the figure embedded), the same bytes for the same dataset."""
+hovers flown; bytes per kind of file; summary.csv as a table; the code version and the
+resolved config. One self-contained HTML file (the figure embedded), the same bytes for
+the same dataset."""
 
 from __future__ import annotations
 
@@ -120,8 +121,8 @@ def dataset_overview(
     rows, curves, sizes, manoeuvres = [], [], [], []
     for index in indexes:
         listed = pd.read_csv(index)
-        manoeuvres += [{"scenario": name, **row} for name in listed["scenario"].unique()[:1]
-                       for row in manoeuvre_stats(listed)]  # fmt: skip
+        if len(listed):  # one scenario's index
+            manoeuvres += [{"scenario": listed["scenario"].iloc[0], **row} for row in manoeuvre_stats(listed)]
         for row in listed.itertuples():
             folder = Path(row.path).parent
             stats = trajectory_stats(folder, sorted(p.name for p in folder.iterdir()))

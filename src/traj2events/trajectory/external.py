@@ -23,8 +23,9 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 from scipy.spatial.transform import Rotation
 
-from .state import ATTITUDE, BODY_RATES, MASS, N_STATE, POSITION, VELOCITY
+from .state import ATTITUDE, BODY_RATES, N_STATE, POSITION, VELOCITY
 
+HERMITE_POSITION = "position: cubic Hermite"  # how interpolation_record names the Hermite
 MAX_STEP_DEG = 90.0  # a larger turn between two samples: slerp's shortest way may not be the flown one
 
 
@@ -98,6 +99,15 @@ def sample_problems(samples: PoseSamples, moon_radius_m: float) -> list[str]:
     return problems
 
 
+def interpolation_record(samples: PoseSamples) -> str:
+    """How ExternalFlight makes the poses between `samples` (trajectory.h5's `interpolation`)."""
+    if samples.velocity_m_s is not None:
+        position = f"{HERMITE_POSITION} (the source's velocities)"
+    else:
+        position = "position: not-a-knot cubic spline"
+    return f"{position}; attitude: slerp, body rates constant between samples"
+
+
 class ExternalFlight:
     """The interpolated flight of `samples` (time from 0 s): `states(t)` (len(t), 13) as a
     solved flight's, the mass NaN; `acceleration(t)` of the trajectory point (site frame,
@@ -117,7 +127,7 @@ class ExternalFlight:
         # change of the intervals' rates between their midpoints, linear in time.
         middles = (self.t_nodes[1:] + self.t_nodes[:-1]) / 2
         self._alpha_t = self.t_nodes[1:-1]
-        self._alpha = np.diff(self._rates, axis=0) / np.diff(middles)[:, None] if len(middles) > 1 else np.zeros((1, 3))
+        self._alpha = np.diff(self._rates, axis=0) / np.diff(middles)[:, None]
 
     def _interval(self, t: np.ndarray) -> np.ndarray:
         if len(t) and (t.min() < self.t_nodes[0] - 1e-9 or t.max() > self.t_nodes[-1] + 1e-9):
@@ -140,8 +150,7 @@ class ExternalFlight:
         out[:, VELOCITY] = self._camera(t, 1) + np.einsum("nij,nj->ni", matrices, np.cross(rates, self.mount_b))
         angles = rotation.as_euler("ZYX")[:, ::-1]  # (phi, theta, psi) of Rz(psi) Ry(theta) Rx(phi)
         out[:, ATTITUDE] = np.unwrap(angles, axis=0) if np.all(np.diff(t) >= 0) else angles
-        out[:, BODY_RATES] = rates
-        out[:, MASS] = np.nan
+        out[:, BODY_RATES] = rates  # the mass stays NaN: not known
         return out
 
     def angular_acceleration(self, t: np.ndarray) -> np.ndarray:

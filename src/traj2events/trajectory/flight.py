@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geometry.camera import camera_motion, camera_pose
 from .dynamics import Dynamics
-from .external import ExternalFlight, PoseSamples
-from .state import ATTITUDE, BODY_RATES, POSITION, VELOCITY, rotation_matrix
+from .external import HERMITE_POSITION, ExternalFlight, PoseSamples, quaternions_from_euler
+from .state import ATTITUDE, VELOCITY
 from .upsample import ReintegratedStates, interpolate_controls
 
 
@@ -35,15 +36,14 @@ def is_external(tr) -> bool:
 
 
 def camera_samples(t: np.ndarray, states: np.ndarray, mount_height_m: float, with_velocity: bool) -> PoseSamples:
-    """States of the trajectory point as the camera's poses (geometry/camera.py):
-    c = r + R m, c' = v + R (omega x m), m = (0, 0, -h)."""
-    from .external import quaternions_from_euler
-
-    rotations = np.array([rotation_matrix(*s[ATTITUDE]) for s in states])
-    mount = np.array([0.0, 0.0, -mount_height_m])
-    camera = states[:, POSITION] + rotations @ mount
-    velocity = states[:, VELOCITY] + np.einsum("nij,nj->ni", rotations, np.cross(states[:, BODY_RATES], mount))
-    return PoseSamples(t, camera, quaternions_from_euler(states[:, ATTITUDE]), velocity if with_velocity else None)
+    """States of the trajectory point as the camera's poses: its position and, with
+    `with_velocity`, its velocity in the site frame (geometry/camera.py's mount)."""
+    poses = [camera_pose(s, mount_height_m) for s in states]
+    camera = np.array([pose.position for pose in poses])
+    velocity = None
+    if with_velocity:
+        velocity = np.array([pose.rotation @ camera_motion(s, mount_height_m)[0] for pose, s in zip(poses, states)])
+    return PoseSamples(t, camera, quaternions_from_euler(states[:, ATTITUDE]), velocity)
 
 
 def flight_of(tr) -> SolvedFlight | ExternalFlight:
@@ -51,5 +51,5 @@ def flight_of(tr) -> SolvedFlight | ExternalFlight:
     if not is_external(tr):
         return SolvedFlight(tr)
     h = float(tr.attrs["camera_mount_height_m"])
-    hermite = str(tr.attrs["interpolation"]).startswith("position: cubic Hermite")
+    hermite = str(tr.attrs["interpolation"]).startswith(HERMITE_POSITION)
     return ExternalFlight(camera_samples(tr.t_nodes, tr.state_nodes, h, hermite), h)
