@@ -1,7 +1,9 @@
 """Rendering on OSMesa (and EGL on Mesa's software device, in a subprocess): depth against
 a ray cast on the mesh, a landmark where the camera model puts it, radiance on a flat plane
-against the reflectance law, determinism, sky, the backends and the tile slots."""
+against the reflectance law, determinism, sky, the backends and the tile slots.
+TRAJ2EVENTS_TEST_BACKEND=egl draws them through EGL instead (a GPU's, where there is one)."""
 
+import os
 import subprocess
 import sys
 
@@ -27,6 +29,7 @@ from traj2events.scene.terrain import (
 from traj2events.scene.tiles import LodSettings, TileSet
 
 R_MOON = 1737400.0
+BACKEND = os.environ.get("TRAJ2EVENTS_TEST_BACKEND", "osmesa")
 SUN = Sun(1.496e11, 105.0, 7.0)
 # Shaded per pixel, as by default, but with textures one level finer, not three: for the
 # tests of slots, eviction and stars, which do not depend on the shading and would spend
@@ -54,7 +57,7 @@ def render(
     scattered_azimuths=16,
 ):
     tiles = TileSet(terrain, sun.direction, radius, half_extent, lod, scattered_azimuths=scattered_azimuths)
-    with lens_renderer(tiles, camera, sun, reflectance, backend="osmesa") as renderer:
+    with lens_renderer(tiles, camera, sun, reflectance, backend=BACKEND) as renderer:
         return renderer.render(pose), tiles
 
 
@@ -99,6 +102,7 @@ def test_auto_backend_takes_the_first_egl_device_that_is_not_software():
         resolve_backend("gpu")
 
 
+@pytest.mark.skipif(BACKEND != "osmesa", reason="binds OSMesa")
 def test_a_process_bound_to_osmesa_refuses_egl():
     render(ProceduralTerrain(TerrainParams(seed=1)), Camera(16, 16, 45.0), camera_pose(state()))  # binds OSMesa
     tiles = TileSet(ProceduralTerrain(TerrainParams(seed=1)), SUN.direction, R_MOON, 140e3)
@@ -308,7 +312,7 @@ def test_horizon_at_the_tilt_limit_splits_sky_and_ground():
 def test_tile_cache_stays_bounded_and_never_drops_what_is_drawn():
     camera = Camera(32, 32, 45.0)
     tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, QUICK)
-    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend="osmesa") as renderer:
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend=BACKEND) as renderer:
         for x in (-3000.0, -1500.0, 0.0):
             frame = renderer.render(camera_pose(state(x=x, altitude=300.0, pitch=30.0)))
             assert frame.n_tiles > 0
@@ -409,7 +413,7 @@ def test_earthshine_on_a_flat_plane_is_the_lambert_sphere_value(shading_levels):
     tiles = TileSet(flat, sun.direction, 1e12, 5e3, lod, scattered_azimuths=0)
     frames = []
     for source in (None, earth):
-        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), backend="osmesa", earth=source) as renderer:
+        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), backend=BACKEND, earth=source) as renderer:
             frames.append(renderer.render(pose).radiance)
     alpha = np.radians(50.0)
     phase = (np.sin(alpha) + (np.pi - alpha) * np.cos(alpha)) / np.pi
@@ -442,7 +446,7 @@ def test_stars_light_only_the_sky_and_leave_the_terrain_as_it_was():
     terrain = ProceduralTerrain(TerrainParams(seed=4))
     tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, QUICK)
     stars = StarField.draw(5.0, seed=1)  # ~ 1400 over the sky: ~60 in a 45 deg view
-    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend="osmesa") as renderer:
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend=BACKEND) as renderer:
         starry = renderer.render(pose)
     plain, _ = render(terrain, camera, pose, lod=QUICK)
     ground = plain.depth_m > 0
@@ -464,10 +468,10 @@ def test_stars_through_a_lens_are_points_on_the_sensor_with_each_frame_its_own_p
     poses = [camera_pose(state(x=-5000.0, altitude=2000.0, pitch=p)) for p in (80.0, 78.0)]
     tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), SUN.direction, R_MOON, 140e3, QUICK)
     stars = StarField.draw(5.0, seed=1)
-    with lens_renderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend="osmesa") as renderer:
+    with lens_renderer(tiles, camera, SUN, ReflectanceParams(), stars=stars, backend=BACKEND) as renderer:
         ahead = list(renderer.render_sequence(poses))
         alone = [renderer.render(pose) for pose in poses]
-    with lens_renderer(tiles, camera, SUN, ReflectanceParams(), backend="osmesa") as renderer:
+    with lens_renderer(tiles, camera, SUN, ReflectanceParams(), backend=BACKEND) as renderer:
         plain = [renderer.render(pose) for pose in poses]
     for k, pose in enumerate(poses):
         expected = add_stars(plain[k].radiance, plain[k].depth_m, stars, camera, pose)
@@ -483,7 +487,7 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
     poses = [camera_pose(state(x=x, altitude=300.0, pitch=30.0)) for x in (-3000.0, -1500.0, 0.0, 1500.0)]
     between = camera_pose(state(x=-800.0, altitude=250.0, pitch=20.0))
     tiles = TileSet(ProceduralTerrain(TerrainParams(seed=6)), SUN.direction, R_MOON, 140e3, QUICK)
-    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend="osmesa") as renderer:
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), max_cached_tiles=20, backend=BACKEND) as renderer:
         frames, extra = [], None
         for k, frame in enumerate(renderer.render_sequence(iter(poses))):
             frames.append(frame)
@@ -538,7 +542,7 @@ def test_more_tiles_than_the_shading_texture_holds_is_a_clear_error(monkeypatch)
     monkeypatch.setattr(render_module, "_SHADING_BYTES", 3 * 8 * 17**2)  # three layers of 17^2 texels
     tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), SUN.direction, R_MOON, 140e3,
                     LodSettings(cells=8, shading_levels=1))  # fmt: skip
-    with TerrainRenderer(tiles, Camera(48, 48, 45.0), SUN, ReflectanceParams(), backend="osmesa") as renderer:
+    with TerrainRenderer(tiles, Camera(48, 48, 45.0), SUN, ReflectanceParams(), backend=BACKEND) as renderer:
         with pytest.raises(RuntimeError, match="render.lod.pixels_per_cell or lower render.lod.shading_levels"):
             renderer.render(camera_pose(state(altitude=400.0, pitch=50.0)))
 
@@ -560,7 +564,7 @@ def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1
     images = []
     for terrain in (cliff, flat):
         tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod)
-        with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend="osmesa", lod_camera=camera) as renderer:
+        with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend=BACKEND, lod_camera=camera) as renderer:
             frame = renderer.render(pose)
         images.append(frame.radiance.reshape(64, samples, 64, samples).mean(axis=(1, 3)))
     row = camera.height // 2

@@ -136,6 +136,9 @@ class _GLScene:
         self.uniform("vertices_per_tile", vertices_per_tile)
         if self.textured:
             self.uniform("shading", 2)
+            # point and trilinear: the level chosen in the shader (the same on every GPU)
+            self.uniform("level_here", int(texture_filter != "anisotropic"))
+            self.uniform("level_bias", footprint.LOD_BIAS)
 
     def _framebuffer(self) -> None:
         gl = self.gl
@@ -193,9 +196,8 @@ class _GLScene:
             (gl.GL_TEXTURE_MAX_LEVEL, len(self.level_sides) - 1),
         ):
             gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
-        if mipmapped:  # the filter as wide as the pixel (footprint.LOD_BIAS)
-            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, gl.GL_TEXTURE_LOD_BIAS, footprint.LOD_BIAS)
         if self.texture_filter == "anisotropic":  # samples along the footprint's long axis (oblique ground)
+            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, gl.GL_TEXTURE_LOD_BIAS, footprint.LOD_BIAS)
             gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, footprint.GL_TEXTURE_MAX_ANISOTROPY, footprint.MAX_ANISOTROPY)
         if self.capacity:
             for level, n in enumerate(self.level_sides):
