@@ -57,10 +57,12 @@ VARIANTS = [
 ]
 
 
-def render_window(settings, camera, states, times, texture_filter: str, samples: int):
+def render_window(settings, camera, states, times, texture_filter: str, samples: int, point_sun: bool = False):
     """(frames (n, h, w) float32 radiance, seconds per frame, the first frame's depth) of one
-    variant."""
+    variant; `point_sun`: shadows of a point Sun (no penumbrae)."""
     _, tiles, sun, reflectance = settings.build()
+    if point_sun:
+        tiles.sun_radius_rad = 0.0  # before any tile is built
     drawn = Camera(camera.width * samples, camera.height * samples, camera.fov_deg, camera.mount_height_m)
     frames = []
     with TerrainRenderer(tiles, drawn, sun, reflectance, texture_filter=texture_filter, lod_camera=camera) as r:
@@ -106,10 +108,12 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=2, help="rounds of the timed variants (best kept)")
     parser.add_argument("--variants", nargs="+", help="names of VARIANTS to run (default: all)")
     parser.add_argument("--regions", action="store_true", help="also each variant's events per kind of pixel")
+    parser.add_argument("--point-sun", action="store_true", help="shadows of a point Sun, without penumbrae")
     args = parser.parse_args()
     variants = [v for v in VARIANTS if not args.variants or v[0] in args.variants]
     print(f"# pixel integration: {args.size}^2, {args.frames} frames at {args.fps:g} fps, clean preset, sensor "
-          f"input; reference {args.reference}x{args.reference} point samples; {platform.node()} "
+          f"input, {'a point Sun' if args.point_sun else 'the Sun disc'}; reference {args.reference}x{args.reference} "
+          f"point samples; {platform.node()} "
           f"({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}")  # fmt: skip
     print("| window | variant | s per frame | vs point | events | vs reference | per-pixel count error "
           "| mean abs d ln I |")  # fmt: skip
@@ -125,13 +129,15 @@ def main() -> None:
         tf = float(tr.t_nodes[-1])
         for window, t0 in (("mid-flight", tf / 2), ("last second", tf - 1.0)):
             times = t0 + np.arange(args.frames) / args.fps
-            reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference)
+            reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference,
+                                                          args.point_sun)  # fmt: skip
             ref_counts = emulate(reference, times, scale)
             ref_log = log_intensity_8bit(reference * scale)
             results = {}
             for _ in range(args.repeats):  # alternated: every variant once per round
                 for name, texture_filter, samples in variants:
-                    frames, seconds, _ = render_window(settings, camera, states, times, texture_filter, samples)
+                    frames, seconds, _ = render_window(settings, camera, states, times, texture_filter, samples,
+                                                       args.point_sun)  # fmt: skip
                     best = min(seconds, results[name][1]) if name in results else seconds
                     results[name] = (frames, best)
             point_s = results.get(variants[0][0], (None, np.nan))[1]

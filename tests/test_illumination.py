@@ -1,11 +1,11 @@
-"""Sun convention and the horizon-march shadows."""
+"""Sun convention and the horizon-march shadows, with the Sun disc's penumbrae."""
 
 import numpy as np
 import pytest
 
-from traj2events.scene.illumination import local_sun_tan_elevation, shadow_field
+from traj2events.scene.illumination import local_sun_tan_elevation, shadow_field, visible_disc_fraction
 from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
-from traj2events.scene.sun import Sun, sun_direction
+from traj2events.scene.sun import AU_M, Sun, sun_direction
 
 FLAT = 1e15  # radius of a Moon so large its surface is a plane
 
@@ -72,3 +72,38 @@ def test_sun_at_azimuth_90_lights_slopes_facing_plus_y():
     bright = radiance_factor(*angles(facing_plus_y, sun, view), params)
     dark = radiance_factor(*angles(facing_minus_y, sun, view), params)
     assert bright > 2 * dark > 0
+
+
+@pytest.mark.parametrize("azimuth", [0.0, 30.0])
+@pytest.mark.parametrize("elevation", [3.0, 7.0])
+def test_a_walls_penumbra_is_the_part_of_the_suns_disc_above_its_top(azimuth, elevation):
+    # A 10 m wall at x >= 40 m, the Sun beyond it: from a point at x, the wall's top edge
+    # stands theta = atan(H cos(az) / (40 - x)) high toward the Sun, and the part of the
+    # 0.27 deg disc above it is lit (the circular segment's area). The penumbra spans
+    # H (cot(e + r) - cot(e - r)) cos(az) along x: 5.4-33 m here, 20-130 grid spacings.
+    spacing, height, wall_x = 0.25, 10.0, 40.0
+    x = np.arange(-260.0, 60.0 + spacing / 2, spacing)
+    y = np.arange(-10.0, 180.0 + spacing / 2, spacing)  # the rays toward a Sun at +30 deg drift to +y
+    h = np.where(x[:, None] >= wall_x, height, 0.0) * np.ones((1, y.size))
+    sun = Sun(AU_M, azimuth, elevation)
+    field = shadow_field(x, y, h, sun.direction, FLAT, sun_radius_rad=sun.angular_radius_rad)
+    r, e = sun.angular_radius_rad, np.radians(elevation)
+    c = np.cos(np.radians(azimuth))
+    front, at_y0 = x < wall_x - 0.5, int(np.argmin(np.abs(y)))
+    theta = np.arctan(height * c / (wall_x - x[front]))
+    expected = visible_disc_fraction((e - theta) / r)
+    row = field.lit[front, at_y0]
+    assert np.abs(row - expected).max() < 0.02
+    width = np.ptp(x[front][(row > 0.1) & (row < 0.9)])
+    d10, d90 = -0.6871, 0.6871  # visible_disc_fraction(d) = 0.1, 0.9
+    analytic = height * c * (1 / np.tan(e - r * d90) - 1 / np.tan(e - r * d10))
+    assert width == pytest.approx(analytic, abs=2 * spacing)
+    point = shadow_field(x, y, h, sun.direction, FLAT, sun_radius_rad=0.0).lit[front, at_y0]
+    assert np.ptp(x[front][(point > 0.1) & (point < 0.9)]) < 0.05 * width  # a point Sun: a sharp edge
+
+
+def test_the_visible_part_of_a_disc_by_hand():
+    assert visible_disc_fraction(np.array([-1.5, -1.0, 0.0, 1.0, 2.0])) == pytest.approx([0, 0, 0.5, 1, 1])
+    # a horizon through half the radius below the centre: segment 1 - (pi/3 - sqrt(3)/4) / pi
+    assert visible_disc_fraction(0.5) == pytest.approx(1 - (np.pi / 3 - np.sqrt(3) / 4) / np.pi, abs=1e-12)
+    assert visible_disc_fraction(-0.5) == pytest.approx((np.pi / 3 - np.sqrt(3) / 4) / np.pi, abs=1e-12)

@@ -550,7 +550,8 @@ def test_more_tiles_than_the_shading_texture_holds_is_a_clear_error(monkeypatch)
 def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """(rendered, analytic) lit fraction of a nadir camera's middle row over a straight
     shadow edge at x = x_edge_m on flat ground: a 10 m cliff beyond the view casts it, the
-    Sun from +x at 20 deg. Texels are 1/8-1/4 of a pixel (2 pixels per cell, 3 levels).
+    Sun from +x at 20 deg, a point (the disc's penumbra would be 0.8 m wide: 0.6 px).
+    Texels are 1/8-1/4 of a pixel (2 pixels per cell, 3 levels).
     `samples`: drawn at samples x samples per pixel and averaged (the same tiles)."""
     spacing, height, elevation = 0.25, 10.0, 20.0
     x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
@@ -563,7 +564,7 @@ def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1
     lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter)
     images = []
     for terrain in (cliff, flat):
-        tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod)
+        tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod, sun_radius_rad=0.0)
         with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend=BACKEND, lod_camera=camera) as renderer:
             frame = renderer.render(pose)
         images.append(frame.radiance.reshape(64, samples, 64, samples).mean(axis=(1, 3)))

@@ -53,8 +53,8 @@ def test_a_shading_texture_holds_the_descendants_normals_at_their_grid_points():
 
 def test_a_shading_texture_casts_shadows_across_the_descendants_edges():
     """The texture's lit fractions are one long sweep's at the fine spacing (to the half
-    float); its descendants', each swept over its own grid and margin with a coarser
-    obstruction beyond, are 10x further off."""
+    float, with the Sun's disc); its descendants', each swept over its own grid and margin
+    with a coarser obstruction beyond, are 10x further off."""
     # A low Sun and a short margin: shadows reach across many descendants' edges.
     tiles = _tiles(sun=(0.3, -0.4, -0.05), min_spacing_m=0.5, margin=4)
     key, levels, n = (4, 7, 8), 2, 9
@@ -68,7 +68,10 @@ def test_a_shading_texture_casts_shadows_across_the_descendants_edges():
     assert 0.05 < reference.mean() < 0.95  # some shadow, some light
     ours, theirs = np.abs(lit - reference).mean(), np.abs(descendants - reference).mean()
     assert ours < theirs / 10 and theirs > 0.01, (ours, theirs)
-    np.testing.assert_allclose(lit, reference, atol=1e-3, err_msg="not the long sweep's shadows")
+    # Penumbrae need the occluder's distance, which beyond the margin comes from the coarser
+    # grid: within 1e-3 but at a few texels (0.5 %) of the last column, within 0.05 there.
+    off = np.abs(lit - reference)
+    assert (off > 1e-3).mean() < 0.01 and off.max() < 0.05, "not the long sweep's shadows"
 
 
 def test_where_the_quadtree_ends_the_shading_texture_is_the_finest_tile_resampled():

@@ -7,7 +7,9 @@ from above, as a compass with +x as north and +y as east. The elevation is above
 site's horizontal plane. The unit vector towards the Sun is
     d = (cos el cos az, cos el sin az, -sin el)        (z down)
 so a Sun at azimuth 90 deg lights slopes that face +y. The range only sets the
-irradiance: E = 1361 W/m^2 (1 AU / range)^2.
+irradiance: E = 1361 W/m^2 (1 AU / range)^2, and the Sun's disc its angular radius,
+asin(R_sun / range): 0.2666 deg at 1 AU, the half-width of the penumbrae
+(illumination.visible_disc_fraction).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import numpy as np
 
 SOLAR_CONSTANT_W_M2 = 1361.0  # at 1 AU
 AU_M = 1.495978707e11
+SOLAR_RADIUS_M = 6.957e8  # IAU 2015 nominal
 
 
 @dataclass(frozen=True)
@@ -34,6 +37,11 @@ class Sun:
     @property
     def irradiance_w_m2(self) -> float:
         return SOLAR_CONSTANT_W_M2 * (AU_M / self.range_m) ** 2
+
+    @property
+    def angular_radius_rad(self) -> float:
+        """The solar disc's angular radius seen from the site (rad)."""
+        return float(np.arcsin(SOLAR_RADIUS_M / self.range_m))
 
 
 def sun_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:

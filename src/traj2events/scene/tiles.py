@@ -22,9 +22,9 @@ Light scattered into shadows (scattering.py): per drawn tile's vertex, a horizon
 the tile's grid, then over the 3 x 3 tiles around each of its ancestors (coarser, wider
 grids of heights and sunlit fractions), computed when the renderer first asks.
 
-Shadows per tile come from the horizon march (illumination.shadow_field) over the tile's
-grid extended by `margin` cells toward the Sun, with the parent tile's obstruction heights
-beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
+Shadows per tile, with the Sun disc's penumbrae, come from the horizon march
+(illumination.shadow_field) over the tile's grid extended by `margin` cells toward the Sun,
+with the parent tile's obstruction heights (and their occluders' distances) beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
 and nearby fine relief at the tile's own.
 """
 
@@ -40,7 +40,7 @@ import numpy as np
 from ..defaults import section
 from ..formats.tile_cache import TileCache
 from ..geometry.camera import Camera, CameraPose
-from .illumination import ShadowField, no_obstruction, shadow_field
+from .illumination import SUN_RADIUS_RAD, ShadowField, no_obstruction, shadow_field
 from .scattering import height_normals, scattered_sunlight
 from .terrain import Terrain, surface_points
 
@@ -95,17 +95,20 @@ class TileSet:
         lod: LodSettings = LodSettings(),
         cache_dir: str | None = None,
         scattered_azimuths: int = _SCATTERED_AZIMUTHS,
+        sun_radius_rad: float = SUN_RADIUS_RAD,
     ):
         """`cache_dir`: a folder for the tile cache (heights shared with other TileSets
         and jobs; formats/tile_cache.py), or None: every tile's terrain is evaluated here.
         `scattered_azimuths`: directions of the march for light scattered into shadows
-        (render.scattered_light.azimuths; 0: none, shadows are black)."""
+        (render.scattered_light.azimuths; 0: none, shadows are black). `sun_radius_rad`:
+        the Sun disc's angular radius, the penumbrae's (Sun.angular_radius_rad; 0: a point)."""
         self.terrain = terrain
         self.sun_dir = np.asarray(sun_dir, float)
         self.radius_m = radius_m
         self.half_extent_m = half_extent_m
         self.lod = lod
         self.scattered_azimuths = scattered_azimuths
+        self.sun_radius_rad = float(sun_radius_rad)
         self._cache: dict[TileKey, Tile] = {}
         self.faces = _grid_faces(lod.cells + 1)
         self.cache_dir = cache_dir
@@ -134,7 +137,7 @@ class TileSet:
 
     def shading_identity(self, levels: int) -> dict:
         """What a drawn tile's shading texture depends on: its descendants' heights, the
-        exact Sun direction and the Moon's radius (their shadows and normals), where the
+        exact Sun direction and disc and the Moon's radius (their shadows and normals), where the
         quadtree ends, the levels, and the tile code (illumination and terrain with it)."""
         from ..fingerprint import code_fingerprint
 
@@ -142,6 +145,7 @@ class TileSet:
             "kind": "shading_texture",
             "heights": self.heights_identity(),
             "sun_dir": [float(v) for v in self.sun_dir],
+            "sun_radius_rad": self.sun_radius_rad,
             "radius_m": float(self.radius_m),
             "min_spacing_m": float(self.lod.min_spacing_m),
             "levels": int(levels),
@@ -227,8 +231,8 @@ class TileSet:
             self.n_evaluated += 1
             if self.disk:
                 self.disk.save(key, h)
-        beyond = no_obstruction if level == 0 else self.tile((level - 1, i >> 1, j >> 1)).shadow.obstruction_at
-        shadow = shadow_field(x, y, h, self.sun_dir, self.radius_m, beyond)
+        beyond = no_obstruction if level == 0 else self.tile((level - 1, i >> 1, j >> 1)).shadow.boundary
+        shadow = shadow_field(x, y, h, self.sun_dir, self.radius_m, beyond, self.sun_radius_rad)
         points = surface_points(xx, yy, h, self.radius_m)
         normals = _grid_normals(points)
         core = (slice(lo_x, lo_x + n + 1), slice(lo_y, lo_y + n + 1))
@@ -340,7 +344,7 @@ class TileSet:
                 x, y, lo_x, lo_y = self._extended_axes(level + down, origin, self.lod.cells * 2**down)
                 xx, yy = np.meshgrid(x, y, indexing="ij")
                 h = self.terrain.height_m(xx, yy, self.tile_spacing_m(level + down))
-                field = shadow_field(x, y, h, self.sun_dir, self.radius_m, field.obstruction_at)
+                field = shadow_field(x, y, h, self.sun_dir, self.radius_m, field.boundary, self.sun_radius_rad)
             out = np.empty((n + 1, n + 1, 4), np.float32)
             inner = (slice(lo_x - 1, lo_x + n), slice(lo_y - 1, lo_y + n))
             out[..., :3] = _grid_normals(surface_points(xx, yy, h, self.radius_m))[inner]
@@ -426,12 +430,13 @@ def long_sweep_lit(tiles: TileSet, key: TileKey, levels: int, widths: int = 4) -
     ancestors = [tiles.tile((level - up, i >> up, j >> up)).shadow for up in range(level + 1)]
 
     def beyond(px, py):  # the finest ancestor's obstruction where its grid holds the point
-        o = np.full(np.shape(px), -np.inf)
+        o, d = no_obstruction(px, py)
         for shadow in ancestors:
-            o = np.where(np.isneginf(o), shadow.obstruction_at(px, py), o)
-        return o
+            o_up, d_up = shadow.boundary(px, py)
+            o, d = np.where(np.isneginf(o), o_up, o), np.where(np.isneginf(o), d_up, d)
+        return o, d
 
-    field = shadow_field(x, y, h, tiles.sun_dir, tiles.radius_m, beyond)
+    field = shadow_field(x, y, h, tiles.sun_dir, tiles.radius_m, beyond, tiles.sun_radius_rad)
     return field.lit[lo_x : lo_x + n + 1, lo_y : lo_y + n + 1]
 
 

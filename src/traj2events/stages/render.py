@@ -92,7 +92,10 @@ class RenderSettings:
         sun = Sun(**self.sun)
         lod = LodSettings(**self.lod)
         azimuths = int(self.scattered_light["azimuths"])
-        tiles = TileSet(terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache, azimuths)
+        tiles = TileSet(
+            terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache, azimuths,
+            sun.angular_radius_rad,
+        )  # fmt: skip
         return (
             Camera.from_settings(vars(self)),
             tiles,
