@@ -610,3 +610,58 @@ def test_relief_seen_edge_on_in_the_texture_is_not_black():
     assert (frames[0].depth_m > 0).mean() > 0.8
     assert textured.min() > 0.5 * np.median(textured)
     assert textured.mean() == pytest.approx(meshed.mean(), rel=0.01)
+
+
+def test_a_translating_shadow_edge_fires_the_events_its_pixels_area_integrals_predict():
+    # shadow_edge_fractions' edge, crossing the middle row at 0.1 px per frame (the camera
+    # flies along +x, 100 fps): each pixel's area integral is the lit radiance times the
+    # part of it left of the edge, a ramp over 10 frames down to the black shadow. The
+    # clean emulator on those analytic rows and on the rendered ones: the same events per
+    # pixel (43 as a pixel darkens), and with the footprint the events come about one
+    # frame after the analytic ones (its filter is a little wider than the pixel: the last
+    # light fades later), half point sampling's error (all of a pixel's events at once).
+    from traj2events.config import resolve_config
+    from traj2events.sensor.emulator import EventEmulator
+    from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+    from traj2events.stages.events import preset_params
+
+    spacing, height, elevation, x_edge = 0.25, 10.0, 20.0, 0.3
+    x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
+    cliff_x = x_edge + height / np.tan(np.radians(elevation))
+    cliff = GridTerrain(np.where(x[:, None] >= cliff_x, height, 0.0) * np.ones((1, x.size)), spacing, (x[0], x[0]))
+    camera, sun = Camera(64, 64, 45.0), Sun(1.496e11, 0.0, elevation)
+    pixel_m, row = 100.0 / camera.focal_px, camera.height // 2
+    times = np.arange(41) / 100.0
+    speed = 0.1 * pixel_m * 100.0
+    centre_x = camera.pixel_coordinates()[0][0] * pixel_m  # each column's ground x, camera at x = 0
+    scale = dn_per_radiance(SensorParams.from_config(resolve_config({})["events"]["sensor"]))
+
+    def rows(terrain, texture_filter):
+        lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter)
+        tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod, scattered_azimuths=0, sun_radius_rad=0.0)
+        with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), backend=BACKEND) as renderer:
+            return np.stack([renderer.render(camera_pose(state(x=speed * t, altitude=100.0))).radiance[row]
+                             for t in times])  # fmt: skip
+
+    def events(frames):
+        emulator = EventEmulator(camera.width, 1, preset_params("clean"), seed=1, input_scale=scale)
+        return emulator.process(frames[:, None, :].astype(np.float32), times)
+
+    lit = rows(GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0)), "trilinear")[0]
+    crossed = np.flatnonzero(np.abs(centre_x - x_edge + 2.0 * pixel_m) < 1.2 * pixel_m)  # crossed in 4 px
+    errors = {}
+    for texture_filter in ("trilinear", "point"):
+        rendered = rows(cliff, texture_filter)
+        # the edge where the rendered first frame puts it (its lit area; the march moves it ~0.2 px)
+        near = np.abs(centre_x - x_edge) < 12.0
+        edge = (centre_x - pixel_m / 2)[near][0] + (rendered[0] / lit)[near].sum() * pixel_m
+        ground = centre_x[None, :] + speed * times[:, None]
+        analytic = lit * np.clip((edge - (ground - pixel_m / 2)) / pixel_m, 0.0, 1.0)
+        expected, got = events(analytic), events(rendered)
+        dt = []
+        for column in crossed:
+            t_expected, t_got = expected["t"][expected["x"] == column], got["t"][got["x"] == column]
+            assert len(t_got) == len(t_expected) > 30, (texture_filter, column)
+            dt.append(np.abs(t_got.astype(float) - t_expected.astype(float)))
+        errors[texture_filter] = np.median(np.concatenate(dt)) * 1e-6  # s
+    assert errors["trilinear"] < 0.011 and errors["trilinear"] < 0.6 * errors["point"], errors
