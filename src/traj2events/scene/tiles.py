@@ -24,8 +24,9 @@ grids of heights and sunlit fractions), computed when the renderer first asks.
 
 Shadows per tile, with the Sun disc's penumbrae, come from the horizon march
 (illumination.shadow_field) over the tile's grid extended by `margin` cells toward the Sun,
-with the parent tile's obstruction heights (and their occluders' distances) beyond, so a shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy
-and nearby fine relief at the tile's own.
+with the parent tile's obstruction heights (and their occluders' distances) beyond, so a
+shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy and nearby
+fine relief at the tile's own.
 """
 
 from __future__ import annotations
