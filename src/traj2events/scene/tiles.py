@@ -22,11 +22,10 @@ Light scattered into shadows (scattering.py): per drawn tile's vertex, a horizon
 the tile's grid, then over the 3 x 3 tiles around each of its ancestors (coarser, wider
 grids of heights and sunlit fractions), computed when the renderer first asks.
 
-Shadows per tile, with the Sun disc's penumbrae, come from the horizon march
-(illumination.shadow_field) over the tile's grid extended by `margin` cells toward the Sun,
-with the parent tile's obstruction heights (and their occluders' distances) beyond, so a
-shadow cast from kilometres away reaches a 1 m tile at the parent's accuracy and nearby
-fine relief at the tile's own.
+Shadows per tile (penumbrae too) come from the horizon march (illumination.shadow_field)
+over the tile's grid extended by `margin` cells toward the Sun, with the parent's obstruction
+(and occluder distances) beyond, so a shadow cast from kilometres away reaches a 1 m tile
+at the parent's accuracy and nearby fine relief at the tile's own.
 """
 
 from __future__ import annotations
@@ -101,8 +100,8 @@ class TileSet:
         """`cache_dir`: a folder for the tile cache (heights shared with other TileSets
         and jobs; formats/tile_cache.py), or None: every tile's terrain is evaluated here.
         `scattered_azimuths`: directions of the march for light scattered into shadows
-        (render.scattered_light.azimuths; 0: none, shadows are black). `sun_radius_rad`:
-        the Sun disc's angular radius, the penumbrae's (Sun.angular_radius_rad; 0: a point)."""
+        (render.scattered_light.azimuths; 0: none, shadows are black). `sun_radius_rad`: the
+        Sun disc's angular radius, of the penumbrae (Sun.angular_radius_rad; 0: a point)."""
         self.terrain = terrain
         self.sun_dir = np.asarray(sun_dir, float)
         self.radius_m = radius_m
@@ -432,8 +431,7 @@ def long_sweep_lit(tiles: TileSet, key: TileKey, levels: int, widths: int = 4) -
 
     def beyond(px, py):  # the finest ancestor's obstruction where its grid holds the point
         o, d = no_obstruction(px, py)
-        for shadow in ancestors:
-            o_up, d_up = shadow.boundary(px, py)
+        for o_up, d_up in (shadow.boundary(px, py) for shadow in ancestors):
             o, d = np.where(np.isneginf(o), o_up, o), np.where(np.isneginf(o), d_up, d)
         return o, d
 
