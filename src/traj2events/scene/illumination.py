@@ -68,19 +68,6 @@ def no_obstruction(x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 @njit(cache=True, nogil=True)
-def _interpolate_row(values, k, x):
-    """np.interp of `values` (one row, grid 0 .. n1-1) at x in [k, k + 1), NaN-tolerant as
-    the sweep's obstruction needs (a NaN neighbour leaves the other's value)."""
-    slope = (values[k + 1] - values[k]) / 1.0
-    value = slope * (x - k) + values[k]
-    if np.isnan(value):
-        value = slope * (x - (k + 1)) + values[k + 1]
-        if np.isnan(value) and values[k] == values[k + 1]:
-            value = values[k]
-    return value
-
-
-@njit(cache=True, nogil=True)
 def _sweep_rows(heights, tan_el, o_next, d_next, lateral, outside, edge_o, edge_d, step_m, s_out, o_out, d_out, c_out):
     """The sweep's recurrence, row by row from the Sun's side (compiled: a tile has ~100
     rows): S = O(next row, interpolated at `lateral`) - step tan(e), DARK_M where the Sun is
@@ -93,29 +80,41 @@ def _sweep_rows(heights, tan_el, o_next, d_next, lateral, outside, edge_o, edge_
             t = tan_el[i, m]
             s = o_next[m] - step_m * t if np.isfinite(t) else DARK_M  # Sun below the local horizon: dark
             s_out[i, m] = s
-            d_out[i, m] = step_m + d_next[m]
+            distance = step_m + d_next[m]
+            d_out[i, m] = distance
             h = heights[i, m]
-            own = h > s or np.isnan(h)  # np.maximum (s is never NaN)
-            o_out[i, m] = h if own else s
-            c_out[i, m] = 0.0 if own else d_out[i, m]
+            if h > s or np.isnan(h):  # np.maximum (s is never NaN): the point is its own obstruction
+                o_out[i, m] = h
+                c_out[i, m] = 0.0
+            else:
+                o_out[i, m] = s
+                c_out[i, m] = distance
         if i:
             n_out = 0
             for m in range(n1):
                 if outside[m]:
-                    o_next[m], d_next[m] = edge_o[i, n_out], edge_d[i, n_out]
+                    o_next[m] = edge_o[i, n_out]
+                    d_next[m] = edge_d[i, n_out]
                     n_out += 1
                     continue
                 x = lateral[m]
                 if x >= n1 - 1:
-                    o_next[m], d_next[m] = o_out[i, n1 - 1], c_out[i, n1 - 1]
+                    o_next[m] = o_out[i, n1 - 1]
+                    d_next[m] = c_out[i, n1 - 1]
                     continue
                 k = int(np.floor(x))
                 if x == k:
-                    o_next[m], d_next[m] = o_out[i, k], c_out[i, k]
+                    o_next[m] = o_out[i, k]
+                    d_next[m] = c_out[i, k]
                     continue
-                o_next[m] = _interpolate_row(o_out[i], k, x)
-                d = _interpolate_row(c_out[i], k, x)
-                d_next[m] = 0.0 if np.isnan(d) else d
+                slope = (o_out[i, k + 1] - o_out[i, k]) / 1.0
+                value = slope * (x - k) + o_out[i, k]
+                if np.isnan(value):
+                    value = slope * (x - (k + 1)) + o_out[i, k + 1]
+                    if np.isnan(value) and o_out[i, k] == o_out[i, k + 1]:
+                        value = o_out[i, k]
+                o_next[m] = value
+                d_next[m] = c_out[i, k] + (c_out[i, k + 1] - c_out[i, k]) * (x - k)  # never NaN
 
 
 @dataclass(frozen=True)
@@ -197,13 +196,18 @@ def shadow_field(
         edge_o, edge_d = (np.asarray(a, dtype=float) for a in beyond_sweep(xa[:, None], lateral[outside][None, :]))
     else:
         edge_o = edge_d = np.empty((n0, 0))
-    with np.errstate(invalid="ignore"):
-        tan_low = np.where(np.isfinite(ta), np.tan(np.arctan(ta) - sun_radius_rad), -np.inf)  # the disc's lowest ray
+    tan_r = np.tan(sun_radius_rad)
+    with np.errstate(invalid="ignore"):  # the disc's lowest ray: tan(e - r), -inf kept where the Sun is set
+        tan_low = np.where(np.isfinite(ta), (ta - tan_r) / (1.0 + ta * tan_r), -np.inf)
     _sweep_rows(ha, tan_low, o_next, d_next, lateral, outside, edge_o, edge_d, step_m, s_out, o_out, d_out, c_out)
     with np.errstate(invalid="ignore", over="ignore"):
         tan_e = np.maximum(ta, 1e-12)
-        disc = d_out * sun_radius_rad * (1.0 + tan_e**2)  # the disc's half-width in h - S (m)
-        lit = visible_disc_fraction((ha - s_out + disc) / np.maximum(disc, 0.5 * step_m * tan_e))  # or a step's rise
+        disc = d_out * sun_radius_rad * (1.0 + tan_e * tan_e)  # the disc's half-width in h - S (m)
+        d = (ha - s_out + disc) / np.maximum(disc, 0.5 * step_m * tan_e)  # or a step's rise's
+        lit = (d >= 1.0).astype(float)
+        edge = np.abs(d) < 1.0  # the few points in a penumbra
+        lit[edge] = visible_disc_fraction(d[edge])
+        lit[np.isnan(d)] = np.nan
     lit[~np.isfinite(ta)] = 0.0
     lit = np.nan_to_num(lit, nan=1.0)
 
