@@ -547,18 +547,26 @@ def test_more_tiles_than_the_shading_texture_holds_is_a_clear_error(monkeypatch)
             renderer.render(camera_pose(state(altitude=400.0, pitch=50.0)))
 
 
+EDGE_SUN = Sun(1.496e11, 0.0, 20.0)  # from +x, 20 deg up
+
+
+def cliff_casting_an_edge_at(x_edge_m: float) -> GridTerrain:
+    """Flat ground and a 10 m cliff toward +x whose top's shadow under EDGE_SUN ends at
+    x = x_edge_m (the cliff 27.5 m beyond it)."""
+    spacing, height = 0.25, 10.0
+    x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
+    cliff_x = x_edge_m + height / np.tan(np.radians(EDGE_SUN.elevation_deg))
+    return GridTerrain(np.where(x[:, None] >= cliff_x, height, 0.0) * np.ones((1, x.size)), spacing, (x[0], x[0]))
+
+
 def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """(rendered, analytic) lit fraction of a nadir camera's middle row over a straight
     shadow edge at x = x_edge_m on flat ground: a 10 m cliff beyond the view casts it, the
     Sun from +x at 20 deg, a point (the disc's penumbra would be 0.8 m wide: 0.6 px).
     Texels are 1/8-1/4 of a pixel (2 pixels per cell, 3 levels).
     `samples`: drawn at samples x samples per pixel and averaged (the same tiles)."""
-    spacing, height, elevation = 0.25, 10.0, 20.0
-    x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
-    cliff_x = x_edge_m + height / np.tan(np.radians(elevation))  # the shadow of its top edge
-    cliff = GridTerrain(np.where(x[:, None] >= cliff_x, height, 0.0) * np.ones((1, x.size)), spacing, (x[0], x[0]))
-    flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
-    camera, sun = Camera(64, 64, 45.0), Sun(1.496e11, 0.0, elevation)
+    cliff, flat = cliff_casting_an_edge_at(x_edge_m), GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
+    camera, sun = Camera(64, 64, 45.0), EDGE_SUN
     drawn = Camera(64 * samples, 64 * samples, 45.0)
     pose = camera_pose(state(altitude=100.0))  # nadir: columns along +x
     lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter)
@@ -625,11 +633,9 @@ def test_a_translating_shadow_edge_fires_the_events_its_pixels_area_integrals_pr
     from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
     from traj2events.stages.events import preset_params
 
-    spacing, height, elevation, x_edge = 0.25, 10.0, 20.0, 0.3
-    x = np.arange(-100.0, 100.0 + spacing / 2, spacing)
-    cliff_x = x_edge + height / np.tan(np.radians(elevation))
-    cliff = GridTerrain(np.where(x[:, None] >= cliff_x, height, 0.0) * np.ones((1, x.size)), spacing, (x[0], x[0]))
-    camera, sun = Camera(64, 64, 45.0), Sun(1.496e11, 0.0, elevation)
+    x_edge = 0.3
+    cliff = cliff_casting_an_edge_at(x_edge)
+    camera, sun = Camera(64, 64, 45.0), EDGE_SUN
     pixel_m, row = 100.0 / camera.focal_px, camera.height // 2
     times = np.arange(41) / 100.0
     speed = 0.1 * pixel_m * 100.0

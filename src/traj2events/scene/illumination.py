@@ -31,11 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .sun import AU_M, SOLAR_RADIUS_M
+from .sun import AU_M, disc_radius_rad
 from .terrain import bilinear
 
 DARK_M = 1.0e12  # shadow height where the Sun is below the horizon (finite, to interpolate)
-SUN_RADIUS_RAD = float(np.arcsin(SOLAR_RADIUS_M / AU_M))  # the disc's angular radius at 1 AU
+SUN_RADIUS_RAD = disc_radius_rad(AU_M)  # the disc's angular radius at 1 AU
 
 
 def visible_disc_fraction(d: np.ndarray) -> np.ndarray:
@@ -129,17 +129,12 @@ class ShadowField:
     occluder_distance_m: np.ndarray  # horizontal, toward the Sun; 0 where O is the point's own height
     lit: np.ndarray  # 0 (shadow) .. 1 (lit): the part of the Sun's disc seen
 
-    def obstruction_at(self, x_m: np.ndarray, y_m: np.ndarray) -> np.ndarray:
-        """Bilinear O at points inside the grid; -inf outside (callers pass a parent)."""
-        return bilinear(
-            self.obstruction_m, (self.x_m[0], self.y_m[0]), self.x_m[1] - self.x_m[0], x_m, y_m, fill=-np.inf
-        )
-
     def boundary(self, x_m: np.ndarray, y_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(O, D) at points inside the grid, bilinear (-inf, 0 outside): a finer grid's
         `beyond` (Boundary)."""
         origin, spacing = (self.x_m[0], self.y_m[0]), self.x_m[1] - self.x_m[0]
-        return self.obstruction_at(x_m, y_m), bilinear(self.occluder_distance_m, origin, spacing, x_m, y_m, fill=0.0)
+        return (bilinear(self.obstruction_m, origin, spacing, x_m, y_m, fill=-np.inf),
+                bilinear(self.occluder_distance_m, origin, spacing, x_m, y_m, fill=0.0))  # fmt: skip
 
 
 def shadow_field(
@@ -207,9 +202,8 @@ def shadow_field(
         lit = (d >= 1.0).astype(float)
         edge = np.abs(d) < 1.0  # the few points in a penumbra
         lit[edge] = visible_disc_fraction(d[edge])
-        lit[np.isnan(d)] = np.nan
+        lit[np.isnan(d)] = 1.0  # a hole in the heights (NaN): lit
     lit[~np.isfinite(ta)] = 0.0
-    lit = np.nan_to_num(lit, nan=1.0)
 
     def back(a):
         if flip_l:

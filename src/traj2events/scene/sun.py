@@ -41,7 +41,12 @@ class Sun:
     @property
     def angular_radius_rad(self) -> float:
         """The solar disc's angular radius seen from the site (rad)."""
-        return float(np.arcsin(SOLAR_RADIUS_M / self.range_m))
+        return disc_radius_rad(self.range_m)
+
+
+def disc_radius_rad(range_m: float) -> float:
+    """The solar disc's angular radius (rad) seen from `range_m`: asin(R_sun / range)."""
+    return float(np.arcsin(SOLAR_RADIUS_M / range_m))
 
 
 def sun_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:

@@ -45,7 +45,7 @@ void main()
     float mu0 = max(dot(normal, sun_dir), clamp(texel.w, 0.0, 1.0));
     float per_mu0 = law_per_mu0(mu0, mu, frag_phase);
     float direct = per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI;
-    float earthshine = earthshine_radiance(normalize(texel.xyz));
+    float earthshine = earthshine_radiance(normal);
     float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
 }
