@@ -1,6 +1,7 @@
 """Tile grids (tiles.py). Selection and drawing are tested with the renderer (test_render.py)."""
 
 import numpy as np
+import pytest
 
 from traj2events.scene.tiles import _grid_faces, long_sweep_lit
 
@@ -112,3 +113,28 @@ def test_building_time_counts_nested_builds_once():
     wall = time.perf_counter() - start
     assert tiles.n_built == 6
     assert 0.5 * wall < tiles.building_s <= wall  # not once per nesting level
+
+
+def test_a_drawn_tiles_cells_cover_at_most_pixels_per_cell_unless_it_is_the_finest():
+    # select_measured's pixels per cell, the renderer's measure of magnified texels: a
+    # cell's spacing over its nearest point's distance, in focal lengths (foreshortened
+    # for tiles far beyond their size), at most pixels_per_cell where the tile could split.
+    from traj2events.geometry.camera import Camera, camera_pose
+
+    tiles = _tiles(pixels_per_cell=4.0, min_spacing_m=0.5)
+    camera = Camera(64, 64, 45.0)
+    state = np.zeros(13)
+    state[:3], state[6:9] = (30.0, -20.0, -150.0), np.radians([0.0, 40.0, 0.0])
+    pose = camera_pose(state)
+    keys, cell_px = tiles.select_measured(pose, camera)
+    assert keys == tiles.select(pose, camera) and len(cell_px) == len(keys) > 4
+    finest = np.array([key[0] for key in keys]) == tiles.max_level()
+    assert np.all(cell_px[~finest] <= 4.0) and np.all(cell_px > 0) and cell_px.max() > 2.0
+    for key, px in zip(keys, cell_px):
+        tile = tiles.tile(key)
+        distance = np.linalg.norm(tile.centre - pose.position)
+        unforeshortened = tile.spacing_m * camera.focal_px / max(distance - tile.radius_m, 1e-3)
+        if distance > 2 * tile.radius_m:
+            assert 0.2 * unforeshortened <= px <= unforeshortened * (1 + 1e-9)
+        else:
+            assert px == pytest.approx(unforeshortened)

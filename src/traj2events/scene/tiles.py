@@ -43,6 +43,7 @@ from ..geometry.camera import Camera, CameraPose
 from .illumination import SUN_RADIUS_RAD, ShadowField, no_obstruction, shadow_field
 from .scattering import height_normals, scattered_sunlight
 from .terrain import Terrain, surface_points
+from .view import frustum_planes, line_of_sight_limit
 
 TileKey = tuple[int, int, int]  # (level, i, j); i along x, j along y, 0..2^level - 1
 
@@ -76,6 +77,7 @@ class LodSettings:
     min_spacing_m: float = _LOD["min_spacing_m"]
     shading_levels: int = _LOD["shading_levels"]  # 0: law per vertex; k: per pixel, normals k levels finer
     texture_filter: str = _LOD["texture_filter"]  # how a pixel samples the shading texture (renderer.draw)
+    magnified_texel_px: float = _LOD["magnified_texel_px"]  # a texel wider than this (px): one level finer
     skirt_cells: float = 2.0  # skirt depth in cells of the tile
     foreshortening: bool = True  # measure a cell by its projected area, not its width
 
@@ -358,14 +360,19 @@ class TileSet:
     # --- selection --------------------------------------------------------------------
 
     def select(self, pose: CameraPose, camera: Camera) -> list[TileKey]:
-        """Tiles to draw for this camera: in view, above the horizon, at the needed detail.
-        Level by level, each level's tests on arrays."""
-        planes = _frustum_planes(camera)
+        """Tiles to draw for this camera: in view, above the horizon, at the needed detail."""
+        return self.select_measured(pose, camera)[0]
+
+    def select_measured(self, pose: CameraPose, camera: Camera) -> tuple[list[TileKey], np.ndarray]:
+        """(select's tiles, the pixels a grid cell of each covers at its nearest point, as
+        the split measures it). Level by level, each level's tests on arrays."""
+        planes = frustum_planes(camera)
         cam = np.asarray(pose.position, float)
-        horizon = _line_of_sight_limit(cam, self.radius_m, self._relief_bound())
+        horizon = line_of_sight_limit(cam, self.radius_m, self._relief_bound())
         max_level = self.max_level()
         moon_centre = np.array([0.0, 0.0, self.radius_m])
         chosen: list[TileKey] = []
+        chosen_px: list[float] = []
         frontier: list[TileKey] = [(0, 0, 0)]
         while frontier:
             tiles = [self.tile(k) for k in frontier]
@@ -385,7 +392,9 @@ class TileSet:
                 far = dist > 2 * radii
                 cell_px = np.where(far, cell_px * np.sqrt(np.maximum(cos_view, 0.05)), cell_px)
             split = inside & (cell_px > self.lod.pixels_per_cell) & (frontier[0][0] < max_level)
-            chosen.extend(k for k, keep, s in zip(frontier, inside, split) if keep and not s)
+            drawn = inside & ~split
+            chosen.extend(k for k, d in zip(frontier, drawn) if d)
+            chosen_px.extend(cell_px[drawn])
             frontier = [
                 (level + 1, 2 * i + a, 2 * j + b)
                 for (level, i, j), s in zip(frontier, split)
@@ -393,7 +402,7 @@ class TileSet:
                 for a in (0, 1)
                 for b in (0, 1)
             ]
-        return chosen
+        return chosen, np.array(chosen_px)
 
     def _relief_bound(self) -> float:
         root = self.tile((0, 0, 0))
@@ -404,16 +413,6 @@ class TileSet:
         centres = np.array([self.tile(k).centre for k in keys]).reshape(-1, 3)
         radii = np.array([self.tile(k).radius_m for k in keys])
         return centres - np.asarray(position, float), radii
-
-
-def depth_range(dists: np.ndarray, radii: np.ndarray, camera: Camera) -> tuple[float, float]:
-    """(znear, zfar) that bracket every drawn tile (centre distances and bounding radii):
-    near from the closest bounding sphere (a point at distance d inside the frustum has
-    depth >= d cos(half diagonal))."""
-    half_diag = np.arctan(np.hypot(camera.width, camera.height) / 2 / camera.focal_px)
-    near = max(float(np.min(dists - radii)) * np.cos(half_diag) * 0.99, 1e-3)
-    far = float(np.max(dists + radii)) * 1.01 + 1.0
-    return near, far
 
 
 def long_sweep_lit(tiles: TileSet, key: TileKey, levels: int, widths: int = 4) -> np.ndarray:
@@ -492,29 +491,3 @@ def _add_skirts(verts, norms, lit, faces, n, depth_m, radius_m):
         np.concatenate([lit, lit[ring]]),
         np.concatenate([faces, skirt_faces.astype(np.uint32)]),
     )
-
-
-def _frustum_planes(camera: Camera) -> np.ndarray:
-    """Inward unit normals (4, 3) of the side planes, camera frame (X forward = columns,
-    Y right = rows, Z boresight); a point p is inside when planes @ p >= 0."""
-    hx = np.arctan(camera.width / 2 / camera.focal_px)
-    hy = np.arctan(camera.height / 2 / camera.focal_px)
-    return np.array(
-        [
-            [np.cos(hx), 0, np.sin(hx)],
-            [-np.cos(hx), 0, np.sin(hx)],
-            [0, np.cos(hy), np.sin(hy)],
-            [0, -np.cos(hy), np.sin(hy)],
-        ]
-    )
-
-
-def _line_of_sight_limit(cam: np.ndarray, radius_m: float, relief_m: float) -> float:
-    """Farthest distance at which terrain up to relief_m can be seen from cam (the two
-    tangent lengths to the sphere of the Moon: camera's and the peaks')."""
-    centre = np.array([0.0, 0.0, radius_m])
-    r_cam = float(np.linalg.norm(cam - centre))
-    r_low = radius_m - relief_m
-    cam_tangent = np.sqrt(max(r_cam**2 - r_low**2, 0.0))
-    peak_tangent = np.sqrt(max((radius_m + relief_m) ** 2 - r_low**2, 0.0))
-    return float(cam_tangent + peak_tangent)
