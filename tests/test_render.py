@@ -6,6 +6,7 @@ TRAJ2EVENTS_TEST_BACKEND=egl draws them through EGL instead (a GPU's, where ther
 import os
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -559,17 +560,19 @@ def cliff_casting_an_edge_at(x_edge_m: float) -> GridTerrain:
     return GridTerrain(np.where(x[:, None] >= cliff_x, height, 0.0) * np.ones((1, x.size)), spacing, (x[0], x[0]))
 
 
-def shadow_edge_fractions(x_edge_m: float, texture_filter: str, samples: int = 1) -> tuple[np.ndarray, np.ndarray]:
+def shadow_edge_fractions(
+    x_edge_m: float, texture_filter: str, samples: int = 1, **lod
+) -> tuple[np.ndarray, np.ndarray]:
     """(rendered, analytic) lit fraction of a nadir camera's middle row over a straight
     shadow edge at x = x_edge_m on flat ground: a 10 m cliff beyond the view casts it, the
     Sun from +x at 20 deg, a point (the disc's penumbra would be 0.8 m wide: 0.6 px).
-    Texels are 1/8-1/4 of a pixel (2 pixels per cell, 3 levels).
+    Texels are 1/8-1/4 of a pixel (2 pixels per cell, 3 levels; `lod`: other LodSettings).
     `samples`: drawn at samples x samples per pixel and averaged (the same tiles)."""
     cliff, flat = cliff_casting_an_edge_at(x_edge_m), GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
     camera, sun = Camera(64, 64, 45.0), EDGE_SUN
     drawn = Camera(64 * samples, 64 * samples, 45.0)
     pose = camera_pose(state(altitude=100.0))  # nadir: columns along +x
-    lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter)
+    lod = LodSettings(**{"pixels_per_cell": 2.0, "shading_levels": 3, "texture_filter": texture_filter, **lod})
     images = []
     for terrain in (cliff, flat):
         tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod, sun_radius_rad=0.0)
@@ -596,6 +599,31 @@ def test_a_pixel_across_a_shadow_edge_gets_its_lit_area_fraction(x_edge_m):
     assert abs((rendered - analytic).sum()) < 0.4 and abs((averaged - analytic).sum()) < 0.4
     point, _ = shadow_edge_fractions(x_edge_m, "point")
     assert set(np.round(point, 2)) <= {0.0, 1.0}  # point sampling: all or nothing
+
+
+def test_tiles_whose_texels_the_camera_magnifies_take_the_finer_texture_and_give_it_back():
+    # Finer textures for exactly the tiles whose texels cover more than magnified_texel_px
+    # at their nearest point, the most magnified first while the array has room (here 6
+    # layers); flying away and back frees and takes layers again, and the frame drawn
+    # again is the frame drawn first.
+    lod = LodSettings(cells=8, shading_levels=1, pixels_per_cell=4.0, magnified_texel_px=1.4)
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), SUN.direction, R_MOON, 140e3, lod)
+    camera = Camera(48, 48, 45.0)
+    here, there = camera_pose(state(altitude=300.0, pitch=30.0)), camera_pose(state(x=900.0, altitude=300.0))
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), backend=BACKEND, max_cached_tiles=12) as renderer:
+        renderer._gl.fine.layer_limit = 6
+        first = renderer.render(here)
+        keys, cell_px = tiles.select_measured(here, camera)
+        texel_px = cell_px / 2
+        held = set(renderer._fine_layers)
+        assert np.sum(texel_px > 1.4) > 6 and len(held) == 6
+        assert held == {keys[a] for a in np.argsort(-texel_px)[:6]}
+        renderer.render(there)
+        assert set(renderer._fine_layers) != held
+        again = renderer.render(here)
+    assert np.array_equal(first.radiance, again.radiance)
+    plain = render(ProceduralTerrain(TerrainParams(seed=4)), camera, here, lod=replace(lod, magnified_texel_px=0.0))[0]
+    assert not np.array_equal(first.radiance, plain.radiance)
 
 
 def test_relief_seen_edge_on_in_the_texture_is_not_black():

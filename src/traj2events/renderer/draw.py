@@ -33,13 +33,16 @@ from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField, add_stars
 from ..scene.sun import Sun
-from ..scene.tiles import TileKey, TileSet, border_ring, depth_range
+from ..scene.tiles import TileKey, TileSet
+from ..scene.view import depth_range
 from . import footprint
 from .context import gl_context, resolve_backend
 from .law_uniforms import law_uniforms
+from .shading_array import ShadingArray, shading_coordinates
 
 _INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
-_SHADING_BYTES = 512 * 2**20  # cap on the shading texture array (bounds the slots kept)
+_SHADING_BYTES = 512 * 2**20  # cap on each shading texture array (bounds the slots kept)
+_INSTANCE_FLOATS = 5  # per drawn tile: its origin's offset from the camera (3), slot, fine layer
 
 
 @dataclass(frozen=True)
@@ -81,10 +84,12 @@ class _GLScene:
         shading_uv: np.ndarray | None = None,
         shading_side: int = 0,
         texture_filter: str = "point",
+        fine_side: int = 0,
     ):
         """`shading_uv`: (vertices_per_tile, 2) where each vertex of a tile sits in its
         (shading_side x shading_side) shading texture, to shade per pixel; None: per vertex.
-        `texture_filter`: how a pixel samples it (footprint.TEXTURE_FILTERS)."""
+        `texture_filter`: how a pixel samples it (footprint.TEXTURE_FILTERS). `fine_side`:
+        the side of the textures one level finer of tiles the camera magnifies (0: none)."""
         from OpenGL import GL as gl
 
         self.gl, self.width, self.height = gl, width, height
@@ -101,7 +106,7 @@ class _GLScene:
         self.instance_buffer = gl.glGenBuffers(1)
         gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
         gl.glEnableVertexAttribArray(0)
-        gl.glVertexAttribPointer(0, 4, gl.GL_FLOAT, gl.GL_FALSE, 16, None)
+        gl.glVertexAttribPointer(0, 4, gl.GL_FLOAT, gl.GL_FALSE, 4 * _INSTANCE_FLOATS, None)
         gl.glVertexAttribDivisor(0, 1)
         if self.textured:
             self.uv_buffer = gl.glGenBuffers(1)
@@ -109,12 +114,13 @@ class _GLScene:
             gl.glBufferData(gl.GL_ARRAY_BUFFER, np.ascontiguousarray(shading_uv, np.float32), gl.GL_STATIC_DRAW)
             gl.glEnableVertexAttribArray(1)
             gl.glVertexAttribPointer(1, 2, gl.GL_FLOAT, gl.GL_FALSE, 8, None)
-            self.shading_side, self.shading_texture = shading_side, 0
-            self.texture_filter = texture_filter
-            self.level_sides = footprint.sampled_levels(texture_filter, shading_side)
-            layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
-            layer_bytes = sum(8 * n**2 for n in self.level_sides)  # RGBA16F texels, every level
-            self.slot_limit = max(1, min(layers, _SHADING_BYTES // layer_bytes))
+            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)  # the fine texture's layer, per tile
+            gl.glEnableVertexAttribArray(2)
+            gl.glVertexAttribPointer(2, 1, gl.GL_FLOAT, gl.GL_FALSE, 4 * _INSTANCE_FLOATS, ctypes.c_void_p(16))
+            gl.glVertexAttribDivisor(2, 1)
+            self.shading = ShadingArray(gl, 2, shading_side, texture_filter, _SHADING_BYTES)
+            self.fine = ShadingArray(gl, 3, fine_side, texture_filter, _SHADING_BYTES) if fine_side else None
+            self.slot_limit = self.shading.layer_limit
         else:
             self.slot_limit = 2**31 // (vertices_per_tile * 16)  # OpenGL's buffer offsets
         # Per-vertex data: (position - tile origin, lit) and, shaded per vertex, (normal,
@@ -136,6 +142,11 @@ class _GLScene:
         self.uniform("vertices_per_tile", vertices_per_tile)
         if self.textured:
             self.uniform("shading", 2)
+            self.uniform("shading_fine", 3)
+            # where a vertex sits in the texture one level finer: uv * scale + offset (shading_coordinates)
+            fine = max(fine_side, 1)
+            self.uniform("fine_uv_scale", 2.0 * shading_side / fine)
+            self.uniform("fine_uv_offset", -0.5 / fine)
             # point and trilinear: the level chosen in the shader (the same on every GPU)
             self.uniform("level_here", int(texture_filter != "anisotropic"))
             self.uniform("level_bias", footprint.LOD_BIAS)
@@ -172,45 +183,13 @@ class _GLScene:
             gl.glActiveTexture(gl.GL_TEXTURE0 + unit)
             gl.glBindTexture(gl.GL_TEXTURE_BUFFER, self.vertex_textures[unit])
             gl.glTexBuffer(gl.GL_TEXTURE_BUFFER, gl.GL_RGBA32F, new)
-        if self.textured:
-            self._allocate_shading(slots)
         self.capacity = slots
-
-    def _allocate_shading(self, slots: int) -> None:
-        """A shading texture array of `slots` layers (RGBA16F: normal xyz, lit), keeping
-        the layers already filled (copied on the GPU)."""
-        gl = self.gl
-        new = gl.glGenTextures(1)
-        gl.glActiveTexture(gl.GL_TEXTURE2)
-        gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, new)
-        for level, n in enumerate(self.level_sides):
-            gl.glTexImage3D(gl.GL_TEXTURE_2D_ARRAY, level, gl.GL_RGBA16F, n, n, slots, 0, gl.GL_RGBA, gl.GL_FLOAT, None)
-        mipmapped = len(self.level_sides) > 1
-        for name, value in (
-            # point: between the texels at the pixel's centre; else also between levels
-            # (trilinear), the level chosen from the pixel's footprint on the texture
-            (gl.GL_TEXTURE_MIN_FILTER, gl.GL_LINEAR_MIPMAP_LINEAR if mipmapped else gl.GL_LINEAR),
-            (gl.GL_TEXTURE_MAG_FILTER, gl.GL_LINEAR),
-            (gl.GL_TEXTURE_WRAP_S, gl.GL_CLAMP_TO_EDGE),
-            (gl.GL_TEXTURE_WRAP_T, gl.GL_CLAMP_TO_EDGE),
-            (gl.GL_TEXTURE_MAX_LEVEL, len(self.level_sides) - 1),
-        ):
-            gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
-        if self.texture_filter == "anisotropic":  # samples along the footprint's long axis (oblique ground)
-            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, gl.GL_TEXTURE_LOD_BIAS, footprint.LOD_BIAS)
-            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, footprint.GL_TEXTURE_MAX_ANISOTROPY, footprint.MAX_ANISOTROPY)
-        if self.capacity:
-            for level, n in enumerate(self.level_sides):
-                gl.glCopyImageSubData(self.shading_texture, gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, 0,
-                                      new, gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, 0, n, n, self.capacity)  # fmt: skip
-            gl.glDeleteTextures([self.shading_texture])
-        self.shading_texture = new
 
     def upload(
         self, slot: int, position_lit: np.ndarray, normal: np.ndarray | None, shading: np.ndarray | None
     ) -> None:
         """Fills `slot`: its vertices (with their normals when shaded per vertex), and its
-        layer of the shading texture when shaded per pixel."""
+        layer of the shading texture when shaded per pixel (the fine one: `self.fine.upload`)."""
         gl = self.gl
         if slot >= self.slot_limit:
             raise RuntimeError(
@@ -225,13 +204,7 @@ class _GLScene:
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, buffer)
             gl.glBufferSubData(gl.GL_ARRAY_BUFFER, offset, data.nbytes, data)
         if self.textured:
-            gl.glActiveTexture(gl.GL_TEXTURE2)
-            gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
-            levels = footprint.mip_levels(shading) if len(self.level_sides) > 1 else [shading]
-            for level, texels in enumerate(levels):
-                n = texels.shape[0]
-                gl.glTexSubImage3D(gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, slot, n, n, 1, gl.GL_RGBA, gl.GL_HALF_FLOAT,
-                                   np.ascontiguousarray(texels, np.float16))  # fmt: skip
+            self.shading.upload(slot, shading)
 
     def uniform(self, name: str, value) -> None:
         gl = self.gl
@@ -248,9 +221,10 @@ class _GLScene:
             gl.glUniform3f(loc, *(float(x) for x in np.asarray(value, np.float32)))
 
     def draw(self, instances: np.ndarray, uniforms: dict) -> int:
-        """Issues one instanced draw of `instances` ((n, 4) float32: offset from the camera,
-        slot) and the read-back of its image into a pixel buffer; returns that buffer, for
-        `image`. The GPU goes on alone: the caller can prepare the next frame meanwhile."""
+        """Issues one instanced draw of `instances` ((n, 5) float32: offset from the camera,
+        slot, layer of the finer texture or -1) and the read-back of its image into a pixel
+        buffer; returns that buffer, for `image`. The GPU goes on alone: the caller can
+        prepare the next frame meanwhile."""
         from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels
 
         gl = self.gl
@@ -269,8 +243,9 @@ class _GLScene:
             gl.glActiveTexture(gl.GL_TEXTURE0 + unit)
             gl.glBindTexture(gl.GL_TEXTURE_BUFFER, texture)
         if self.textured:
-            gl.glActiveTexture(gl.GL_TEXTURE2)
-            gl.glBindTexture(gl.GL_TEXTURE_2D_ARRAY, self.shading_texture)
+            self.shading.bind()
+            if self.fine is not None:
+                self.fine.bind()
         gl.glBindVertexArray(self.vao)
         if len(instances):
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
@@ -314,7 +289,9 @@ class _GLScene:
         buffers = [*self.vertex_buffers, self.index_buffer, self.instance_buffer]
         gl.glDeleteBuffers(len(buffers), buffers)
         if self.textured:
-            gl.glDeleteTextures([self.shading_texture])
+            self.shading.delete()
+            if self.fine is not None:
+                self.fine.delete()
             gl.glDeleteBuffers(1, [self.uv_buffer])
         if self.pixel_buffers:
             gl.glDeleteBuffers(len(self.pixel_buffers), self.pixel_buffers)
@@ -354,18 +331,6 @@ def _compile_program(gl, stem: str) -> int:
     return program
 
 
-def shading_coordinates(cells: int, levels: int) -> tuple[np.ndarray, int]:
-    """((vertices, 2) texture coordinates of a tile's vertices in its shading texture, the
-    texture's side): grid vertex (a, b) sits at texel (a, b) 2^levels, at the texel's centre
-    (s along b, t along a, as TileSet.shading_texture lays them out); a skirt vertex takes
-    those of the grid vertex it hangs from."""
-    n, side = cells + 1, cells * 2**levels + 1
-    vertex = np.concatenate([np.arange(n * n), border_ring(n)])
-    a, b = np.divmod(vertex, n)
-    uv = np.stack([b * 2**levels + 0.5, a * 2**levels + 0.5], axis=1) / side
-    return uv.astype(np.float32), side
-
-
 class TerrainRenderer:
     """Renders a TileSet from camera poses. One OpenGL context; tiles are uploaded once
     and kept while they are in use (at most `max_cached_tiles` beyond one frame's)."""
@@ -400,11 +365,18 @@ class TerrainRenderer:
         root = tiles.tile((0, 0, 0))  # every tile has its number of vertices and its faces
         self.shading_levels = tiles.lod.shading_levels
         uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
-        self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter)
+        # Tiles whose texels the camera sees wider than magnified_texel_px take a texture one
+        # level finer where the quadtree has one (docs/rendering.md "Pixel footprint").
+        self.fine_texel_px = tiles.lod.magnified_texel_px if self.shading_levels else 0.0
+        fine_side = tiles.lod.cells * 2 ** (self.shading_levels + 1) + 1 if self.fine_texel_px else 0
+        self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter,
+                            fine_side)  # fmt: skip
         self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
         self._uniforms = law_uniforms(reflectance, sun, earth)
         self._slots: dict[TileKey, int] = {}
         self._free: list[int] = []
+        self._fine_layers: dict[TileKey, int] = {}  # tiles with a texture one level finer: its layer
+        self._fine_free: list[int] = []
         self._last_used: dict[TileKey, int] = {}
         self._frame_count = 0
 
@@ -425,6 +397,40 @@ class TerrainRenderer:
             self._slots[key] = slot
         return self._slots[key]
 
+    def _fine_layer(self, key: TileKey, frame_keys: set[TileKey]) -> int:
+        """`key`'s layer of the finer textures, uploaded if new; -1 where the array is full
+        of this frame's (the tile then keeps its texture)."""
+        if key in self._fine_layers:
+            return self._fine_layers[key]
+        fine = self._gl.fine
+        if self._fine_free:
+            layer = self._fine_free.pop()
+        elif len(self._fine_layers) < fine.layer_limit:
+            layer = len(self._fine_layers)  # none freed: layers 0 .. n-1 are taken
+        else:  # the least recently drawn tile not in this frame gives its layer up
+            idle = [k for k in self._fine_layers if k not in frame_keys]
+            if not idle:
+                return -1
+            layer = self._fine_layers.pop(min(idle, key=lambda k: (self._last_used.get(k, 0), k)))
+        texture = self.tiles.shading_texture(key, self.shading_levels + 1)
+        fine.upload(layer, footprint.sunlit(texture, self.sun.direction))
+        self._fine_layers[key] = layer
+        return layer
+
+    def _fine_layers_of(self, keys: list[TileKey], cell_px: np.ndarray) -> np.ndarray:
+        """Each tile's layer of the finer textures (-1: none): those whose texels cover more
+        than `fine_texel_px` pixels at their nearest point and have finer levels below them,
+        the most magnified first."""
+        layers = np.full(len(keys), -1.0, np.float32)
+        if not self.fine_texel_px:
+            return layers
+        texel_px = cell_px / 2**self.shading_levels
+        frame_keys = set(keys)
+        for a in np.argsort(-texel_px, kind="stable"):
+            if texel_px[a] > self.fine_texel_px:
+                layers[a] = self._fine_layer(keys[a], frame_keys)
+        return layers
+
     def render(self, pose: CameraPose) -> Frame:
         return self._finish(self._start(pose))
 
@@ -443,10 +449,11 @@ class TerrainRenderer:
 
     def _start(self, pose: CameraPose) -> tuple:
         """Selects, uploads and draws `pose`'s tiles; the read-back runs on (`_finish`)."""
-        keys = self.tiles.select(pose, self.lod_camera)
+        keys, cell_px = self.tiles.select_measured(pose, self.lod_camera)
         self._frame_count += 1
         self._platform.make_current()
         slots = [self._slot(key) for key in keys]
+        fine_layers = self._fine_layers_of(keys, cell_px)
         for key in keys:
             self._last_used[key] = self._frame_count
         # Slots freed here may still feed a frame in flight: OpenGL runs the commands in
@@ -455,9 +462,10 @@ class TerrainRenderer:
         offsets, radii = self.tiles.offsets(keys, pose.position)
         dists = np.linalg.norm(offsets, axis=1)
         order = sorted(range(len(keys)), key=lambda a: (dists[a], keys[a]))
-        instances = np.empty((len(keys), 4), np.float32)
+        instances = np.empty((len(keys), _INSTANCE_FLOATS), np.float32)
         instances[:, :3] = offsets[order]
         instances[:, 3] = np.asarray(slots, np.float32)[order]
+        instances[:, 4] = fine_layers[order]
         near, far = depth_range(dists, radii, self.camera) if keys else (1.0, 10.0)
         uniforms = {
             **self._uniforms,
@@ -491,6 +499,8 @@ class TerrainRenderer:
         for key in old[: len(self._slots) - self.max_cached_tiles]:
             self._free.append(self._slots.pop(key))
             self._last_used.pop(key, None)
+            if key in self._fine_layers:
+                self._fine_free.append(self._fine_layers.pop(key))
         self.tiles.evict(set(self._slots))
 
     def close(self) -> None:

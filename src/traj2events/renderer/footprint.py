@@ -22,10 +22,13 @@ TEXTURE_FILTERS = ("point", "trilinear", "anisotropic")
 # under a bilinear tent of half-width t, variance t^2 / 12 + t^2 / 6 = t^2 / 4; a pixel's
 # box has 1 / 12, so t = 1 / sqrt(3). Unbiased (t = 1) the filter is twice as wide in
 # variance as the pixel: images blurred, events too few (0.66-0.97x a 16 x 16 average).
-# The level itself is log2(rho) + LOD_BIAS, rho the footprint's longer side in texels
-# (OpenGL's reference scale factor), computed in the shader: samplers approximate rho their
-# own way (an NVIDIA H200's gave 0.82x the events of a 16 x 16 average where llvmpipe's gave
-# 1.00x; chosen in the shader, 0.98x and 0.97x: docs/rendering.md "Backends").
+# The level itself is log2(rho) + LOD_BIAS, computed in the shader (samplers approximate the
+# footprint their own way: an NVIDIA H200's gave 0.82x the events of a 16 x 16 average where
+# llvmpipe's gave 1.00x; docs/rendering.md "Backends"). rho (texels per pixel) is the root
+# mean square of the footprint's two sides: a pixel's box has variance (a a^T + b b^T) / 12
+# on the texture (a, b its sides), and the isotropic filter of the same total variance has
+# rho^2 = (|a|^2 + |b|^2) / 2. OpenGL's reference takes the longer side, which blurs ground
+# seen obliquely along its short side (docs/rendering.md "Pixel footprint").
 LOD_BIAS = float(np.log2(1.0 / np.sqrt(3.0)))  # -0.79
 MAX_ANISOTROPY = 16.0  # samples along the long axis at most (what llvmpipe and GPUs offer)
 GL_TEXTURE_MAX_ANISOTROPY = 0x84FE  # OpenGL 4.6's (ARB/EXT_texture_filter_anisotropic before)
