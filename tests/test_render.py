@@ -601,29 +601,34 @@ def test_a_pixel_across_a_shadow_edge_gets_its_lit_area_fraction(x_edge_m):
     assert set(np.round(point, 2)) <= {0.0, 1.0}  # point sampling: all or nothing
 
 
-def test_tiles_whose_texels_the_camera_magnifies_take_the_finer_texture_and_give_it_back():
-    # Finer textures for exactly the tiles whose texels cover more than magnified_texel_px
-    # at their nearest point, the most magnified first while the array has room (here 6
-    # layers); flying away and back frees and takes layers again, and the frame drawn
-    # again is the frame drawn first.
+def test_tiles_whose_texels_the_camera_magnifies_take_the_finer_texture_and_give_it_back(monkeypatch):
+    # A texture one level finer, in four more slots, for exactly the tiles whose texels
+    # cover more than magnified_texel_px at their nearest point. Flying away and back
+    # (12 slots kept beyond a frame's) frees slots and takes them again: the frame drawn
+    # again is the frame drawn first. Where the slots run short, the most magnified first.
     lod = LodSettings(cells=8, shading_levels=1, pixels_per_cell=4.0, magnified_texel_px=1.4)
-    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), SUN.direction, R_MOON, 140e3, lod)
-    camera = Camera(48, 48, 45.0)
+    terrain, camera = ProceduralTerrain(TerrainParams(seed=4)), Camera(48, 48, 45.0)
     here, there = camera_pose(state(altitude=300.0, pitch=30.0)), camera_pose(state(x=900.0, altitude=300.0))
+    tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, lod)
+    keys, cell_px = tiles.select_measured(here, camera)
+    magnified = {k for k, px in zip(keys, cell_px) if px / 2 > 1.4}
+    assert 6 < len(magnified) < len(keys)
     with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), backend=BACKEND, max_cached_tiles=12) as renderer:
-        renderer._gl.fine.layer_limit = 6
         first = renderer.render(here)
-        keys, cell_px = tiles.select_measured(here, camera)
-        texel_px = cell_px / 2
-        held = set(renderer._fine_layers)
-        assert np.sum(texel_px > 1.4) > 6 and len(held) == 6
-        assert held == {keys[a] for a in np.argsort(-texel_px)[:6]}
+        assert set(renderer._fine) == magnified
         renderer.render(there)
-        assert set(renderer._fine_layers) != held
+        assert not set(renderer._fine) & magnified and renderer._n_slots < 2 * (len(keys) + 4 * len(magnified))
         again = renderer.render(here)
     assert np.array_equal(first.radiance, again.radiance)
-    plain = render(ProceduralTerrain(TerrainParams(seed=4)), camera, here, lod=replace(lod, magnified_texel_px=0.0))[0]
+    plain = render(terrain, camera, here, lod=replace(lod, magnified_texel_px=0.0))[0]
     assert not np.array_equal(first.radiance, plain.radiance)
+
+    layer_bytes = 8 * sum(n**2 for n in (17, 8, 4, 2, 1))
+    monkeypatch.setattr(render_module, "_SHADING_BYTES", (len(keys) + 4 * 6) * layer_bytes)  # room for 6
+    tiles = TileSet(terrain, SUN.direction, R_MOON, 140e3, lod)
+    with TerrainRenderer(tiles, camera, SUN, ReflectanceParams(), backend=BACKEND) as renderer:
+        renderer.render(here)
+        assert set(renderer._fine) == {keys[a] for a in np.argsort(-cell_px)[:6]}
 
 
 def test_relief_seen_edge_on_in_the_texture_is_not_black():

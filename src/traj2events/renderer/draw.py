@@ -16,7 +16,9 @@ the drawn tiles and interpolates the radiance (shaders/terrain.*). k > 0 gives e
 a layer of a texture array holding the normals and lit fractions of its tile's area k
 levels finer (TileSet.shading_texture), with levels averaged over areas (`footprint`), and
 evaluates the law per pixel from it (shaders/terrain_textured.*): the geometry
-(silhouettes, depth) is the drawn tiles', the shading that of tiles 2^k times finer.
+(silhouettes, depth) is the drawn tiles', the shading that of tiles 2^k times finer. A tile
+whose texels the camera magnifies (`render.lod.magnified_texel_px`) takes k + 1 levels, as
+four quarters in four more slots, so that a pixel's mean comes from texels below its size.
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from importlib import resources
 
 import numpy as np
 
-from ..geometry.camera import Camera, CameraPose, opengl_camera_to_world
+from ..geometry.camera import Camera, CameraPose
 from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField, add_stars
@@ -36,13 +38,14 @@ from ..scene.sun import Sun
 from ..scene.tiles import TileKey, TileSet
 from ..scene.view import depth_range
 from . import footprint
+from .camera_matrices import projection_matrix, view_rotation
 from .context import gl_context, resolve_backend
 from .law_uniforms import law_uniforms
-from .shading_array import ShadingArray, shading_coordinates
+from .shading_array import ShadingArray, quarters, shading_coordinates
 
 _INITIAL_SLOTS = 256  # tiles the vertex buffer holds before it first grows (it doubles)
 _SHADING_BYTES = 512 * 2**20  # cap on each shading texture array (bounds the slots kept)
-_INSTANCE_FLOATS = 5  # per drawn tile: its origin's offset from the camera (3), slot, fine layer
+_INSTANCE_FLOATS = 8  # per drawn tile: its origin's offset from the camera (3), slot, the finer texture's 4 slots
 
 
 @dataclass(frozen=True)
@@ -51,25 +54,6 @@ class Frame:
     depth_m: np.ndarray  # (H, W) float32, along the boresight; 0 = sky
     n_tiles: int
     n_triangles: int
-
-
-def projection_matrix(camera: Camera, near_m: float, far_m: float) -> np.ndarray:
-    """OpenGL clip matrix of the pinhole camera (principal point at the image centre)."""
-    p = np.zeros((4, 4))
-    p[0, 0] = 2.0 * camera.focal_px / camera.width
-    p[1, 1] = 2.0 * camera.focal_px / camera.height
-    p[2, 2] = (far_m + near_m) / (near_m - far_m)
-    p[2, 3] = 2.0 * far_m * near_m / (near_m - far_m)
-    p[3, 2] = -1.0
-    return p
-
-
-def view_rotation(pose: CameraPose) -> np.ndarray:
-    """World -> OpenGL camera, rotation only: the camera sits at the origin (tiles are
-    drawn relative to it)."""
-    v = np.eye(4)
-    v[:3, :3] = opengl_camera_to_world(pose)[:3, :3].T
-    return v
 
 
 class _GLScene:
@@ -84,12 +68,10 @@ class _GLScene:
         shading_uv: np.ndarray | None = None,
         shading_side: int = 0,
         texture_filter: str = "point",
-        fine_side: int = 0,
     ):
         """`shading_uv`: (vertices_per_tile, 2) where each vertex of a tile sits in its
         (shading_side x shading_side) shading texture, to shade per pixel; None: per vertex.
-        `texture_filter`: how a pixel samples it (footprint.TEXTURE_FILTERS). `fine_side`:
-        the side of the textures one level finer of tiles the camera magnifies (0: none)."""
+        `texture_filter`: how a pixel samples it (footprint.TEXTURE_FILTERS)."""
         from OpenGL import GL as gl
 
         self.gl, self.width, self.height = gl, width, height
@@ -114,12 +96,11 @@ class _GLScene:
             gl.glBufferData(gl.GL_ARRAY_BUFFER, np.ascontiguousarray(shading_uv, np.float32), gl.GL_STATIC_DRAW)
             gl.glEnableVertexAttribArray(1)
             gl.glVertexAttribPointer(1, 2, gl.GL_FLOAT, gl.GL_FALSE, 8, None)
-            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)  # the fine texture's layer, per tile
+            gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)  # per tile: its finer texture's slots
             gl.glEnableVertexAttribArray(2)
-            gl.glVertexAttribPointer(2, 1, gl.GL_FLOAT, gl.GL_FALSE, 4 * _INSTANCE_FLOATS, ctypes.c_void_p(16))
+            gl.glVertexAttribPointer(2, 4, gl.GL_FLOAT, gl.GL_FALSE, 4 * _INSTANCE_FLOATS, ctypes.c_void_p(16))
             gl.glVertexAttribDivisor(2, 1)
             self.shading = ShadingArray(gl, 2, shading_side, texture_filter, _SHADING_BYTES)
-            self.fine = ShadingArray(gl, 3, fine_side, texture_filter, _SHADING_BYTES) if fine_side else None
             self.slot_limit = self.shading.layer_limit
         else:
             self.slot_limit = 2**31 // (vertices_per_tile * 16)  # OpenGL's buffer offsets
@@ -142,11 +123,7 @@ class _GLScene:
         self.uniform("vertices_per_tile", vertices_per_tile)
         if self.textured:
             self.uniform("shading", 2)
-            self.uniform("shading_fine", 3)
-            # where a vertex sits in the texture one level finer: uv * scale + offset (shading_coordinates)
-            fine = max(fine_side, 1)
-            self.uniform("fine_uv_scale", 2.0 * shading_side / fine)
-            self.uniform("fine_uv_offset", -0.5 / fine)
+            self.uniform("texture_side", float(shading_side))
             # point and trilinear: the level chosen in the shader (the same on every GPU)
             self.uniform("level_here", int(texture_filter != "anisotropic"))
             self.uniform("level_bias", footprint.LOD_BIAS)
@@ -189,15 +166,9 @@ class _GLScene:
         self, slot: int, position_lit: np.ndarray, normal: np.ndarray | None, shading: np.ndarray | None
     ) -> None:
         """Fills `slot`: its vertices (with their normals when shaded per vertex), and its
-        layer of the shading texture when shaded per pixel (the fine one: `self.fine.upload`)."""
+        layer of the shading texture when shaded per pixel."""
         gl = self.gl
-        if slot >= self.slot_limit:
-            raise RuntimeError(
-                f"a frame needs more than {self.slot_limit} tiles, what the shading texture holds: "
-                "raise render.lod.pixels_per_cell or lower render.lod.shading_levels"
-            )
-        if slot >= self.capacity:
-            self._allocate(min(max(2 * self.capacity, slot + 1), self.slot_limit))
+        self._make_room(slot)
         offset = slot * self.vertices_per_tile * 16
         # Shaded per pixel there is one vertex buffer: zip stops before `normal` (None).
         for buffer, data in zip(self.vertex_buffers, (position_lit, normal)):
@@ -205,6 +176,20 @@ class _GLScene:
             gl.glBufferSubData(gl.GL_ARRAY_BUFFER, offset, data.nbytes, data)
         if self.textured:
             self.shading.upload(slot, shading)
+
+    def upload_texture(self, slot: int, shading: np.ndarray) -> None:
+        """Fills `slot`'s layer of the shading texture alone (a quarter of a finer texture)."""
+        self._make_room(slot)
+        self.shading.upload(slot, shading)
+
+    def _make_room(self, slot: int) -> None:
+        if slot >= self.slot_limit:
+            raise RuntimeError(
+                f"a frame needs more than {self.slot_limit} tiles, what the shading texture holds: "
+                "raise render.lod.pixels_per_cell or lower render.lod.shading_levels"
+            )
+        if slot >= self.capacity:
+            self._allocate(min(max(2 * self.capacity, slot + 1), self.slot_limit))
 
     def uniform(self, name: str, value) -> None:
         gl = self.gl
@@ -221,8 +206,8 @@ class _GLScene:
             gl.glUniform3f(loc, *(float(x) for x in np.asarray(value, np.float32)))
 
     def draw(self, instances: np.ndarray, uniforms: dict) -> int:
-        """Issues one instanced draw of `instances` ((n, 5) float32: offset from the camera,
-        slot, layer of the finer texture or -1) and the read-back of its image into a pixel
+        """Issues one instanced draw of `instances` ((n, 8) float32: offset from the camera,
+        slot, the slots of its finer texture's quarters or -1) and the read-back of its image into a pixel
         buffer; returns that buffer, for `image`. The GPU goes on alone: the caller can
         prepare the next frame meanwhile."""
         from OpenGL.raw.GL.VERSION.GL_1_0 import glReadPixels as raw_read_pixels
@@ -244,8 +229,6 @@ class _GLScene:
             gl.glBindTexture(gl.GL_TEXTURE_BUFFER, texture)
         if self.textured:
             self.shading.bind()
-            if self.fine is not None:
-                self.fine.bind()
         gl.glBindVertexArray(self.vao)
         if len(instances):
             gl.glBindBuffer(gl.GL_ARRAY_BUFFER, self.instance_buffer)
@@ -290,8 +273,6 @@ class _GLScene:
         gl.glDeleteBuffers(len(buffers), buffers)
         if self.textured:
             self.shading.delete()
-            if self.fine is not None:
-                self.fine.delete()
             gl.glDeleteBuffers(1, [self.uv_buffer])
         if self.pixel_buffers:
             gl.glDeleteBuffers(len(self.pixel_buffers), self.pixel_buffers)
@@ -366,24 +347,27 @@ class TerrainRenderer:
         self.shading_levels = tiles.lod.shading_levels
         uv, side = shading_coordinates(tiles.lod.cells, self.shading_levels) if self.shading_levels else (None, 0)
         # Tiles whose texels the camera sees wider than magnified_texel_px take a texture one
-        # level finer where the quadtree has one (docs/rendering.md "Pixel footprint").
+        # level finer, as its four quarters in four more slots (docs/rendering.md "Pixel footprint").
         self.fine_texel_px = tiles.lod.magnified_texel_px if self.shading_levels else 0.0
-        fine_side = tiles.lod.cells * 2 ** (self.shading_levels + 1) + 1 if self.fine_texel_px else 0
-        self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter,
-                            fine_side)  # fmt: skip
+        self._gl = _GLScene(camera.width, camera.height, root.faces, len(root.vertices), uv, side, texture_filter)
         self.max_cached_tiles = min(max_cached_tiles, self._gl.slot_limit // 2)  # room for a frame's own
         self._uniforms = law_uniforms(reflectance, sun, earth)
         self._slots: dict[TileKey, int] = {}
         self._free: list[int] = []
-        self._fine_layers: dict[TileKey, int] = {}  # tiles with a texture one level finer: its layer
-        self._fine_free: list[int] = []
+        self._n_slots = 0  # slots ever taken: 0 .. n-1 (those not in self._free are in use)
+        self._fine: dict[TileKey, list[int]] = {}  # tiles with a texture one level finer: its quarters' slots
         self._last_used: dict[TileKey, int] = {}
         self._frame_count = 0
 
     def _slot(self, key: TileKey) -> int:
         if key not in self._slots:
             t = self.tiles.tile(key)
-            slot = self._free.pop() if self._free else len(self._slots)
+            slot = self._new_slot()
+            if slot is None:  # finer textures of other frames' tiles give their slots back first
+                for other in [k for k in self._fine if self._last_used.get(k, 0) < self._frame_count]:
+                    self._free.extend(self._fine.pop(other))
+                slot = self._new_slot()
+            slot = self._gl.slot_limit if slot is None else slot  # None still: upload's clear error
             position_lit = np.empty((len(t.vertices), 4), np.float32)
             position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
             normal = shading = None
@@ -397,39 +381,49 @@ class TerrainRenderer:
             self._slots[key] = slot
         return self._slots[key]
 
-    def _fine_layer(self, key: TileKey, frame_keys: set[TileKey]) -> int:
-        """`key`'s layer of the finer textures, uploaded if new; -1 where the array is full
-        of this frame's (the tile then keeps its texture)."""
-        if key in self._fine_layers:
-            return self._fine_layers[key]
-        fine = self._gl.fine
-        if self._fine_free:
-            layer = self._fine_free.pop()
-        elif len(self._fine_layers) < fine.layer_limit:
-            layer = len(self._fine_layers)  # none freed: layers 0 .. n-1 are taken
-        else:  # the least recently drawn tile not in this frame gives its layer up
-            idle = [k for k in self._fine_layers if k not in frame_keys]
-            if not idle:
-                return -1
-            layer = self._fine_layers.pop(min(idle, key=lambda k: (self._last_used.get(k, 0), k)))
-        texture = self.tiles.shading_texture(key, self.shading_levels + 1)
-        fine.upload(layer, footprint.sunlit(texture, self.sun.direction))
-        self._fine_layers[key] = layer
-        return layer
+    def _new_slot(self) -> int | None:
+        """A free slot, or None where all the slots the texture holds are taken."""
+        if self._free:
+            return self._free.pop()
+        if self._n_slots < self._gl.slot_limit:
+            self._n_slots += 1
+            return self._n_slots - 1
+        return None
 
-    def _fine_layers_of(self, keys: list[TileKey], cell_px: np.ndarray) -> np.ndarray:
-        """Each tile's layer of the finer textures (-1: none): those whose texels cover more
-        than `fine_texel_px` pixels at their nearest point and have finer levels below them,
-        the most magnified first."""
-        layers = np.full(len(keys), -1.0, np.float32)
+    def _fine_slots(self, key: TileKey, frame_keys: set[TileKey]) -> list[int]:
+        """The four slots of `key`'s texture one level finer (its quarters), uploaded if new;
+        [-1] * 4 where the slots are all taken by this frame's tiles (it keeps its texture)."""
+        if key in self._fine:
+            return self._fine[key]
+        idle = sorted((k for k in self._fine if k not in frame_keys), key=lambda k: (self._last_used.get(k, 0), k))
+        slots = []
+        while len(slots) < 4:
+            slot = self._new_slot()
+            if slot is None and idle:  # the least recently drawn tile's finer texture gives its slots up
+                self._free.extend(self._fine.pop(idle.pop(0)))
+                continue
+            if slot is None:
+                self._free.extend(slots)
+                return [-1] * 4
+            slots.append(slot)
+        texture = footprint.sunlit(self.tiles.shading_texture(key, self.shading_levels + 1), self.sun.direction)
+        for slot, quarter in zip(slots, quarters(texture)):
+            self._gl.upload_texture(slot, quarter)
+        self._fine[key] = slots
+        return slots
+
+    def _fine_slots_of(self, keys: list[TileKey], cell_px: np.ndarray) -> np.ndarray:
+        """(n, 4): each tile's finer texture's slots (-1: none): for tiles whose texels
+        cover more than `fine_texel_px` pixels at their nearest point, the most magnified first."""
+        slots = np.full((len(keys), 4), -1.0, np.float32)
         if not self.fine_texel_px:
-            return layers
+            return slots
         texel_px = cell_px / 2**self.shading_levels
         frame_keys = set(keys)
         for a in np.argsort(-texel_px, kind="stable"):
             if texel_px[a] > self.fine_texel_px:
-                layers[a] = self._fine_layer(keys[a], frame_keys)
-        return layers
+                slots[a] = self._fine_slots(keys[a], frame_keys)
+        return slots
 
     def render(self, pose: CameraPose) -> Frame:
         return self._finish(self._start(pose))
@@ -453,7 +447,7 @@ class TerrainRenderer:
         self._frame_count += 1
         self._platform.make_current()
         slots = [self._slot(key) for key in keys]
-        fine_layers = self._fine_layers_of(keys, cell_px)
+        fine_slots = self._fine_slots_of(keys, cell_px)
         for key in keys:
             self._last_used[key] = self._frame_count
         # Slots freed here may still feed a frame in flight: OpenGL runs the commands in
@@ -465,7 +459,7 @@ class TerrainRenderer:
         instances = np.empty((len(keys), _INSTANCE_FLOATS), np.float32)
         instances[:, :3] = offsets[order]
         instances[:, 3] = np.asarray(slots, np.float32)[order]
-        instances[:, 4] = fine_layers[order]
+        instances[:, 4:] = fine_slots[order]
         near, far = depth_range(dists, radii, self.camera) if keys else (1.0, 10.0)
         uniforms = {
             **self._uniforms,
@@ -489,18 +483,21 @@ class TerrainRenderer:
         return len(self._slots)
 
     def _evict(self) -> None:
-        """Free the least recently drawn tiles beyond the cap (never this frame's)."""
-        if len(self._slots) <= self.max_cached_tiles:
+        """Free the least recently drawn tiles beyond the cap of slots (never this frame's)."""
+        used = self._n_slots - len(self._free)
+        if used <= self.max_cached_tiles:
             return
         old = sorted(
             (k for k in self._slots if self._last_used.get(k, 0) < self._frame_count),
             key=lambda k: (self._last_used.get(k, 0), k),
         )
-        for key in old[: len(self._slots) - self.max_cached_tiles]:
+        for key in old:
+            if used <= self.max_cached_tiles:
+                break
             self._free.append(self._slots.pop(key))
+            self._free.extend(self._fine.pop(key, []))
+            used = self._n_slots - len(self._free)
             self._last_used.pop(key, None)
-            if key in self._fine_layers:
-                self._fine_free.append(self._fine_layers.pop(key))
         self.tiles.evict(set(self._slots))
 
     def close(self) -> None:

@@ -1,7 +1,9 @@
 """A texture array of shading textures, one tile per layer (RGBA16F: normal xyz, lit
 fraction times mu0), with every level the pixel's footprint samples (footprint.py); it
-grows by copying its layers on the GPU. The renderer holds two: every drawn tile's texture,
-and the one level finer of the tiles whose texels the camera magnifies."""
+grows by copying its layers on the GPU. A tile whose texels the camera magnifies also has
+its texture one level finer there, as four layers (`quarters`): one array, one sampler, so
+that a pixel takes one texture read (llvmpipe runs both sides of a branch: a second
+sampler's read cost every pixel, 1.6-2x the render time at 1024^2, even where unused)."""
 
 from __future__ import annotations
 
@@ -84,3 +86,11 @@ def shading_coordinates(cells: int, levels: int) -> tuple[np.ndarray, int]:
     a, b = np.divmod(vertex, n)
     uv = np.stack([b * 2**levels + 0.5, a * 2**levels + 0.5], axis=1) / side
     return uv.astype(np.float32), side
+
+
+def quarters(texture: np.ndarray) -> list[np.ndarray]:
+    """The four (side, side) quarters of a (2 side - 1)^2 texture, sharing its middle row and
+    column: [rows first half, columns first half], [first, second], [second, first],
+    [second, second] (the shader's quarter 2 qa + qb, qa along the rows (t), qb along s)."""
+    half = (len(texture) - 1) // 2
+    return [texture[a * half : a * half + half + 1, b * half : b * half + half + 1] for a in (0, 1) for b in (0, 1)]

@@ -4,15 +4,14 @@
 // footprint (render.lod.texture_filter), plus the light the terrain scattered there and
 // earthshine;// depth along the boresight (m) as in terrain.frag.
 in vec2 frag_uv;
-in vec2 frag_uv_fine;
 flat in float frag_layer;
-flat in float frag_fine_layer;  // >= 0: the tile's layer of shading_fine, which it samples instead
+flat in vec4 frag_fine_slots;   // >= 0: the layers of the tile's texture one level finer, by quarter
 in vec3 frag_to_camera_m;
 in float frag_phase;
 in float frag_scattered;
 
 uniform sampler2DArray shading;  // per slot: normal xyz, lit fraction times mu0 (0..1)
-uniform sampler2DArray shading_fine;  // the same one level finer, for tiles the camera magnifies
+uniform float texture_side;      // its texels a side (cells 2^levels + 1)
 uniform float radiance_max;      // the law's maximum for this Sun (W m^-2 sr^-1)
 uniform bool level_here;         // choose the texture's level here (footprint.py), not in the sampler
 uniform float level_bias;        // log2 of the filter's width against the footprint (footprint.LOD_BIAS)
@@ -30,20 +29,22 @@ void main()
     // root mean square of its two sides, an isotropic filter as wide in variance as the
     // footprint (footprint.LOD_BIAS). Chosen here, not by the sampler: GPUs approximate
     // the footprint their own way (an NVIDIA H200's gave 18 % fewer events than llvmpipe's).
-    // The texture one level finer where the tile has one (per tile: the same branch for
-    // the whole triangle, so the derivatives below are its own).
-    bool fine = frag_fine_layer >= 0.0;
-    vec2 uv = fine ? frag_uv_fine : frag_uv;
-    vec3 at = vec3(uv, fine ? frag_fine_layer : frag_layer);
+    // Where the tile has its texture one level finer (magnified texels), that one, held as
+    // four quarters that share their middle texels: the texel coordinates run on across
+    // them (so do their derivatives), and one read takes the quarter's layer.
+    bool fine = frag_fine_slots.x >= 0.0;
+    vec2 texel_at = (frag_uv * texture_side - 0.5) * (fine ? 2.0 : 1.0);
+    vec2 quarter = fine ? step(vec2(texture_side - 1.0), texel_at) : vec2(0.0);
+    float layer = fine ? frag_fine_slots[int(quarter.y) * 2 + int(quarter.x)] : frag_layer;
+    vec3 at = vec3((texel_at - quarter * (texture_side - 1.0) + 0.5) / texture_side, layer);
+    vec2 across = dFdx(texel_at), down = dFdy(texel_at);  // texels per pixel
     vec4 texel;
     if (level_here) {
-        vec2 texels = vec2(fine ? textureSize(shading_fine, 0).xy : textureSize(shading, 0).xy);
-        vec2 across = dFdx(uv) * texels, down = dFdy(uv) * texels;
         float rho2 = 0.5 * (dot(across, across) + dot(down, down));
         float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;
-        texel = fine ? textureLod(shading_fine, at, level) : textureLod(shading, at, level);
+        texel = textureLod(shading, at, level);
     } else {  // anisotropic: the sampler's own footprint along its long axis
-        texel = fine ? texture(shading_fine, at) : texture(shading, at);
+        texel = textureGrad(shading, at, across / texture_side, down / texture_side);
     }
     vec3 normal = normalize(texel.xyz);
     // The triangle drawn here faces the camera; relief in its texture that faces away is

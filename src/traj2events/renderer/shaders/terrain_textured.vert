@@ -6,20 +6,17 @@
 // a triangle of a few pixels (the per-pixel rest: terrain_textured.frag).
 layout(location = 0) in vec4 tile;  // per instance (tile): xyz its origin minus the camera position (m), w its slot
 layout(location = 1) in vec2 uv;    // per vertex of a tile: its place in the tile's shading texture
-layout(location = 2) in float fine_layer;  // per instance: its layer of the textures one level finer, or -1
+layout(location = 2) in vec4 fine_slots;  // per instance: the slots of its texture one level finer, or -1
 
 uniform samplerBuffer vertex_position_lit;  // per vertex: position minus its tile's origin (m), scattered light S
                                             // (scattering.py; lit comes from the texture here)
 uniform int vertices_per_tile;
 uniform mat4 V;            // the view rotation only (camera at the origin)
 uniform mat4 P;
-uniform float fine_uv_scale;  // a vertex's place in the texture one level finer: uv * scale + offset
-uniform float fine_uv_offset;
 
 out vec2 frag_uv;
-out vec2 frag_uv_fine;
 flat out float frag_layer;  // the tile's slot: its layer of the shading texture array
-flat out float frag_fine_layer;
+flat out vec4 frag_fine_slots;
 out vec3 frag_to_camera_m;
 out float frag_phase;
 out float frag_scattered;   // light scattered into shadows by the terrain (W m^-2 sr^-1)
@@ -32,9 +29,8 @@ void main()
     vec3 offset = position_scattered.xyz + tile.xyz;
     frag_scattered = scattered_factor(position_scattered.w) * irradiance / PI;
     frag_uv = uv;
-    frag_uv_fine = uv * fine_uv_scale + fine_uv_offset;
     frag_layer = tile.w;
-    frag_fine_layer = fine_layer;
+    frag_fine_slots = fine_slots;
     frag_to_camera_m = -offset;
     frag_phase = phase_term(dot(sun_dir, -normalize(offset)));
     gl_Position = P * V * vec4(offset, 1.0);
