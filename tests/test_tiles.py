@@ -138,3 +138,22 @@ def test_a_drawn_tiles_cells_cover_at_most_pixels_per_cell_unless_it_is_the_fine
             assert 0.2 * unforeshortened <= px <= unforeshortened * (1 + 1e-9)
         else:
             assert px == pytest.approx(unforeshortened)
+
+
+def test_a_shading_texture_is_in_c_order_as_the_tile_cache_gives_it_back(tmp_path):
+    # Where the quadtree ends the texture is resampled, which left it in another memory
+    # order than the tile cache reads back; arithmetic on it rounds by that order (numpy's
+    # strided loops), and a warm cache drew a pixel 1 ulp apart from a cold one.
+    from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+    from traj2events.scene.tiles import LodSettings, TileSet
+
+    def tiles():
+        sun = np.array([0.3, 0.4, -0.2]) / np.linalg.norm([0.3, 0.4, -0.2])
+        return TileSet(ProceduralTerrain(TerrainParams(seed=3)), sun, 1737400.0, 40.0,
+                       LodSettings(cells=8, min_spacing_m=0.5), cache_dir=str(tmp_path))  # fmt: skip
+
+    built = tiles()
+    key = (built.max_level(), 0, 0)
+    first = built.shading_texture(key, 2)  # the quadtree ends: resampled
+    again = tiles().shading_texture(key, 2)  # read from the cache
+    assert first.flags.c_contiguous and again.flags.c_contiguous and first.tobytes() == again.tobytes()

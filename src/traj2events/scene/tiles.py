@@ -321,8 +321,8 @@ class TileSet:
         disk = self.texture_disk(levels)
         with self._timed():
             texture = disk.load(key, (side, side, 4), np.float16) if disk else None
-            if texture is None:
-                texture = self._compose_shading(key, levels).astype(np.float16)
+            if texture is None:  # C order, as read back: arithmetic on it rounds alike either way
+                texture = np.ascontiguousarray(self._compose_shading(key, levels), np.float16)
                 if disk:
                     disk.save(key, texture)
         return texture
