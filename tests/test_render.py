@@ -661,6 +661,23 @@ def test_a_sub_pixel_bright_strip_gives_its_pixels_its_area_fraction():
         assert np.allclose(point[near].sum(axis=0), 0.0) or np.all(point[near].sum(axis=0) > 4 * width_px)
 
 
+@pytest.mark.parametrize("texture_filter", ["point", "trilinear"])  # anisotropic: its probes clamp at the seams
+def test_a_magnified_tiles_quarters_draw_what_its_whole_finer_texture_draws(texture_filter):
+    # Every tile magnified (texels 2-4 px below a nadir camera): its texture one level finer
+    # drawn from four quarter layers gives the pixels that texture drawn whole, as the
+    # texture of one more shading level: the quarters share their middle texels and the
+    # texel coordinates run on across them (magnified: level 0, no mipmaps between).
+    terrain, camera = ProceduralTerrain(TerrainParams(seed=4)), Camera(48, 48, 45.0)
+    pose = camera_pose(state(altitude=300.0))
+    quartered, whole = (
+        render(terrain, camera, pose, lod=LodSettings(cells=8, pixels_per_cell=8.0, texture_filter=texture_filter,
+                                                      shading_levels=levels, magnified_texel_px=px))[0]
+        for levels, px in ((1, 1e-6), (2, 0.0))
+    )  # fmt: skip
+    assert np.array_equal(quartered.depth_m, whole.depth_m) and (whole.depth_m > 0).all()
+    np.testing.assert_allclose(quartered.radiance, whole.radiance, rtol=1e-4, atol=1e-4 * whole.radiance.max())
+
+
 def test_tiles_whose_texels_the_camera_magnifies_take_the_finer_texture_and_give_it_back(monkeypatch):
     # A texture one level finer, in four more slots, for exactly the tiles whose texels
     # cover more than magnified_texel_px at their nearest point. Flying away and back
