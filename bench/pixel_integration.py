@@ -15,7 +15,9 @@ with LP_NUM_THREADS=1; the best of --repeats rounds, alternated variant by varia
 against the reference's, the per-pixel event-count error (sum |n - n_ref| / sum n_ref) and
 the mean |ln I - ln I_ref| of the emulator's input (lin-log, as the pixel sees it). With
 --regions, also each variant's events against the reference's per kind of pixel (`regions`):
-sky and horizon, depth edges, shadow, shadow edges, lit ground.
+sky and horizon, depth edges, shadow, shadow edges, lit ground. --magnified-texel-px sets
+render.lod.magnified_texel_px (0: no finer texels where the camera magnifies them), for the
+same windows with and without them; --point-sun draws shadows without penumbrae.
 """
 
 from __future__ import annotations
@@ -98,6 +100,12 @@ def emulate(frames: np.ndarray, times: np.ndarray, scale: float) -> np.ndarray:
     return np.bincount(events["y"].astype(np.int64) * w + events["x"], minlength=h * w).reshape(h, w)
 
 
+def config_note(magnified_texel_px: float | None) -> str:
+    if magnified_texel_px is None:
+        return "the default's"
+    return f"finer above {magnified_texel_px:g} px" if magnified_texel_px else "never finer"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("trajectories", type=Path, nargs="+")
@@ -109,10 +117,12 @@ def main() -> None:
     parser.add_argument("--variants", nargs="+", help="names of VARIANTS to run (default: all)")
     parser.add_argument("--regions", action="store_true", help="also each variant's events per kind of pixel")
     parser.add_argument("--point-sun", action="store_true", help="shadows of a point Sun, without penumbrae")
+    parser.add_argument("--magnified-texel-px", type=float, help="render.lod.magnified_texel_px (0: no finer texels)")
     args = parser.parse_args()
     variants = [v for v in VARIANTS if not args.variants or v[0] in args.variants]
     print(f"# pixel integration: {args.size}^2, {args.frames} frames at {args.fps:g} fps, clean preset, sensor "
-          f"input, {'a point Sun' if args.point_sun else 'the Sun disc'}; reference {args.reference}x{args.reference} "
+          f"input, {'a point Sun' if args.point_sun else 'the Sun disc'}, magnified texels "
+          f"{config_note(args.magnified_texel_px)}; reference {args.reference}x{args.reference} "
           f"point samples; {platform.node()} "
           f"({os.cpu_count()} cores, 1 used), {time.strftime('%Y-%m-%d')}")  # fmt: skip
     print("| window | variant | s per frame | vs point | events | vs reference | per-pixel count error "
@@ -121,7 +131,8 @@ def main() -> None:
     for path in args.trajectories:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
-        config = resolve_config({"camera": {"width": args.size, "height": args.size}})
+        lod = {} if args.magnified_texel_px is None else {"magnified_texel_px": args.magnified_texel_px}
+        config = resolve_config({"camera": {"width": args.size, "height": args.size}, "render": {"lod": lod}})
         settings = RenderSettings.from_config(config, scenario)
         camera = settings.build()[0]
         scale = dn_per_radiance(SensorParams.from_config(config["events"]["sensor"]))
