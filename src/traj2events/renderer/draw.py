@@ -359,15 +359,11 @@ class TerrainRenderer:
         self._last_used: dict[TileKey, int] = {}
         self._frame_count = 0
 
-    def _slot(self, key: TileKey) -> int:
+    def _slot(self, key: TileKey, frame_keys: set[TileKey]) -> int:
         if key not in self._slots:
             t = self.tiles.tile(key)
-            slot = self._new_slot()
-            if slot is None:  # finer textures of other frames' tiles give their slots back first
-                for other in [k for k in self._fine if self._last_used.get(k, 0) < self._frame_count]:
-                    self._free.extend(self._fine.pop(other))
-                slot = self._new_slot()
-            slot = self._gl.slot_limit if slot is None else slot  # None still: upload's clear error
+            slot = self._new_slot(frame_keys)
+            slot = self._gl.slot_limit if slot is None else slot  # none left: upload's clear error
             position_lit = np.empty((len(t.vertices), 4), np.float32)
             position_lit[:, :3], position_lit[:, 3] = t.vertices, t.lit
             normal = shading = None
@@ -381,8 +377,14 @@ class TerrainRenderer:
             self._slots[key] = slot
         return self._slots[key]
 
-    def _new_slot(self) -> int | None:
-        """A free slot, or None where all the slots the texture holds are taken."""
+    def _new_slot(self, frame_keys: set[TileKey]) -> int | None:
+        """A free slot; where all the slots the texture holds are taken, the finer texture
+        of the least recently drawn tile not in `frame_keys` gives its slots up first; None
+        where none can."""
+        if not self._free and self._n_slots == self._gl.slot_limit:
+            idle = [k for k in self._fine if k not in frame_keys]
+            if idle:
+                self._free.extend(self._fine.pop(min(idle, key=lambda k: (self._last_used.get(k, 0), k))))
         if self._free:
             return self._free.pop()
         if self._n_slots < self._gl.slot_limit:
@@ -395,13 +397,9 @@ class TerrainRenderer:
         [-1] * 4 where the slots are all taken by this frame's tiles (it keeps its texture)."""
         if key in self._fine:
             return self._fine[key]
-        idle = sorted((k for k in self._fine if k not in frame_keys), key=lambda k: (self._last_used.get(k, 0), k))
         slots = []
         while len(slots) < 4:
-            slot = self._new_slot()
-            if slot is None and idle:  # the least recently drawn tile's finer texture gives its slots up
-                self._free.extend(self._fine.pop(idle.pop(0)))
-                continue
+            slot = self._new_slot(frame_keys)
             if slot is None:
                 self._free.extend(slots)
                 return [-1] * 4
@@ -412,14 +410,13 @@ class TerrainRenderer:
         self._fine[key] = slots
         return slots
 
-    def _fine_slots_of(self, keys: list[TileKey], cell_px: np.ndarray) -> np.ndarray:
+    def _fine_slots_of(self, keys: list[TileKey], cell_px: np.ndarray, frame_keys: set[TileKey]) -> np.ndarray:
         """(n, 4): each tile's finer texture's slots (-1: none): for tiles whose texels
         cover more than `fine_texel_px` pixels at their nearest point, the most magnified first."""
         slots = np.full((len(keys), 4), -1.0, np.float32)
         if not self.fine_texel_px:
             return slots
         texel_px = cell_px / 2**self.shading_levels
-        frame_keys = set(keys)
         for a in np.argsort(-texel_px, kind="stable"):
             if texel_px[a] > self.fine_texel_px:
                 slots[a] = self._fine_slots(keys[a], frame_keys)
@@ -446,8 +443,9 @@ class TerrainRenderer:
         keys, cell_px = self.tiles.select_measured(pose, self.lod_camera)
         self._frame_count += 1
         self._platform.make_current()
-        slots = [self._slot(key) for key in keys]
-        fine_slots = self._fine_slots_of(keys, cell_px)
+        frame_keys = set(keys)
+        slots = [self._slot(key, frame_keys) for key in keys]
+        fine_slots = self._fine_slots_of(keys, cell_px, frame_keys)
         for key in keys:
             self._last_used[key] = self._frame_count
         # Slots freed here may still feed a frame in flight: OpenGL runs the commands in
