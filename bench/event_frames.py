@@ -37,12 +37,12 @@ from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance  # noqa: E402
 from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.pictures import save_png  # noqa: E402
+from traj2events.stages.pictures import PAPER_FRACTIONS, PAPER_LABELS, centred_window, save_png  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
 from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
 from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
 
-FRACTIONS = ((0.25, "tf/4"), (0.5, "tf/2"), (0.75, "3tf/4"))  # events.png's middle panels
+MIDDLE = slice(1, 4)  # events.png's middle panels: tf/4, tf/2, 3tf/4
 
 
 def isolated_share(fired: np.ndarray) -> float:
@@ -67,7 +67,8 @@ def main() -> None:
     args = parser.parse_args()
     config = resolve_config({"camera": {"width": args.size, "height": args.size}})
     events = config["events"]
-    window_s = (args.window_ms or events["window_ms"]) * 1e-3
+    window_us = int(round((args.window_ms or events["window_ms"]) * 1000))
+    window_s = window_us * 1e-6
     fps = float(config["camera"]["fps"])
     scale = dn_per_radiance(SensorParams.from_config(events["sensor"]))
     variants = (("point", "point", 1), ("default", config["render"]["lod"]["texture_filter"], 1),
@@ -86,19 +87,17 @@ def main() -> None:
         camera = settings.build()[0]
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
-        for fraction, label in FRACTIONS:
-            start = fraction * tf - window_s / 2
-            times = start + window_s - np.arange(int(round(args.history * fps)) + 1)[::-1] / fps
-            times = np.append(times, start + window_s) if times[-1] < start + window_s else times
+        for fraction, label in zip(PAPER_FRACTIONS[MIDDLE], PAPER_LABELS[MIDDLE]):
+            lo, hi = centred_window(int(round(fraction * tf * 1e6)), window_us, int(round(tf * 1e6)))
+            times = hi * 1e-6 - np.arange(int(round(args.history * fps)) + 1)[::-1] / fps  # ending at the window's end
             fired = {}
             for name, texture_filter, samples in variants:
                 frames = render_window(settings, camera, states, times, texture_filter, samples)[0]
                 stream = EventEmulator(args.size, args.size, preset_params(events["preset"]), seed=1,
                                        input_scale=scale).process(frames, times)  # fmt: skip
-                image = event_frame(stream, args.size, args.size, int(round(start * 1e6)),
-                                    int(round((start + window_s) * 1e6)))  # fmt: skip
-                in_window = (stream["t"] >= round(start * 1e6)) & (stream["t"] < round((start + window_s) * 1e6))
-                fired[name] = (image, int(in_window.sum()), (image != 255).any(axis=2))
+                image = event_frame(stream, args.size, args.size, lo, hi)
+                count = int(((stream["t"] >= lo) & (stream["t"] < hi)).sum())
+                fired[name] = (image, count, (image != 255).any(axis=2))
             reference = fired[variants[-1][0]]
             at_random = found_share(np.ones_like(reference[2]), reference[2])
             for name, (image, count, pixels) in fired.items():
