@@ -3,21 +3,21 @@
   python bench/pixel_integration.py results/braking/0000/trajectory.h5 results/descent/0000/trajectory.h5 \\
       [--size 128] [--reference 16] [--frames 31] [--fps 100] [--repeats 2]
 
-Windows of each trajectory (mid-flight from t_f / 2; the last second from t_f - 1 s), --frames
-frames at --fps, rendered with the tiles the camera's own size selects (the same scene for
-every variant), through the sensor model, emulated with the clean preset (no noise: every
-event is the scene's or the sampling's). Variants: the shading texture sampled bilinearly at
-each pixel's centre (point sampling), trilinearly from its levels averaged over the pixel's
-footprint, anisotropically (also along the footprint's long axis), and brute force: S x S
-samples per pixel averaged in linear radiance. The reference is --reference x --reference
-point samples per pixel. Per variant: render seconds per frame (wall, one core: llvmpipe
-with LP_NUM_THREADS=1; the best of --repeats rounds, alternated variant by variant), events
-against the reference's, the per-pixel event-count error (sum |n - n_ref| / sum n_ref) and
-the mean |ln I - ln I_ref| of the emulator's input (lin-log, as the pixel sees it). With
---regions, also each variant's events against the reference's per kind of pixel (`regions`):
-sky and horizon, depth edges, shadow, shadow edges, lit ground. --magnified-texel-px sets
-render.lod.magnified_texel_px (0: no finer texels where the camera magnifies them), for the
-same windows with and without them; --point-sun draws shadows without penumbrae.
+Windows of each trajectory (mid-flight from t_f / 2; the last second from t_f - 1 s),
+--frames frames at --fps, rendered with the tiles the camera's own size selects (the same
+scene for every variant), through the sensor model, emulated with the clean preset (no
+noise: every event is the scene's or the sampling's). Variants: the shading texture sampled
+bilinearly at each pixel's centre (point sampling), trilinearly from its levels averaged
+over the pixel's footprint, and brute force: S x S samples per pixel averaged in linear
+radiance. The reference is --reference x --reference point samples per pixel. Per variant:
+render seconds per frame (wall, one core: llvmpipe with LP_NUM_THREADS=1; the best of
+--repeats rounds, alternated variant by variant), events against the reference's, the
+per-pixel event-count error (sum |n - n_ref| / sum n_ref) and the mean |ln I - ln I_ref| of
+the emulator's input (lin-log, as the pixel sees it). With --regions, also each variant's
+events against the reference's per kind of pixel (`regions`): sky and horizon, depth edges,
+shadow, shadow edges, lit ground. --magnified-texel-px sets render.lod.magnified_texel_px
+(0: no finer texels where the camera magnifies them), for the same windows with and without
+them; --point-sun draws shadows without penumbrae.
 """
 
 from __future__ import annotations
@@ -52,8 +52,6 @@ from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
 VARIANTS = [
     ("point", "point", 1),
     ("trilinear", "trilinear", 1),
-    ("anisotropic", "anisotropic", 1),
-    ("anisotropic, 2x2", "anisotropic", 2),
     ("point, 2x2", "point", 2),
     ("point, 4x4", "point", 4),
 ]

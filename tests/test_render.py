@@ -661,7 +661,7 @@ def test_a_sub_pixel_bright_strip_gives_its_pixels_its_area_fraction():
         assert np.allclose(point[near].sum(axis=0), 0.0) or np.all(point[near].sum(axis=0) > 4 * width_px)
 
 
-@pytest.mark.parametrize("texture_filter", ["point", "trilinear"])  # anisotropic: its probes clamp at the seams
+@pytest.mark.parametrize("texture_filter", ["point", "trilinear"])
 def test_a_magnified_tiles_quarters_draw_what_its_whole_finer_texture_draws(texture_filter):
     # Every tile magnified (texels 2-4 px below a nadir camera): its texture one level finer
     # drawn from four quarter layers gives the pixels that texture drawn whole, as the

@@ -124,8 +124,6 @@ class _GLScene:
         if self.textured:
             self.uniform("shading", 2)
             self.uniform("texture_side", float(shading_side))
-            # point and trilinear: the level chosen in the shader (the same on every GPU)
-            self.uniform("level_here", int(texture_filter != "anisotropic"))
             self.uniform("level_bias", footprint.LOD_BIAS)
 
     def _framebuffer(self) -> None:

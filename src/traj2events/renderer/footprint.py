@@ -14,9 +14,8 @@ from __future__ import annotations
 import numpy as np
 
 # How a pixel samples the shading texture (render.lod.texture_filter): `point` at its centre
-# (bilinear between texels); `trilinear` from the levels below, averaged over its footprint;
-# `anisotropic` also along the footprint's long axis, where the ground is seen obliquely.
-TEXTURE_FILTERS = ("point", "trilinear", "anisotropic")
+# (bilinear between texels); `trilinear` from the levels below, averaged over its footprint.
+TEXTURE_FILTERS = ("point", "trilinear")
 # The level a pixel samples, relative to the one whose texels match its footprint (log2):
 # a trilinear sample at level size t (pixels) is a t-wide box (the level's own averaging)
 # under a bilinear tent of half-width t, variance t^2 / 12 + t^2 / 6 = t^2 / 4; a pixel's
@@ -30,8 +29,6 @@ TEXTURE_FILTERS = ("point", "trilinear", "anisotropic")
 # rho^2 = (|a|^2 + |b|^2) / 2. OpenGL's reference takes the longer side, which blurs ground
 # seen obliquely along its short side (docs/rendering.md "Pixel footprint").
 LOD_BIAS = float(np.log2(1.0 / np.sqrt(3.0)))  # -0.79
-MAX_ANISOTROPY = 16.0  # samples along the long axis at most (what llvmpipe and GPUs offer)
-GL_TEXTURE_MAX_ANISOTROPY = 0x84FE  # OpenGL 4.6's (ARB/EXT_texture_filter_anisotropic before)
 
 
 def sunlit(texture: np.ndarray, sun_dir: np.ndarray) -> np.ndarray:

@@ -44,9 +44,6 @@ class ShadingArray:
             (gl.GL_TEXTURE_MAX_LEVEL, len(self.level_sides) - 1),
         ):
             gl.glTexParameteri(gl.GL_TEXTURE_2D_ARRAY, name, value)
-        if self.texture_filter == "anisotropic":  # samples along the footprint's long axis (oblique ground)
-            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, gl.GL_TEXTURE_LOD_BIAS, footprint.LOD_BIAS)
-            gl.glTexParameterf(gl.GL_TEXTURE_2D_ARRAY, footprint.GL_TEXTURE_MAX_ANISOTROPY, footprint.MAX_ANISOTROPY)
         if self.capacity:
             for level, n in enumerate(self.level_sides):
                 gl.glCopyImageSubData(self.texture, gl.GL_TEXTURE_2D_ARRAY, level, 0, 0, 0,

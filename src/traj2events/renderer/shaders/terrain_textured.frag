@@ -2,7 +2,8 @@
 // traj2events terrain shaded per pixel, fragment stage: the reflectance law at every pixel
 // from the shading texture's normal and lit fraction times mu0, sampled over the pixel's
 // footprint (render.lod.texture_filter), plus the light the terrain scattered there and
-// earthshine;// depth along the boresight (m) as in terrain.frag.
+// earthshine; depth along the boresight (m) as in terrain.frag. No branches on options:
+// llvmpipe runs both sides of a branch, even on a uniform (a second read here cost 14 %).
 in vec2 frag_uv;
 flat in float frag_layer;
 flat in vec4 frag_fine_slots;   // >= 0: the layers of the tile's texture one level finer, by quarter
@@ -13,7 +14,6 @@ in float frag_scattered;
 uniform sampler2DArray shading;  // per slot: normal xyz, lit fraction times mu0 (0..1)
 uniform float texture_side;      // its texels a side (cells 2^levels + 1)
 uniform float radiance_max;      // the law's maximum for this Sun (W m^-2 sr^-1)
-uniform bool level_here;         // choose the texture's level here (footprint.py), not in the sampler
 uniform float level_bias;        // log2 of the filter's width against the footprint (footprint.LOD_BIAS)
 
 out vec4 frag_color;             // (radiance, depth, -, -): only R and G are stored
@@ -38,15 +38,9 @@ void main()
     float layer = fine ? frag_fine_slots[int(quarter.y) * 2 + int(quarter.x)] : frag_layer;
     vec3 at = vec3((texel_at - quarter * (texture_side - 1.0) + 0.5) / texture_side, layer);
     vec2 across = dFdx(texel_at), down = dFdy(texel_at);  // texels per pixel
-    vec4 texel;
-    if (level_here) {
-        float rho2 = 0.5 * (dot(across, across) + dot(down, down));
-        float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;
-        texel = textureLod(shading, at, level);
-    } else {  // anisotropic: the sampler's own footprint along its long axis (its probes
-              // clamp at a finer texture's quarter seams: 16 % of pixels apart at 2-4 px texels)
-        texel = textureGrad(shading, at, across / texture_side, down / texture_side);
-    }
+    float rho2 = 0.5 * (dot(across, across) + dot(down, down));
+    float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;
+    vec4 texel = textureLod(shading, at, level);
     vec3 normal = normalize(texel.xyz);
     // The triangle drawn here faces the camera; relief in its texture that faces away is
     // seen edge-on (its limb, mu -> 0), not black: a cut to 0 at mu = 0 flickered between
