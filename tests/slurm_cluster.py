@@ -62,6 +62,12 @@ def _memory_mb() -> int:
     return int(total_kb / 1024 * 0.9)
 
 
+# The node offers twice this machine's cores (slurmd told to trust the file,
+# config_overrides): a trajectory's group job asks for 2 CPUs and mostly starts Python
+# processes one after another, so on a 2-core node the groups would wait for each other.
+NODE_CPUS = 2 * (os.cpu_count() or 1)
+
+
 class SingleNodeSlurm:
     """munged + slurmctld + slurmd on this machine, configured under `folder`."""
 
@@ -101,6 +107,7 @@ JobAcctGatherType=jobacct_gather/none
 JobCompType=jobcomp/none
 MinJobAge=600
 ReturnToService=2
+SlurmdParameters=config_overrides
 SchedulerType=sched/backfill
 GresTypes=gpu
 StateSaveLocation={f}/ctld
@@ -109,7 +116,7 @@ SlurmctldPidFile={f}/ctld.pid
 SlurmdPidFile={f}/d.pid
 SlurmctldLogFile={f}/log/slurmctld.log
 SlurmdLogFile={f}/log/slurmd.log
-NodeName={self.host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} RealMemory={_memory_mb()} Gres=gpu:1 State=UNKNOWN
+NodeName={self.host} NodeAddr=127.0.0.1 CPUs={NODE_CPUS} RealMemory={_memory_mb()} Gres=gpu:1 State=UNKNOWN
 PartitionName=test Nodes=ALL Default=YES MaxTime=INFINITE State=UP
 PartitionName=gpu Nodes=ALL Default=NO MaxTime=INFINITE State=UP
 """
