@@ -115,6 +115,22 @@ def test_building_time_counts_nested_builds_once():
     assert 0.5 * wall < tiles.building_s <= wall  # not once per nesting level
 
 
+def test_evicting_keeps_the_tiles_a_kept_tiles_scattered_light_is_marched_over():
+    # A sibling of a kept tile is lit from the same ancestors' neighbourhoods: after the
+    # eviction only the sibling itself is built (they were dropped, and built again for
+    # every tile uploaded next: 94 builds per 1024^2 braking frame).
+    tiles = _tiles(min_spacing_m=0.5)
+    kept, sibling = (4, 6, 9), (4, 6, 8)
+    tiles.scattered(kept)
+    tiles.tile((2, 0, 0))  # not near the kept tile's ancestors: dropped
+    built = tiles.n_built
+    tiles.evict({kept})
+    tiles.scattered(sibling)
+    assert tiles.n_built == built + 1
+    tiles.tile((2, 0, 0))
+    assert tiles.n_built == built + 2
+
+
 def test_a_drawn_tiles_cells_cover_at_most_pixels_per_cell_unless_it_is_the_finest():
     # select_measured's pixels per cell, the renderer's measure of magnified texels: a
     # cell's spacing over its nearest point's distance, in focal lengths (foreshortened

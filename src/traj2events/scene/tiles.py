@@ -193,11 +193,15 @@ class TileSet:
                 self.building_s += time.perf_counter() - start
 
     def evict(self, keep: set[TileKey]) -> None:
-        """Drop cached tiles not in `keep` (their ancestors stay: children need them)."""
+        """Drop cached tiles not in `keep`. Their ancestors stay (children need them), and
+        so do the tiles around each ancestor, which `scattered` marches over for every
+        tile near these: dropped, they were built again for each tile uploaded next."""
         needed = set()
         for level, i, j in keep:
             for up in range(level + 1):
-                needed.add((level - up, i >> up, j >> up))
+                a, b, last = i >> up, j >> up, 2 ** (level - up) - 1
+                needed.update((level - up, a + da, b + db) for da in (-1, 0, 1) for db in (-1, 0, 1)
+                              if 0 <= a + da <= last and 0 <= b + db <= last)  # fmt: skip
         for key in list(self._cache):
             if key not in needed:
                 del self._cache[key]
