@@ -22,8 +22,9 @@ the rasteriser discarding everything: the vertex stage alone (shading, clipping)
 
 instead times the braking stretch (after 5 warm-up frames, --frames poses x 3 rounds,
 median ms per frame) with the committed shaders and with each probe of PROBES: the
-shaders with one part taken out (the law, the phase term, the texture read, every
-interpolated input), each run as its own process, all of them alternated --rounds times.
+shaders with one part taken out (the law, earthshine, the footprint's level, the texture
+read, everything: a constant radiance), each run as its own process, all of them
+alternated --rounds times.
 The differences say what each part costs. A probe whose text the shaders no longer
 contain stops the run with its name.
 """
@@ -62,19 +63,25 @@ def timed(log: list[float], function):
 
 # Probes of the textured fragment shader: (committed text, replacement), each taking one
 # part out; together they split a frame's time (docs/performance.md).
-_LAW = "    float per_mu0 = reflectance_per_mu0(normalize(texel.xyz), normalize(frag_to_camera_m), frag_phase);"
-_BODY = _LAW.join(
+_LAW = "    float per_mu0 = law_per_mu0(mu0, mu, frag_phase);"
+_READ = "    vec4 texel = textureLod(shading, at, level);"
+_FOOTPRINT = _READ.join(
     [
-        "    vec4 texel = texture(shading, vec3(frag_uv, frag_layer));\n",
-        "\n    float radiance = clamp(per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI, 0.0, radiance_max);",
+        "    vec2 across = dFdx(texel_at), down = dFdy(texel_at);  // texels per pixel\n"
+        "    float rho2 = 0.5 * (dot(across, across) + dot(down, down));\n"
+        "    float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;\n",
+        "",
     ]
 )
+_EARTHSHINE = "    float earthshine = earthshine_radiance(normal);"
+_RADIANCE = "    float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);"
 PROBED_SHADER = "terrain_textured.frag"
 PROBES = {
-    "no law": (_LAW, "    float per_mu0 = texel.x + frag_phase;"),
-    "no law, no phase term": (_LAW, "    float per_mu0 = texel.x;"),
-    "no texture": (_BODY, "    float radiance = frag_phase + frag_uv.x * frag_uv.y + frag_layer;"),
-    "constant radiance": (_BODY, "    float radiance = 1.0;"),
+    "no law": (_LAW, "    float per_mu0 = mu0 + mu + frag_phase;"),
+    "no earthshine": (_EARTHSHINE, "    float earthshine = 0.0;"),
+    "one level (no footprint)": (_FOOTPRINT, "    vec4 texel = textureLod(shading, at, 0.0);"),
+    "no texture read": (_READ, "    vec4 texel = vec4(at.xy, level, at.z + 1.0);"),
+    "constant radiance": (_RADIANCE, "    float radiance = 1.0;"),
 }
 
 
@@ -201,7 +208,7 @@ def main() -> None:
                 r.render(pose)  # uploads, compiles
             total, start, finish, select = [], [], [], []
             r._start, r._finish = timed(start, r._start), timed(finish, r._finish)
-            tiles.select = timed(select, tiles.select)
+            tiles.select_measured = timed(select, tiles.select_measured)
             for pose in path:
                 frame = timed(total, r.render)(pose)
             ms = {k: 1e3 * statistics.median(v) for k, v in dict(total=total, start=start, finish=finish).items()}
