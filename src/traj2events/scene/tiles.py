@@ -194,14 +194,14 @@ class TileSet:
 
     def evict(self, keep: set[TileKey]) -> None:
         """Drop cached tiles not in `keep`. Their ancestors stay (children need them), and
-        so do the tiles around each ancestor, which `scattered` marches over for every
-        tile near these: dropped, they were built again for each tile uploaded next."""
+        so do the tiles around each of them and around each ancestor, which the next
+        frame's uploads and `scattered` read: dropped, they were built again for each tile
+        uploaded next."""
         needed = set()
         for level, i, j in keep:
             for up in range(level + 1):
-                a, b, last = i >> up, j >> up, 2 ** (level - up) - 1
-                needed.update((level - up, a + da, b + db) for da in (-1, 0, 1) for db in (-1, 0, 1)
-                              if 0 <= a + da <= last and 0 <= b + db <= last)  # fmt: skip
+                rows, cols = self._around((level - up, i >> up, j >> up))
+                needed.update((level - up, row, col) for row in rows for col in cols)
         for key in list(self._cache):
             if key not in needed:
                 del self._cache[key]
@@ -297,9 +297,8 @@ class TileSet:
     def _neighbourhood(self, key: TileKey) -> tuple[np.ndarray, np.ndarray, tuple[float, float]]:
         """(heights, lit mu0, origin) on one grid over the tile `key` and the tiles around it
         at its level (those inside the quadtree)."""
-        level, i, j = key
-        last, n = 2**level - 1, self.lod.cells
-        rows, cols = range(max(i - 1, 0), min(i + 1, last) + 1), range(max(j - 1, 0), min(j + 1, last) + 1)
+        level, n = key[0], self.lod.cells
+        rows, cols = self._around(key)
         heights = np.empty((len(rows) * n + 1, len(cols) * n + 1))
         sunlit = np.empty_like(heights)
         for a, row in enumerate(rows):
@@ -308,6 +307,14 @@ class TileSet:
                 heights[a * n : a * n + n + 1, b * n : b * n + n + 1] = t.heights_m
                 sunlit[a * n : a * n + n + 1, b * n : b * n + n + 1] = t.sunlit
         return heights, sunlit, self._origin((level, rows[0], cols[0]))
+
+    @staticmethod
+    def _around(key: TileKey) -> tuple[range, range]:
+        """(rows, columns) of the tile `key` and the tiles around it at its level, inside
+        the quadtree: what `_neighbourhood` lays out and `evict` keeps."""
+        level, i, j = key
+        last = 2**level - 1
+        return range(max(i - 1, 0), min(i + 1, last) + 1), range(max(j - 1, 0), min(j + 1, last) + 1)
 
     def _local_normals(self, tile: Tile) -> np.ndarray:
         """(cells + 1, cells + 1, 3) unit normals (x, y, up) of the tile's heights."""
