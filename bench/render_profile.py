@@ -23,7 +23,8 @@ the rasteriser discarding everything: the vertex stage alone (shading, clipping)
 instead times the braking stretch (after 5 warm-up frames, --frames poses x 3 rounds,
 median ms per frame) with the committed shaders and with each probe of PROBES: the
 shaders with one part taken out (the law, earthshine, the footprint's level, the texture
-read, everything: a constant radiance), each run as its own process, all of them
+array's layers: every read from the first, the same reads with their texels in the cache,
+the texture read, everything: a constant radiance), each run as its own process, all of them
 alternated --rounds times.
 The differences say what each part costs. A probe whose text the shaders no longer
 contain stops the run with its name.
@@ -80,6 +81,7 @@ PROBES = {
     "no law": (_LAW, "    float per_mu0 = mu0 + mu + frag_phase;"),
     "no earthshine": (_EARTHSHINE, "    float earthshine = 0.0;"),
     "one level (no footprint)": (_FOOTPRINT, "    vec4 texel = textureLod(shading, at, 0.0);"),
+    "one layer (in cache)": (_READ, "    vec4 texel = textureLod(shading, vec3(at.xy, 0.0), level);"),
     "no texture read": (_READ, "    vec4 texel = vec4(at.xy, level, at.z + 1.0);"),
     "constant radiance": (_RADIANCE, "    float radiance = 1.0;"),
 }
