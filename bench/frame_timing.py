@@ -65,8 +65,9 @@ from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.geometry.camera import Camera  # noqa: E402
 from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
-from traj2events.renderer.draw import Frame, TerrainRenderer  # noqa: E402
+from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
 from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
+from traj2events.renderer.supersample import Supersampled  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.events import preset_params  # noqa: E402
@@ -92,25 +93,6 @@ WHOLE = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "
 FLIGHT = ("adaptive, log 2", "adaptive, log 1", "adaptive, log 0.5 (ESIM)", "adaptive, log 0.2")
 # Clips (two per trajectory): the bounds measured since session 9.
 CLIPS = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "adaptive, log 0.05", "adaptive, 1 px")
-
-
-class Supersampled:
-    """A renderer at `factor` times the camera's size whose frames are block-averaged down:
-    radiance as the mean over each pixel's block (area integration), depth as the inverse
-    of the mean inverse depth (what the motion field scales with; sky counts as 0)."""
-
-    def __init__(self, renderer: TerrainRenderer, factor: int):
-        self.renderer, self.factor = renderer, factor
-
-    def render(self, pose) -> Frame:
-        frame = self.renderer.render(pose)
-        s = self.factor
-        h, w = frame.radiance.shape[0] // s, frame.radiance.shape[1] // s
-        radiance = frame.radiance.reshape(h, s, w, s).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
-        depth = frame.depth_m.reshape(h, s, w, s).astype(np.float64)
-        inverse = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0).mean(axis=(1, 3))
-        depth_m = np.divide(1.0, inverse, out=np.zeros_like(inverse), where=inverse > 0).astype(np.float32)
-        return Frame(radiance, depth_m, frame.n_tiles, frame.n_triangles)
 
 
 class Stream:
@@ -323,7 +305,7 @@ def main() -> None:
         with TerrainRenderer(
             tiles, drawn, sun, reflectance, texture_filter=args.texture_filter, lod_camera=camera
         ) as drawing:
-            renderer = drawing if args.supersample == 1 else Supersampled(drawing, args.supersample)
+            renderer = drawing if args.supersample == 1 else Supersampled(drawing, camera, args.supersample)
             for clip, (t0, t1) in clips.items():
                 rows = run_clip(
                     renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps,

@@ -9,7 +9,8 @@ scene for every variant), through the sensor model, emulated with the clean pres
 noise: every event is the scene's or the sampling's). Variants: the shading texture sampled
 bilinearly at each pixel's centre (point sampling), trilinearly from its levels averaged
 over the pixel's footprint, and brute force: S x S samples per pixel averaged in linear
-radiance. The reference is --reference x --reference point samples per pixel. Per variant:
+radiance (render.supersample, with either filter). The reference is --reference x
+--reference point samples per pixel. Per variant:
 render seconds per frame (wall, one core: llvmpipe with LP_NUM_THREADS=1; the best of
 --repeats rounds, alternated variant by variant), events against the reference's, the
 per-pixel event-count error (sum |n - n_ref| / sum n_ref) and the mean |ln I - ln I_ref| of
@@ -34,12 +35,10 @@ os.environ.setdefault("LP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
-from frame_timing import Supersampled  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.camera import Camera  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
+from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import log_intensity_8bit  # noqa: E402
 from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance  # noqa: E402
@@ -54,6 +53,8 @@ VARIANTS = [
     ("trilinear", "trilinear", 1),
     ("point, 2x2", "point", 2),
     ("point, 4x4", "point", 4),
+    ("trilinear, 2x2", "trilinear", 2),  # render.supersample: 2 with the default filter
+    ("trilinear, 4x4", "trilinear", 4),
 ]
 
 
@@ -63,10 +64,10 @@ def render_window(settings, camera, states, times, texture_filter: str, samples:
     _, tiles, sun, reflectance = settings.build()
     if point_sun:
         tiles.sun_radius_rad = 0.0  # before any tile is built
-    drawn = Camera(camera.width * samples, camera.height * samples, camera.fov_deg, camera.mount_height_m)
     frames = []
-    with TerrainRenderer(tiles, drawn, sun, reflectance, texture_filter=texture_filter, lod_camera=camera) as r:
-        renderer = r if samples == 1 else Supersampled(r, samples)
+    with sensor_renderer(
+        tiles, camera, sun, reflectance, texture_filter=texture_filter, supersample=samples
+    ) as renderer:
         poses = [camera.pose(s) for s in states.states(times)]
         depth_m = renderer.render(poses[0]).depth_m  # tiles built and uploaded before the clock starts
         start = time.perf_counter()

@@ -355,3 +355,15 @@ def test_a_number_yaml_reads_as_text_gets_a_hint():
         resolve_config({"events": {"window_ms": "1.0e9"}})
     with pytest.raises(ConfigError, match=r"expected number, got str 'ten'$"):
         resolve_config({"events": {"window_ms": "ten"}})
+
+
+@pytest.mark.parametrize(
+    "camera, supersample",
+    [({"width": 2048, "height": 1024}, 9), ({"width": 1024, "height": 1024, "distortion": {"k1": -0.2}}, 16)],
+    ids=["pinhole", "lens"],
+)
+def test_a_supersampled_image_beyond_what_opengl_draws_is_refused_naming_the_key(camera, supersample):
+    # 2048 x 9 = 18 432 px; the lens's pinhole cover adds its margin to 16 x 1024 = 16 384.
+    with pytest.raises(ConfigError, match=r"'render\.supersample'.*expected at most 16384 px a side"):
+        resolve_config({"camera": camera, "render": {"supersample": supersample}})
+    resolve_config({"camera": {"width": 1024, "height": 1024}, "render": {"supersample": 16}})  # 16 384: drawn

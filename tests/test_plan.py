@@ -4,7 +4,7 @@ import pytest
 
 from conftest import ROOT
 from traj2events.config import ConfigError, load_config, resolve_config
-from traj2events.plan import BYTES_PER_PX, dataset_plan, events_bytes_per_px
+from traj2events.plan import BYTES_PER_PX, DRAWN_MB_PER_PX, RENDER_S, dataset_plan, events_bytes_per_px, job_resources
 
 ONE = {"scenarios": {"descent": {"n_trajectories": 3, "tf_guess_s": 10.0}}}
 
@@ -45,6 +45,18 @@ def test_without_the_preview_neither_its_disk_nor_its_encoder_is_planned():
     # The encoder's measured share of a 1024^2 frame's render CPU (bench/preview_cost.py).
     assert 0.1 < 1 - off.core_hours["render"] / on.core_hours["render"] < 0.3
     assert off.core_hours["events"] == on.core_hours["events"]
+
+
+def test_supersampling_plans_its_drawn_pixels_cpu_and_memory():
+    plain = resolve_config({**ONE, "camera": {"width": 1024, "height": 1024}})
+    four = resolve_config({**ONE, "camera": {"width": 1024, "height": 1024}, "render": {"supersample": 4}})
+    added = dataset_plan(four).core_hours["render"] - dataset_plan(plain).core_hours["render"]
+    frames = dataset_plan(plain).frames  # fixed timing: one render per frame
+    assert added == pytest.approx(frames * 15 * 1024**2 * RENDER_S[1] / 3600, rel=1e-9)
+    more_mb = job_resources(four, "render", "descent")["mem_mb"] - job_resources(plain, "render", "descent")["mem_mb"]
+    assert more_mb == pytest.approx(1.25 * 15 * 1024**2 * DRAWN_MB_PER_PX, abs=2)  # with the requests' margin
+    assert dataset_plan(four).core_hours["events"] == dataset_plan(plain).core_hours["events"]
+    assert dataset_plan(four).disk_bytes == dataset_plan(plain).disk_bytes  # the same pixels written
 
 
 def test_default_dataset_plan_is_near_what_it_measured():

@@ -17,6 +17,7 @@ from traj2events.renderer import draw as render_module
 from traj2events.renderer.context import check_pyopengl, egl_devices, hardware_egl_device, resolve_backend
 from traj2events.renderer.draw import TerrainRenderer
 from traj2events.renderer.lens import lens_renderer
+from traj2events.renderer.supersample import sensor_renderer
 from traj2events.scene.earthshine import Earth
 from traj2events.scene.reflectance import ReflectanceParams, angles, bihemispherical_albedo, radiance_factor
 from traj2events.scene.sun import Sun
@@ -567,18 +568,16 @@ def shadow_edge_fractions(
     shadow edge at x = x_edge_m on flat ground: a 10 m cliff beyond the view casts it, the
     Sun from +x at 20 deg, a point (the disc's penumbra would be 0.8 m wide: 0.6 px).
     Texels are 1/8-1/4 of a pixel (2 pixels per cell, 3 levels; `lod`: other LodSettings).
-    `samples`: drawn at samples x samples per pixel and averaged (the same tiles)."""
+    `samples`: each pixel the mean of samples x samples (render.supersample)."""
     cliff, flat = cliff_casting_an_edge_at(x_edge_m), GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
     camera, sun = Camera(64, 64, 45.0), EDGE_SUN
-    drawn = Camera(64 * samples, 64 * samples, 45.0)
     pose = camera_pose(state(altitude=100.0))  # nadir: columns along +x
     lod = LodSettings(**{"pixels_per_cell": 2.0, "shading_levels": 3, "texture_filter": texture_filter, **lod})
     images = []
     for terrain in (cliff, flat):
         tiles = TileSet(terrain, sun.direction, 1e12, 2e3, lod, sun_radius_rad=0.0)
-        with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend=BACKEND, lod_camera=camera) as renderer:
-            frame = renderer.render(pose)
-        images.append(frame.radiance.reshape(64, samples, 64, samples).mean(axis=(1, 3)))
+        with sensor_renderer(tiles, camera, sun, ReflectanceParams(), backend=BACKEND, supersample=samples) as r:
+            images.append(r.render(pose).radiance)
     row = camera.height // 2
     pixel_m = 100.0 / camera.focal_px  # flat ground 100 m below: a pixel's width there
     centre_x = camera.pixel_coordinates()[0][0] * pixel_m
@@ -609,7 +608,7 @@ def notch_strip_fractions(texture_filter: str, samples: int = 1, shift_px: float
     texture's bilinear lit field holds exactly that width. Rows: along the strip's
     width, the 5 pixel columns 1.5-6.5 m from the wall's foot (all within one tile's grid:
     the notch is seen at the texels' spacing). Texels 1/10 px (2 px per cell, 3 levels).
-    `samples`: drawn at samples x samples per pixel and averaged (the same tiles);
+    `samples`: each pixel the mean of samples x samples (render.supersample);
     `shift_px`: the camera moved along the strip's width by that part of a pixel."""
     camera, sun, altitude = Camera(64, 64, 45.0), EDGE_SUN, 100.0
     lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter, magnified_texel_px=0.0)
@@ -626,13 +625,11 @@ def notch_strip_fractions(texture_filter: str, samples: int = 1, shift_px: float
     y = np.arange(30.0, 62.0, spacing)
     wall = (x[:, None] >= wall_x) & (x[:, None] <= wall_x + 5.0) & ~((y >= notch[0]) & (y <= notch[1]))[None, :]
     terrains = GridTerrain(np.where(wall, 10.0, 0.0), spacing, (x[0], y[0])), flat
-    drawn = Camera(64 * samples, 64 * samples, 45.0)
     images = []
     for terrain in terrains:
         tiles = TileSet(terrain, sun.direction, 1e12, half_extent, lod, scattered_azimuths=0, sun_radius_rad=0.0)
-        with TerrainRenderer(tiles, drawn, sun, ReflectanceParams(), backend=BACKEND, lod_camera=camera) as renderer:
-            frame = renderer.render(pose)
-        images.append(frame.radiance.reshape(64, samples, 64, samples).mean(axis=(1, 3)))
+        with sensor_renderer(tiles, camera, sun, ReflectanceParams(), backend=BACKEND, supersample=samples) as r:
+            images.append(r.render(pose).radiance)
     fraction = images[0] / images[1]
     ground_x = wall_x - 4.0 + camera.pixel_coordinates()[0][0] * pixel_m
     columns = np.flatnonzero((ground_x > wall_x - 6.5) & (ground_x < wall_x - 1.5))

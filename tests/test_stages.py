@@ -484,3 +484,21 @@ def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(bu
     emulate(frame_source(tmp_path / "frames.h5"), preset_params("clean"), 0, tmp_path / "events.h5", "clean", "f")
     _, attrs = read_events(tmp_path / "events.h5")
     np.testing.assert_array_equal(attrs["distortion_coefficients"], coefficients)
+
+
+@pytest.mark.slow  # a whole trajectory rendered again
+def test_supersampled_frames_say_so_and_keep_the_scenes_light(built, config, tmp_path):
+    """render.supersample: frames.h5 holds the camera's pixels, each the mean of S x S
+    samples, and says how many; the default's jobs are as before (no new setting)."""
+    assert "supersample" not in RenderSettings.from_config(config, "descent").to_json()
+    settings = RenderSettings.from_config(resolve_config({**CONFIG_OVERLAY, "render": {"supersample": 3}}), "descent")
+    render_trajectory(built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None)
+    with h5py.File(tmp_path / "frames.h5") as f, h5py.File(built / "frames.h5") as one:
+        assert f.attrs["samples_per_pixel"] == 3 and one.attrs["samples_per_pixel"] == 1
+        assert f["radiance"].shape == one["radiance"].shape == (len(one["t"]), SIZE, SIZE)
+        # The same scene: each frame's light as the footprint's filter gives it, within what
+        # its law of a mean normal departs from the mean of the law over a 16^2 camera's huge
+        # pixels (measured: 0.954-1.014x, median 0.985x; 6 x 6 samples 0.98-1.01x these).
+        ratio = f["radiance"][()].sum(axis=(1, 2)) / one["radiance"][()].sum(axis=(1, 2))
+        assert np.abs(ratio - 1).max() < 0.06 and abs(np.median(ratio) - 1) < 0.025
+        np.testing.assert_array_equal(f["depth_m"][()] > 0, one["depth_m"][()] > 0)

@@ -254,6 +254,7 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
     errors += _display_errors(config) + _lens_errors(config["camera"])
+    errors += _supersample_errors(config["camera"], config["render"]["supersample"]) if not errors else []
     return errors or _elevation_grid_error(terrain)
 
 
@@ -267,6 +268,25 @@ def _lens_errors(camera: dict) -> list[str]:
     except ValueError as exc:
         return [f"config key '{exc}".replace(":", "':", 1)]
     return []
+
+
+# The largest image drawn: OpenGL 4.1's least GL_MAX_RENDERBUFFER_SIZE (llvmpipe's own).
+MAX_DRAWN_PX = 16384
+
+
+def _supersample_errors(camera: dict, supersample: int) -> list[str]:
+    """An image to draw (the camera's, S times its size, its lens's pinhole cover) larger
+    than OpenGL's framebuffers hold, before any job starts."""
+    from .geometry.camera import Camera
+
+    drawn = Camera.from_settings(camera).scaled(supersample).pinhole_cover()
+    if max(drawn.width, drawn.height) <= MAX_DRAWN_PX:
+        return []
+    return [
+        f"config key 'render.supersample': {supersample} x {supersample} samples per pixel of the "
+        f"{camera['width']} x {camera['height']} camera draw {drawn.width} x {drawn.height} px (with the lens's "
+        f"margin); expected at most {MAX_DRAWN_PX} px a side, got {supersample}"
+    ]
 
 
 def _timing_errors(timing: dict) -> list[str]:

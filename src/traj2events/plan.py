@@ -26,6 +26,7 @@ FIELD_S_PER_PX = COSTS["cpu_s"]["motion_field_per_px"]
 MANOEUVRE_S = COSTS["manoeuvre_s"]  # seconds of flight a hover (beyond its hold) or a divert adds
 STAR_S = COSTS["cpu_s"]["star_in_view"]  # per star a frame projects (scene.stars.stars_in_view)
 MEMORY_MB = {stage: tuple(v) for stage, v in COSTS["memory_mb"].items()}  # (fixed, per pixel)
+DRAWN_MB_PER_PX = COSTS["drawn_mb_per_px"]  # a render job's, per pixel drawn beyond the camera's
 ADAPTIVE_EXTRA = tuple(COSTS["adaptive_extra"])  # (a, p, q): see rendered_per_frame
 RUNTIME_MARGIN = 3.0  # requested run time / estimate: t_f may exceed its guess, nodes vary
 # Beyond these, `allow_large_dataset: true` must say the user means it.
@@ -129,7 +130,8 @@ def rendered_per_frame(config: dict) -> float:
 def render_s_per_frame(config: dict, pixels: int) -> float:
     """One core's seconds per rendered frame, encoders included (the preview's only with
     render.preview), and the stars a frame projects (beyond the default's few thousand, a
-    cost of its own: V 12 adds ~45 ms a frame)."""
+    cost of its own: V 12 adds ~45 ms a frame). With render.supersample S, the per-pixel
+    part S^2 times (the encoders' share of it too: an estimate with a margin)."""
     from .geometry.camera import Camera
     from .scene.stars import stars_in_view
 
@@ -137,7 +139,8 @@ def render_s_per_frame(config: dict, pixels: int) -> float:
     stars = config["render"]["stars"]
     camera = Camera(config["camera"]["width"], config["camera"]["height"], config["camera"]["fov_deg"])
     star_s = STAR_S * stars_in_view(stars["magnitude_limit"], camera) if stars["enabled"] else 0.0
-    return RENDER_S[0] + RENDER_S[1] * pixels - preview + star_s
+    drawn = pixels * config["render"]["supersample"] ** 2
+    return RENDER_S[0] + RENDER_S[1] * drawn - preview + star_s
 
 
 def dataset_plan(config: dict) -> Plan:
@@ -214,6 +217,8 @@ def job_resources(config: dict, stage: str, scenario: str | None, threads: int =
         seconds = 2 * n * 5.0 / threads  # ~1-5 s per draw, ~2 n draws at most (batch.max_draws)
     fixed, per_px = MEMORY_MB.get(stage, (1000.0, 0.0))
     mem = fixed + per_px * pixels
+    if stage == "render":  # render.supersample's larger image
+        mem += DRAWN_MB_PER_PX * pixels * (config["render"]["supersample"] ** 2 - 1)
     if stage == "sample_trajectories":
         mem += 500.0 * threads
     return {"mem_mb": int(mem * 1.25) + 1, "runtime": max(10, int(RUNTIME_MARGIN * seconds / 60.0) + 1)}

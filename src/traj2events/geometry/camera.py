@@ -13,7 +13,7 @@ lens's distortion where `distortion` has one (geometry/distortion.py): x_s = f a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -132,6 +132,12 @@ class Camera:
             )
         fov = float(np.degrees(2.0 * np.arctan(width / (2.0 * f))))
         return Camera(width, height, fov, self.mount_height_m)
+
+    def scaled(self, factor: int) -> "Camera":
+        """This camera with `factor` x `factor` pixels in each of its pixels: the same field
+        of view and lens, `factor` times the focal length in pixels (a block of pixels' middle
+        is the ray of the pixel it divides)."""
+        return replace(self, width=self.width * factor, height=self.height * factor)
 
     def to_pixel_index(self, xy_s: np.ndarray) -> np.ndarray:
         """Centred coordinates (..., 2) -> (column, row) continuous indices (centre of pixel 0 = 0)."""

@@ -52,7 +52,7 @@ class LensResampling:
 
     def depth(self, depth_m: np.ndarray) -> np.ndarray:
         """(H, W) float32 depth along the boresight, 0 = sky: bilinear in inverse depth over
-        the terrain samples, sky where their weights sum to less than a half."""
+        the terrain samples (mean_depth)."""
         inverse = np.zeros(self.shape)
         terrain_weight = np.zeros(self.shape)
         for w, d in zip(self.weights, self._corners(depth_m)):
@@ -60,30 +60,32 @@ class LensResampling:
             terrain = d > 0
             inverse += np.where(terrain, w / np.where(terrain, d, 1.0), 0.0)
             terrain_weight += np.where(terrain, w, 0.0)
-        terrain = terrain_weight >= 0.5
-        return np.where(terrain, terrain_weight / np.where(terrain, inverse, 1.0), 0.0).astype(np.float32)
+        return mean_depth(inverse, terrain_weight)
 
 
-class LensRenderer:
-    """A TerrainRenderer drawing the pinhole cover of `camera` (without stars), its frames
-    resampled onto `camera`'s sensor and `stars` (None: none) added through the lens
-    (`render`, `render_sequence`, `backend`, `gl_renderer` as the renderer's); it owns the
-    renderer it wraps."""
+def mean_depth(inverse_weighted: np.ndarray, terrain_weight: np.ndarray) -> np.ndarray:
+    """float32 depth (m, 0 = sky) of pixels made of weighted samples, from the weighted sum
+    of the terrain samples' inverse depths and the sum of their weights (all samples' sum
+    to 1): the inverse of the terrain's mean inverse depth, exact on a plane (1/Z is affine
+    in the image); sky where the terrain's weights sum to less than a half."""
+    terrain = terrain_weight >= 0.5
+    return np.where(terrain, terrain_weight / np.where(terrain, inverse_weighted, 1.0), 0.0).astype(np.float32)
 
-    def __init__(self, renderer: TerrainRenderer, camera: Camera, stars: StarField | None = None):
-        self.renderer, self.camera, self.stars = renderer, camera, stars
-        self.resampling = LensResampling(camera, renderer.camera)
-        self.backend, self.gl_renderer = renderer.backend, renderer.gl_renderer
 
-    def _onto_sensor(self, frame: Frame, pose: CameraPose) -> Frame:
-        r = self.resampling
-        radiance, depth = r.radiance(frame.radiance), r.depth(frame.depth_m)
-        if self.stars is not None:
-            radiance = add_stars(radiance, depth, self.stars, self.camera, pose)
-        return Frame(radiance, depth, frame.n_tiles, frame.n_triangles)
+class WrappedRenderer:
+    """A renderer (`inner`) whose frames each pass through `_after(frame, pose)`: `render`,
+    `render_sequence` (one drawn ahead, as the inner's), `backend`, `gl_renderer` as the
+    inner's; it owns the inner renderer."""
+
+    def __init__(self, inner):
+        self.renderer = inner
+        self.backend, self.gl_renderer = inner.backend, inner.gl_renderer
+
+    def _after(self, frame: Frame, pose: CameraPose) -> Frame:
+        raise NotImplementedError
 
     def render(self, pose: CameraPose) -> Frame:
-        return self._onto_sensor(self.renderer.render(pose), pose)
+        return self._after(self.renderer.render(pose), pose)
 
     def render_sequence(self, poses: Iterable[CameraPose]) -> Iterator[Frame]:
         drawn = deque()  # the poses handed to the renderer, whose frames come back in order
@@ -94,7 +96,7 @@ class LensRenderer:
                 yield pose
 
         for frame in self.renderer.render_sequence(remembered()):
-            yield self._onto_sensor(frame, drawn.popleft())
+            yield self._after(frame, drawn.popleft())
 
     def close(self) -> None:
         self.renderer.close()
@@ -104,6 +106,23 @@ class LensRenderer:
 
     def __exit__(self, *exc):
         self.close()
+
+
+class LensRenderer(WrappedRenderer):
+    """A TerrainRenderer drawing the pinhole cover of `camera` (without stars), its frames
+    resampled onto `camera`'s sensor and `stars` (None: none) added through the lens."""
+
+    def __init__(self, renderer: TerrainRenderer, camera: Camera, stars: StarField | None = None):
+        super().__init__(renderer)
+        self.camera, self.stars = camera, stars
+        self.resampling = LensResampling(camera, renderer.camera)
+
+    def _after(self, frame: Frame, pose: CameraPose) -> Frame:
+        r = self.resampling
+        radiance, depth = r.radiance(frame.radiance), r.depth(frame.depth_m)
+        if self.stars is not None:
+            radiance = add_stars(radiance, depth, self.stars, self.camera, pose)
+        return Frame(radiance, depth, frame.n_tiles, frame.n_triangles)
 
 
 def lens_renderer(tiles, camera: Camera, *args, **kwargs) -> TerrainRenderer | LensRenderer:

@@ -25,7 +25,7 @@ import random
 
 def without_late_defaults(settings: dict) -> dict:
     """`settings` without the keys that came after datasets were built where they hold
-    their default (`compression` Blosc, `distortion` none), so that those datasets' jobs'
+    their default (`compression` Blosc, `distortion` none, `supersample` 1), so that those datasets' jobs'
     settings (the rules' params) stay as they were."""
     return {k: v for k, v in settings.items() if not _late_default(k, v)}
 
@@ -33,6 +33,8 @@ def without_late_defaults(settings: dict) -> dict:
 def _late_default(key: str, value) -> bool:
     if key == "compression":
         return value == "blosc"
+    if key == "supersample":
+        return value == 1
     if key == "distortion":
         return value is None or not any((value or {}).values())
     return False

@@ -89,6 +89,7 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
             "earth": dict(sc["earth"]) if sc.get("earth") else None,
             "reflectance": dict(r["reflectance"]),
             "lod": dict(r["lod"]),
+            "supersample": int(r["supersample"]),
             "scattered_light": dict(r["scattered_light"]),
             "half_extent_m": float(reach + horizon),
             "display_white_w_m2_sr": float(r["display_white_w_m2_sr"]),

@@ -22,7 +22,8 @@ from ..geometry.camera import Camera
 from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
 from ..renderer.draw import TerrainRenderer
-from ..renderer.lens import LensRenderer, lens_renderer
+from ..renderer.lens import LensRenderer
+from ..renderer.supersample import Supersampled, sensor_renderer
 from ..scene.earthshine import Earth
 from ..scene.reflectance import ReflectanceParams
 from ..scene.stars import StarField
@@ -63,6 +64,7 @@ class RenderSettings:
     emulator_input: dict | None  # adaptive timing: events.input and events.sensor (its log's scale)
     compression: str = "blosc"  # frames.h5's images (formats.hdf5.COMPRESSIONS)
     distortion: dict | None = None  # camera.distortion (None: a pinhole)
+    supersample: int = 1  # each pixel from S x S samples (render.supersample)
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
@@ -129,6 +131,7 @@ class RenderSettings:
             "reflectance": self.reflectance,
             "terrain": self.terrain,
             "lod": self.lod,
+            "samples_per_pixel": self.supersample,
             "scattered_light": self.scattered_light,
             "terrain_half_extent_m": self.half_extent_m,
             "display_white_w_m2_sr": self.display_white_w_m2_sr,
@@ -140,7 +143,7 @@ class RenderSettings:
 
 
 def render_between(
-    renderer: TerrainRenderer | LensRenderer,
+    renderer: TerrainRenderer | LensRenderer | Supersampled,
     camera: Camera,
     states: SolvedFlight | ExternalFlight,
     frame,
@@ -208,9 +211,9 @@ class TrajectoryRender:
         start = time.perf_counter()
         triangles = reused = added = 0
         with (
-            lens_renderer(
+            sensor_renderer(
                 tiles, camera, self.sun, self.reflectance, stars=s.star_field(), backend=backend,
-                earth=s.earth_light(),
+                earth=s.earth_light(), supersample=s.supersample,
             ) as renderer,
             FramesWriter(frames, s.height, s.width, self.attrs, keep_radiance, s.compression) as out,
             VideoWriter(video, s.width, s.height, fps, "ffv1") as lossless,
@@ -292,6 +295,7 @@ FRAME_ATTR_ORDER = (
     "reflectance",
     "terrain",
     "lod",
+    "samples_per_pixel",
     "scattered_light",
     "terrain_half_extent_m",
     "display_white_w_m2_sr",
