@@ -60,3 +60,29 @@ def test_flat_ground_seen_obliquely_is_the_same_supersampled(distortion):
     depth_rtol = 2e-6 if distortion.is_pinhole else 2.5e-5
     np.testing.assert_allclose(four.depth_m, one.depth_m, rtol=depth_rtol)
     np.testing.assert_allclose(four.radiance, one.radiance, rtol=5e-4)
+
+
+def test_stars_are_points_on_the_cameras_own_pixels_with_each_frame_its_own_pose():
+    # Stars go onto the averaged frame, as the 1-sample frame takes them: a star's light is
+    # not divided among S x S samples and averaged back (nor lost on a mixed horizon pixel).
+    from traj2events.scene.stars import StarField
+    from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+
+    camera, sun = Camera(48, 48, 45.0), Sun(1.496e11, 30.0, 40.0)
+    poses = [camera_pose(state(x=-5000.0, altitude=2000.0, pitch=p)) for p in (80.0, 78.0)]  # the horizon in view
+    tiles = TileSet(ProceduralTerrain(TerrainParams(seed=4)), sun.direction, 1_737_400.0, 140e3, LodSettings())
+    stars = StarField.draw(5.0, seed=1)
+    frames = {}
+    for samples in (1, 2):
+        for with_stars in (None, stars):
+            with sensor_renderer(
+                tiles, camera, sun, ReflectanceParams(), stars=with_stars, backend=BACKEND, supersample=samples
+            ) as r:
+                frames[samples, with_stars is not None] = list(r.render_sequence(poses))
+    for k in range(len(poses)):
+        starlight = {s: frames[s, True][k].radiance - frames[s, False][k].radiance for s in (1, 2)}
+        sky = (frames[1, True][k].depth_m == 0) & (frames[2, True][k].depth_m == 0)
+        assert np.count_nonzero(starlight[2][sky]) > 3
+        np.testing.assert_allclose(starlight[2][sky], starlight[1][sky], rtol=1e-5, atol=1e-12)
+    with sensor_renderer(tiles, camera, sun, ReflectanceParams(), stars=stars, backend=BACKEND, supersample=2) as r:
+        np.testing.assert_array_equal(r.render(poses[1]).radiance, frames[2, True][1].radiance)
