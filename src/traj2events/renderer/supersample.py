@@ -23,15 +23,15 @@ from .lens import LensRenderer, WrappedRenderer, lens_renderer, mean_depth
 def block_mean(image: np.ndarray, samples: int) -> np.ndarray:
     """(H, W) float64: the mean of each `samples` x `samples` block of an (H S, W S) image."""
     h, w = image.shape[0] // samples, image.shape[1] // samples
-    return image.reshape(h, samples, w, samples).mean(axis=(1, 3), dtype=np.float64)
+    # The block's rows summed first, along memory: 2x numpy's mean over both axes at once.
+    return image.reshape(h, samples, w, samples).sum(axis=1, dtype=np.float64).sum(axis=2) / samples**2
 
 
 def block_depth(depth_m: np.ndarray, samples: int) -> np.ndarray:
     """(H, W) float32 depth (m, 0 = sky) of each `samples` x `samples` block (lens.mean_depth)."""
-    d = depth_m.astype(np.float64)
-    terrain = d > 0
-    inverse = np.where(terrain, 1.0 / np.where(terrain, d, 1.0), 0.0)
-    return mean_depth(block_mean(inverse, samples), block_mean(terrain.astype(np.float64), samples))
+    terrain = depth_m > 0
+    inverse = np.divide(1.0, depth_m, out=np.zeros(depth_m.shape, np.float32), where=terrain)  # float32: ~6e-8
+    return mean_depth(block_mean(inverse, samples), block_mean(terrain, samples))
 
 
 class Supersampled(WrappedRenderer):
