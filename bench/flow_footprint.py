@@ -29,7 +29,6 @@ import numpy as np  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.camera import Camera  # noqa: E402
 from traj2events.geometry.motion_field import depth_flow  # noqa: E402
 from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
 from traj2events.stages.render import RenderSettings  # noqa: E402
@@ -52,7 +51,7 @@ def main() -> None:
         config = resolve_config({"camera": {"width": args.size, "height": args.size}})
         settings = RenderSettings.from_config(config, str(tr.attrs["scenario"]))
         camera, tiles, sun, reflectance = settings.build()
-        big = Camera(camera.width * s, camera.height * s, camera.fov_deg, camera.mount_height_m)
+        big = camera.scaled(s)
         for fraction in (0.25, 0.5, 0.75):
             k = int(fraction * (len(tr.t) - 1))
             state = tr.state[k]

@@ -63,11 +63,9 @@ import numpy as np  # noqa: E402
 
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.camera import Camera  # noqa: E402
 from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
 from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
-from traj2events.renderer.supersample import Supersampled  # noqa: E402
+from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.events import preset_params  # noqa: E402
@@ -292,9 +290,6 @@ def main() -> None:
         config = resolve_config({"camera": {"width": args.size, "height": args.size, "fps": args.fps}})
         settings = RenderSettings.from_config(config, scenario)
         camera, tiles, sun, reflectance = settings.build()
-        drawn = Camera(
-            args.size * args.supersample, args.size * args.supersample, camera.fov_deg, camera.mount_height_m
-        )
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
         if args.flight:
@@ -302,10 +297,9 @@ def main() -> None:
         else:
             clips = {"mid-flight": (tf / 2, tf / 2 + args.duration), "last second": (tf - args.duration, tf)}
         flight: dict[str, list[dict]] = {}
-        with TerrainRenderer(
-            tiles, drawn, sun, reflectance, texture_filter=args.texture_filter, lod_camera=camera
-        ) as drawing:
-            renderer = drawing if args.supersample == 1 else Supersampled(drawing, camera, args.supersample)
+        with sensor_renderer(
+            tiles, camera, sun, reflectance, texture_filter=args.texture_filter, supersample=args.supersample
+        ) as renderer:
             for clip, (t0, t1) in clips.items():
                 rows = run_clip(
                     renderer, camera, states, settings.display_white_w_m2_sr, t0, t1, args.reference_fps, args.fps,

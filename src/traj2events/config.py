@@ -254,7 +254,8 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
     errors += _display_errors(config) + _lens_errors(config["camera"])
-    errors += _supersample_errors(config["camera"], config["render"]["supersample"]) if not errors else []
+    if not errors:  # a lens refused above has no pinhole cover to measure
+        errors += _supersample_errors(config["camera"], config["render"]["supersample"])
     return errors or _elevation_grid_error(terrain)
 
 
