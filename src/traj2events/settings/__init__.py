@@ -25,8 +25,8 @@ import random
 
 def without_late_defaults(settings: dict) -> dict:
     """`settings` without the keys that came after datasets were built where they hold
-    their default (`compression` Blosc, `distortion` none, `supersample` 1), so that those datasets' jobs'
-    settings (the rules' params) stay as they were."""
+    their default (`compression` Blosc, `distortion` none, `supersample` 1), so that those
+    datasets' jobs' settings (the rules' params) stay as they were."""
     return {k: v for k, v in settings.items() if not _late_default(k, v)}
 
 
