@@ -711,8 +711,10 @@ def test_relief_seen_edge_on_in_the_texture_is_not_black():
     # faces (no scattered light): every visible point is lit. Drawn as a coarse mesh with
     # the relief in its shading texture, the texels of the drops face away from the
     # camera under triangles that face it: seen edge-on, at the law's limb, not black.
-    # The same terrain drawn as a mesh that resolves the teeth (the depth test hides the
-    # drops) is the truth: the mean radiance within 1 % of it (black texels: 2.7 % under).
+    # The same terrain drawn as a mesh that resolves the teeth at the grid's spacing (the
+    # depth test hides the drops) is the reference: the mean radiance within 1.5 % of it
+    # (1.2 % under, with the texture's texels finer than the quadtree's geometry; black
+    # texels: 6.5 % under).
     spacing = 0.125
     x = np.arange(-40.0, 80.0 + spacing / 2, spacing)
     saw = GridTerrain(0.2 * (x % 1.0)[:, None] * np.ones((1, x.size)), spacing, (x[0], x[0]))
@@ -724,7 +726,7 @@ def test_relief_seen_edge_on_in_the_texture_is_not_black():
     textured, meshed = (f.radiance[f.depth_m > 0] for f in frames)
     assert (frames[0].depth_m > 0).mean() > 0.8
     assert textured.min() > 0.5 * np.median(textured)
-    assert textured.mean() == pytest.approx(meshed.mean(), rel=0.01)
+    assert textured.mean() == pytest.approx(meshed.mean(), rel=0.015)
 
 
 def test_a_translating_shadow_edge_fires_the_events_its_pixels_area_integrals_predict():

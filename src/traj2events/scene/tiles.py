@@ -325,9 +325,9 @@ class TileSet:
         """(side, side, 4) float16 (the renderer's texel format), side = cells 2^levels + 1:
         the unit normals (xyz) and lit fractions of the tile's area at the spacing of its
         descendants `levels` levels down, texel [a, b] at the tile's grid point
-        (a, b) / 2^levels (a along x, b along y). Where the quadtree ends sooner, the
-        finest level there, linearly resampled. With a tile cache, read from it when
-        stored there."""
+        (a, b) / 2^levels (a along x, b along y), also below the quadtree's end (the
+        terrain evaluated at the texels' spacing: detail finer than the finest geometry).
+        With a tile cache, read from it when stored there."""
         side = self.lod.cells * 2**levels + 1
         disk = self.texture_disk(levels)
         with self._timed():
@@ -343,29 +343,26 @@ class TileSet:
         one grid over the whole tile (plus the margin toward the Sun) at that level's
         spacing, and its shadow swept with the level above's obstruction beyond: the
         descendants' heights and normals, with shadows cast across their edges at the fine
-        spacing (4^levels descendants, each swept alone, took ~5x longer)."""
+        spacing (4^levels descendants, each swept alone, took ~5x longer). Below the
+        quadtree's end (`min_spacing_m`: the finest geometry) the levels go on: the terrain
+        resolves its roughness down to two texels there too, so that the last seconds of a
+        flight see detail down to their pixels, not the finest tile's relief magnified."""
         level = key[0]
-        k = min(levels, self.max_level() - level)
         tile = self.tile(key)
-        n = self.lod.cells * 2**k
-        if k == 0:
+        n = self.lod.cells * 2**levels
+        if levels == 0:
             out = np.concatenate([tile.normals[: (n + 1) ** 2], tile.lit[: (n + 1) ** 2, None]], axis=1)
-            out = out.reshape(n + 1, n + 1, 4).astype(np.float32)
-        else:
-            origin, field = self._origin(key), tile.shadow
-            for down in range(1, k + 1):
-                x, y, lo_x, lo_y = self._extended_axes(level + down, origin, self.lod.cells * 2**down)
-                xx, yy = np.meshgrid(x, y, indexing="ij")
-                h = self.terrain.height_m(xx, yy, self.tile_spacing_m(level + down))
-                field = shadow_field(x, y, h, self.sun_dir, self.radius_m, field.boundary, self.sun_radius_rad)
-            out = np.empty((n + 1, n + 1, 4), np.float32)
-            inner = (slice(lo_x - 1, lo_x + n), slice(lo_y - 1, lo_y + n))
-            out[..., :3] = _grid_normals(surface_points(xx, yy, h, self.radius_m))[inner]
-            out[..., 3] = field.lit[lo_x : lo_x + n + 1, lo_y : lo_y + n + 1]
-        side = self.lod.cells * 2**levels + 1
-        if len(out) != side:
-            out = _resample_linear(out, side)
-            out[..., :3] /= np.linalg.norm(out[..., :3], axis=-1, keepdims=True)
+            return out.reshape(n + 1, n + 1, 4).astype(np.float32)
+        origin, field = self._origin(key), tile.shadow
+        for down in range(1, levels + 1):
+            x, y, lo_x, lo_y = self._extended_axes(level + down, origin, self.lod.cells * 2**down)
+            xx, yy = np.meshgrid(x, y, indexing="ij")
+            h = self.terrain.height_m(xx, yy, self.tile_spacing_m(level + down))
+            field = shadow_field(x, y, h, self.sun_dir, self.radius_m, field.boundary, self.sun_radius_rad)
+        out = np.empty((n + 1, n + 1, 4), np.float32)
+        inner = (slice(lo_x - 1, lo_x + n), slice(lo_y - 1, lo_y + n))
+        out[..., :3] = _grid_normals(surface_points(xx, yy, h, self.radius_m))[inner]
+        out[..., 3] = field.lit[lo_x : lo_x + n + 1, lo_y : lo_y + n + 1]
         return out
 
     # --- selection --------------------------------------------------------------------
@@ -428,11 +425,10 @@ class TileSet:
 
 def long_sweep_lit(tiles: TileSet, key: TileKey, levels: int, widths: int = 4) -> np.ndarray:
     """A reference for shading textures' shadows (tests, bench/shading_texture.py): lit
-    fractions at `key`'s grid points `levels` levels finer (fewer where the quadtree ends)
-    from one sweep at that spacing over the tile and `widths` tile widths toward the Sun,
-    with no tile edge in between; beyond, the finest ancestor's obstruction."""
+    fractions at `key`'s grid points `levels` levels finer from one sweep at that spacing
+    over the tile and `widths` tile widths toward the Sun, with no tile edge in between;
+    beyond, the finest ancestor's obstruction."""
     level, i, j = key
-    levels = min(levels, tiles.max_level() - level)
     n = tiles.lod.cells * 2**levels
     x, y, lo_x, lo_y = tiles._extended_axes(level + levels, tiles._origin(key), n, margin=widths * n)
     xx, yy = np.meshgrid(x, y, indexing="ij")
