@@ -245,7 +245,11 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"events": {"sensor": {"pixel_pitch_m": 1.0}}}, ["events.sensor.pixel_pitch_m", "<= 0.0001"]),
     ({"events": {"sensor": {"band_m": [1e-9, 2e-9]}}}, ["events.sensor.band_m.0", ">= 2e-07"]),
     ({"terrain": {"boulder_diameter_min_m": 9.0}}, ["terrain.boulder_diameter_min_m", "boulder_diameter_max_m"]),
-    ({"terrain": {"boulder_density_k": 0.2}}, ["terrain.boulder_density_k", "cover 83%"]),
+    ({"terrain": {"boulder_density_k": 0.02}}, ["terrain.boulder_density_k", "cover 53%"]),
+    (
+        {"terrain": {"rock_diameter_min_m": 1.0}},
+        ["terrain.rock_diameter_min_m", "at most terrain.boulder_diameter_min_m"],
+    ),
     ({"events": {"window_ms": 1e5}}, ["events.window_ms", "shortest flight"]),
     ({"events": {"pixel": {"hot_pixel_fraction": 0.01}}}, ["events.pixel.hot_pixel_hz", "> 0"]),
     (

@@ -77,12 +77,14 @@ def test_landing_pad_is_level_but_keeps_its_regolith_texture():
     r = np.linspace(0, 19.9, 50)
     assert np.all(flat.height_m(0.6 * r, 0.8 * r, 0.5) == 0.0)
     assert site_pad_weight(np.array([40.0]), np.array([0.0]), 20.0)[0] == 1.0
-    # With the default, the pad keeps the roughness of 2 m and shorter (cm high): texture
-    # for the last seconds, level at the lander's scale.
+    # With the default, the pad keeps the roughness of 2 m and shorter (cm high) and the
+    # rocks up to 0.2 m: texture for the last seconds, level at the lander's scale.
     terrain = ProceduralTerrain(TerrainParams(seed=1, site_radius_m=20.0))
     x, y = np.meshgrid(np.arange(-10, 10, 0.05), np.arange(-10, 10, 0.05), indexing="ij")
     h = terrain.height_m(x, y, 0.05)
-    np.testing.assert_array_equal(h, terrain.roughness_m(x, y, 0.05, short=True))
+    rocks = terrain.rock_relief_m(x, y, 0.05, pad=True)
+    np.testing.assert_array_equal(h, terrain.roughness_m(x, y, 0.05, short=True) + rocks)
+    assert 0 < rocks.max() <= 0.1  # rocks of 0.1-0.2 m resolved at 5 cm: hemispheres at most 10 cm high
     expected_rms = 0.02 * np.sqrt(sum((2 * 0.5**k) ** (2 * 0.8) for k in range(5)))  # octaves 2, 1, ..., 0.125 m
     assert 0.3 * expected_rms < h.std() < 1.5 * expected_rms and np.abs(h).max() < 0.15
     slope_deg = np.degrees(np.arctan(np.hypot(*np.gradient(h, 0.05))))
@@ -184,12 +186,32 @@ def test_boulders_crowd_the_ejecta_of_fresh_craters():
     assert density_on / density_off == pytest.approx(terrain.params.boulder_ejecta_factor, rel=0.25)
 
 
+def test_rocks_follow_the_boulders_law_below_them_and_leave_the_boulders_alone():
+    # No fresh craters: N(>D) = K D^-2.5 per m^2 from rock_diameter_min_m up to the boulders.
+    params = TerrainParams(seed=3, fresh_fraction=0.0)
+    terrain = ProceduralTerrain(params)
+    box = (0.0, 60.0)
+    x, y, d = terrain.rocks_in(box, box)
+    inside = (x >= 0) & (x < 60) & (y >= 0) & (y < 60)
+    for d_min in (0.02, 0.05, 0.1, 0.2):
+        expected = params.boulder_density_k * (d_min**-2.5 - params.boulder_diameter_min_m**-2.5) * 60.0**2
+        observed = int((inside & (d >= d_min)).sum())
+        assert abs(observed - expected) < 4 * np.sqrt(expected) + 1, (d_min, observed, expected)
+    assert d.min() >= params.rock_diameter_min_m and d.max() < params.boulder_diameter_min_m
+    # The boulders are where they were without rocks (their own random streams).
+    without = ProceduralTerrain(TerrainParams(seed=3, fresh_fraction=0.0, rock_diameter_min_m=0.5))
+    assert without.rocks_in(box, box)[0].size == 0
+    for a, b in zip(terrain.boulders_in((0.0, 500.0), (0.0, 500.0)), without.boulders_in((0.0, 500.0), (0.0, 500.0))):
+        np.testing.assert_array_equal(a, b)
+
+
 def test_boulder_shadow_has_the_analytic_length():
     """A hemisphere of radius a on flat ground, Sun at elevation e: the shadow's tip lies
     a / sin(e) from its centre, straight away from the Sun."""
     from traj2events.scene.illumination import shadow_field
+    from traj2events.scene.populations import boulder_profile
     from traj2events.scene.sun import sun_direction
-    from traj2events.scene.terrain import bilinear, boulder_profile
+    from traj2events.scene.terrain import bilinear
 
     a, spacing, elevation = 2.0, 0.05, 15.0
     x = np.arange(-20.0, 20.0 + spacing / 2, spacing)

@@ -215,10 +215,14 @@ def _semantic_errors(config: dict) -> list[str]:
     for kind in ("crater", "boulder"):
         if terrain[f"{kind}_diameter_min_m"] > terrain[f"{kind}_diameter_max_m"]:
             errors.append(f"config key 'terrain.{kind}_diameter_min_m': expected at most terrain.{kind}_diameter_max_m")
+    if terrain["rock_diameter_min_m"] > terrain["boulder_diameter_min_m"]:
+        errors.append(f"config key 'terrain.rock_diameter_min_m': expected at most terrain.boulder_diameter_min_m "
+                      f"= {terrain['boulder_diameter_min_m']} (rocks are the boulders' law below it), "
+                      f"got {terrain['rock_diameter_min_m']}")  # fmt: skip
     covered = _boulder_cover(terrain)
     if covered > 0.5:
-        errors.append(f"config key 'terrain.boulder_density_k': boulders would cover {covered:.0%} of the ground "
-                      f"(pi/4 of D^2 summed over N(>D) = K D^-slope from the smallest to the largest); "
+        errors.append(f"config key 'terrain.boulder_density_k': boulders and rocks would cover {covered:.0%} of "
+                      f"the ground (pi/4 of D^2 summed over N(>D) = K D^-slope from the smallest to the largest); "
                       f"expected at most 50 %, got K = {terrain['boulder_density_k']}")  # fmt: skip
     for name, sc in config["scenarios"].items():
         errors += _scenario_errors(config, name, sc)
@@ -330,10 +334,11 @@ _Validator = jsonschema.validators.extend(
 
 
 def _boulder_cover(terrain: dict) -> float:
-    """Share of the ground boulders cover: the integral of (pi/4) D^2 |dN/dD| from the smallest
-    diameter to the largest, N(>D) = K D^-s per m^2 (terrain.boulder_*)."""
+    """Share of the ground boulders and rocks cover: the integral of (pi/4) D^2 |dN/dD| from
+    the smallest rock to the largest boulder, N(>D) = K D^-s per m^2 (terrain.boulder_*)."""
     k, s = terrain["boulder_density_k"], terrain["boulder_slope"]
-    lo, hi = terrain["boulder_diameter_min_m"], terrain["boulder_diameter_max_m"]
+    lo = min(terrain["rock_diameter_min_m"], terrain["boulder_diameter_min_m"])
+    hi = terrain["boulder_diameter_max_m"]
     if k == 0 or hi <= lo:
         return 0.0
     power = math.log(hi / lo) if s == 2 else (hi ** (2 - s) - lo ** (2 - s)) / (2 - s)

@@ -12,13 +12,15 @@ The procedural surface is a sum of
   - a fraction of them fresh (parabolic bowl, depth/diameter ~0.2 rim to floor, raised
     rim, ejecta blanket thinning as r^-3), the rest degraded (shallow, rimless cosine bowl);
   - boulders (hemispheres) from a cumulative power law N(>D) = K D^-slope per m^2, that
-    many times denser on the ejecta of fresh craters wider than 20 m;
+    many times denser on the ejecta of fresh craters wider than 20 m, and rocks (pebbles
+    and stones down to `rock_diameter_min_m`) from the same law below them;
   - fractal roughness below the crater scale (value noise, one octave per halving of the
     wavelength, amplitude ~ wavelength^hurst);
   - a landing pad around the site, level at the lander's scale so that the trajectories'
     touchdown point (z = 0) lies on the surface: craters and the roughness longer than
     `pad_relief_wavelength_max_m` fade out over it, the shorter roughness (regolith
-    texture, cm high) stays, so the last seconds of a landing see texture; a divert's
+    texture, cm high) and rocks up to 0.2 m stay, so the last seconds of a landing see
+    texture; a divert's
     new site (`divert_sites_m`) gets the same pad;
 Evaluation takes the grid spacing: craters narrower than two spacings and roughness
 shorter than two spacings are left out, which is the level of detail (a coarse tile is
@@ -38,6 +40,7 @@ import numpy as np
 from numba import float64, njit, vectorize
 
 from ..defaults import section
+from .populations import hemispheres_m, power_law_count, power_law_diameter, size_octaves
 from .terrain_kernels import (
     as_regular_grid,
     features_in_cells,
@@ -72,6 +75,7 @@ class TerrainParams:
     boulder_diameter_min_m: float = _TERRAIN["boulder_diameter_min_m"]
     boulder_diameter_max_m: float = _TERRAIN["boulder_diameter_max_m"]
     boulder_ejecta_factor: float = _TERRAIN["boulder_ejecta_factor"]
+    rock_diameter_min_m: float = _TERRAIN["rock_diameter_min_m"]
     # Sites diverts re-target to, (x, y) m: each gets a pad as the site's (the render
     # settings add a trajectory's; not a config key).
     divert_sites_m: tuple = ()
@@ -84,6 +88,8 @@ class TerrainParams:
             raise ValueError(f"terrain.fresh_fraction: expected 0..1, got {self.fresh_fraction}")
         if not 0 < self.boulder_diameter_min_m <= self.boulder_diameter_max_m:
             raise ValueError("terrain.boulder_diameter_min_m/max_m: expected 0 < min <= max")
+        if not 0 < self.rock_diameter_min_m <= self.boulder_diameter_min_m:
+            raise ValueError("terrain.rock_diameter_min_m: expected 0 < rock_diameter_min_m <= boulder_diameter_min_m")
 
 
 class Terrain(Protocol):
@@ -99,29 +105,11 @@ class Terrain(Protocol):
 EJECTA_EXTENT = 3.0  # ejecta reach 3 crater radii; beyond, the crater leaves the surface alone
 BOULDER_SOURCE_CRATER_M = 20.0  # fresh craters at least this wide throw boulders onto their ejecta
 BOULDER_STREAM = 100_000  # random streams of the boulders (craters use 0 .. 8 x octaves)
+ROCK_STREAM = 200_000  # and of the rocks below them
+# Rocks at most this wide stay on the landing pad: hemispheres at most 10 cm high, the
+# pad's own relief (its roughness reaches 11 cm); wider ones fade out with the craters.
+PAD_ROCK_DIAMETER_MAX_M = 0.2
 DEGRADED_EXTENT = 1.3
-
-
-def size_octaves(d_min_m: float, d_max_m: float) -> list[tuple[float, float]]:
-    """[d_lo, d_hi) size bins doubling from d_min up to d_max (at least one bin)."""
-    n = max(int(np.ceil(np.log2(d_max_m / d_min_m))), 1)
-    return [(d_lo, min(2 * d_lo, d_max_m)) for d_lo in d_min_m * 2.0 ** np.arange(n)]
-
-
-def power_law_count(density_k: float, slope: float, d_lo: float, d_hi: float) -> float:
-    """Features per m^2 with d_lo <= D < d_hi under the cumulative law N(>D) = K D^-slope."""
-    return density_k * (d_lo**-slope - d_hi**-slope)
-
-
-def power_law_diameter(w: np.ndarray, slope: float, d_lo: float, d_hi: float) -> np.ndarray:
-    """Diameters from uniforms w, the power law restricted to [d_lo, d_hi) (inverse transform)."""
-    return (d_lo**-slope - w * (d_lo**-slope - d_hi**-slope)) ** (-1.0 / slope)
-
-
-def boulder_profile(rho: np.ndarray, radius_m: float) -> np.ndarray:
-    """A boulder as a hemisphere of `radius_m` on the surface: radius sqrt(1 - rho^2) up to
-    rho = 1, 0 beyond."""
-    return radius_m * np.sqrt(np.clip(1.0 - np.asarray(rho) ** 2, 0.0, None))
 
 
 def _fresh_crater(rho, depth_m, rim_m):
@@ -187,6 +175,10 @@ class ProceduralTerrain:
         self.params = params
         self.crater_octaves = size_octaves(params.crater_diameter_min_m, params.crater_diameter_max_m)
         self.boulder_octaves = size_octaves(params.boulder_diameter_min_m, params.boulder_diameter_max_m)
+        # The boulders' law below them (pebbles and small rocks), in octaves of their own so
+        # that the boulders stay where they were.
+        rocks = params.rock_diameter_min_m < params.boulder_diameter_min_m
+        self.rock_octaves = size_octaves(params.rock_diameter_min_m, params.boulder_diameter_min_m) if rocks else []
 
     def identity(self) -> dict:
         """What the heights depend on (the tile cache's key): the parameters, seed included."""
@@ -246,8 +238,18 @@ class ProceduralTerrain:
         box. Candidates are drawn at `boulder_ejecta_factor` times the background density
         and thinned back to it, except on the ejecta (1-3 radii) of fresh craters of at
         least BOULDER_SOURCE_CRATER_M, where all stay."""
+        return self._stones_in(self.boulder_octaves, BOULDER_STREAM, x_range, y_range, min_diameter_m)
+
+    def rocks_in(
+        self, x_range: tuple[float, float], y_range: tuple[float, float], min_diameter_m: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(x, y, diameter) of every rock (rock_diameter_min_m .. boulder_diameter_min_m,
+        diameter >= min_diameter_m) reaching into the box: the boulders' law and placement."""
+        return self._stones_in(self.rock_octaves, ROCK_STREAM, x_range, y_range, min_diameter_m)
+
+    def _stones_in(self, octaves, stream, x_range, y_range, min_diameter_m):
         p = self.params
-        if p.boulder_density_k <= 0 or min_diameter_m >= p.boulder_diameter_max_m:
+        if p.boulder_density_k <= 0 or not octaves or min_diameter_m >= octaves[-1][1]:
             return np.empty(0), np.empty(0), np.empty(0)  # none, or none resolved (coarse tiles: no crater lookup)
         sources = self.craters_in(
             (x_range[0] - p.boulder_diameter_max_m, x_range[1] + p.boulder_diameter_max_m),
@@ -257,12 +259,12 @@ class ProceduralTerrain:
         sources = [(x, y, d / 2) for x, y, d, fresh in zip(sources.x_m, sources.y_m, sources.diameter_m,
                                                           sources.fresh) if fresh]  # fmt: skip
         xs, ys, ds = [], [], []
-        for k, (d_lo, d_hi) in enumerate(self.boulder_octaves):
+        for k, (d_lo, d_hi) in enumerate(octaves):
             if d_hi < min_diameter_m or d_hi <= d_lo:
                 continue
             cell = 16.0 * d_lo
             peak = p.boulder_ejecta_factor * power_law_count(p.boulder_density_k, p.boulder_slope, d_lo, d_hi)
-            ci, cj, (u, v, w, z) = self._in_cells(BOULDER_STREAM + 8 * k, peak, cell, d_hi / 2, x_range, y_range)
+            ci, cj, (u, v, w, z) = self._in_cells(stream + 8 * k, peak, cell, d_hi / 2, x_range, y_range)
             x, y = (ci + u) * cell, (cj + v) * cell
             on_ejecta = np.zeros(len(x), bool)
             for cx, cy, radius in sources:
@@ -283,18 +285,18 @@ class ProceduralTerrain:
 
     def boulder_relief_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
         """Boulders as hemispheres (boulder_profile), those at least two spacings wide."""
-        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
-        h = np.zeros(x_m.shape)
-        if x_m.size == 0:
-            return h
-        bx, by, bd = self.boulders_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()), 2 * spacing_m)
-        flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
-        grid = as_regular_grid(x_m, y_m)
-        for cx, cy, d in zip(bx, by, bd):
-            idx = points_near(grid, flat_x, flat_y, cx, cy, d / 2)
-            rho = np.hypot(flat_x[idx] - cx, flat_y[idx] - cy) / (d / 2)
-            flat_h[idx] = np.maximum(flat_h[idx], boulder_profile(rho, d / 2))  # on top of each other: the higher
-        return flat_h.reshape(x_m.shape)
+        return hemispheres_m(x_m, y_m, lambda box_x, box_y: self.boulders_in(box_x, box_y, 2 * spacing_m))
+
+    def rock_relief_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float, pad: bool | None = None) -> np.ndarray:
+        """Rocks as hemispheres, those at least two spacings wide; `pad` True/False: only
+        those at most / wider than PAD_ROCK_DIAMETER_MAX_M (None: all)."""
+
+        def rocks(box_x, box_y):
+            x, y, d = self.rocks_in(box_x, box_y, 2 * spacing_m)
+            keep = np.ones(len(d), bool) if pad is None else (d <= PAD_ROCK_DIAMETER_MAX_M) == pad
+            return x[keep], y[keep], d[keep]
+
+        return hemispheres_m(x_m, y_m, rocks)
 
     def _craters(self, i, j, cell, d_lo, d_hi, u, v, w, z) -> Craters:
         p = self.params
@@ -346,15 +348,20 @@ class ProceduralTerrain:
         return h
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
+        textured_pad = self.params.pad_relief_wavelength_max_m > 0  # else a flat pad: no rocks either
         long = (
             self.crater_relief_m(x_m, y_m, spacing_m)
             + self.boulder_relief_m(x_m, y_m, spacing_m)
+            + self.rock_relief_m(x_m, y_m, spacing_m, pad=False if textured_pad else None)
             + self.roughness_m(x_m, y_m, spacing_m, short=False)
         )
         pad = site_pad_weight(x_m, y_m, self.params.site_radius_m)
         for site_x, site_y in self.params.divert_sites_m:
             pad = pad * site_pad_weight(x_m - site_x, y_m - site_y, self.params.site_radius_m)
-        return long * pad + self.roughness_m(x_m, y_m, spacing_m, short=True)
+        short = self.roughness_m(x_m, y_m, spacing_m, short=True)
+        if textured_pad:
+            short = short + self.rock_relief_m(x_m, y_m, spacing_m, pad=True)
+        return long * pad + short
 
 
 @njit(cache=True, nogil=True)
