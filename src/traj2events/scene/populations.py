@@ -1,9 +1,8 @@
 """Features drawn from cumulative power laws of size (craters, boulders, rocks), one size
-octave at a time, and the stones' shape: hemispheres on the surface."""
+octave at a time, the box of points they are looked up for, and the stones' shape:
+hemispheres on the surface."""
 
 from __future__ import annotations
-
-from collections.abc import Callable
 
 import numpy as np
 
@@ -33,19 +32,23 @@ def boulder_profile(rho: np.ndarray, radius_m: float) -> np.ndarray:
 
 
 def hemispheres_m(
-    x_m: np.ndarray, y_m: np.ndarray, stones_in: Callable[[tuple, tuple], tuple[np.ndarray, np.ndarray, np.ndarray]]
+    x_m: np.ndarray, y_m: np.ndarray, x_c: np.ndarray, y_c: np.ndarray, diameter_m: np.ndarray
 ) -> np.ndarray:
-    """Heights of the hemispheres `stones_in(x_range, y_range)` gives as (x, y, diameter)
-    over the points' box; where they overlap, the higher."""
-    x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    """Heights at the points (x_m, y_m), float arrays of one shape, of hemispheres centred at
+    (x_c, y_c) with diameters `diameter_m` (boulder_profile); where they overlap, the higher."""
     h = np.zeros(x_m.shape)
-    if x_m.size == 0:
-        return h
-    bx, by, bd = stones_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()))
     flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
     grid = as_regular_grid(x_m, y_m)
-    for cx, cy, d in zip(bx, by, bd):
+    for cx, cy, d in zip(x_c, y_c, diameter_m):
         idx = points_near(grid, flat_x, flat_y, cx, cy, d / 2)
         rho = np.hypot(flat_x[idx] - cx, flat_y[idx] - cy) / (d / 2)
         flat_h[idx] = np.maximum(flat_h[idx], boulder_profile(rho, d / 2))
-    return flat_h.reshape(x_m.shape)
+    return h
+
+
+def points_and_box(x_m, y_m) -> tuple[np.ndarray, np.ndarray, tuple | None]:
+    """The points as float arrays of one shape, and their bounding box ((x lo, x hi), (y lo,
+    y hi)): what a feature lookup takes (None: no points)."""
+    x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    box = None if x_m.size == 0 else ((x_m.min(), x_m.max()), (y_m.min(), y_m.max()))
+    return x_m, y_m, box

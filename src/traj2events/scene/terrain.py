@@ -40,7 +40,7 @@ import numpy as np
 from numba import float64, njit, vectorize
 
 from ..defaults import section
-from .populations import hemispheres_m, power_law_count, power_law_diameter, size_octaves
+from .populations import hemispheres_m, points_and_box, power_law_count, power_law_diameter, size_octaves
 from .terrain_kernels import (
     as_regular_grid,
     features_in_cells,
@@ -285,18 +285,24 @@ class ProceduralTerrain:
 
     def boulder_relief_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
         """Boulders as hemispheres (boulder_profile), those at least two spacings wide."""
-        return hemispheres_m(x_m, y_m, lambda box_x, box_y: self.boulders_in(box_x, box_y, 2 * spacing_m))
+        x_m, y_m, box = points_and_box(x_m, y_m)
+        if box is None:
+            return np.zeros(x_m.shape)
+        return hemispheres_m(x_m, y_m, *self.boulders_in(*box, 2 * spacing_m))
 
-    def rock_relief_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float, pad: bool | None = None) -> np.ndarray:
-        """Rocks as hemispheres, those at least two spacings wide; `pad` True/False: only
-        those at most / wider than PAD_ROCK_DIAMETER_MAX_M (None: all)."""
-
-        def rocks(box_x, box_y):
-            x, y, d = self.rocks_in(box_x, box_y, 2 * spacing_m)
-            keep = np.ones(len(d), bool) if pad is None else (d <= PAD_ROCK_DIAMETER_MAX_M) == pad
-            return x[keep], y[keep], d[keep]
-
-        return hemispheres_m(x_m, y_m, rocks)
+    def rock_relief_m(
+        self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float, keep_on_pad: bool = True
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Rocks as hemispheres, those at least two spacings wide, in two parts: those that
+        stay on the landing pad (at most PAD_ROCK_DIAMETER_MAX_M wide; none unless
+        `keep_on_pad`), and the others."""
+        x_m, y_m, box = points_and_box(x_m, y_m)
+        if box is None:
+            return np.zeros(x_m.shape), np.zeros(x_m.shape)
+        x, y, d = self.rocks_in(*box, 2 * spacing_m)
+        stays = (d <= PAD_ROCK_DIAMETER_MAX_M) & keep_on_pad
+        on_pad = hemispheres_m(x_m, y_m, x[stays], y[stays], d[stays])
+        return on_pad, hemispheres_m(x_m, y_m, x[~stays], y[~stays], d[~stays])
 
     def _craters(self, i, j, cell, d_lo, d_hi, u, v, w, z) -> Craters:
         p = self.params
@@ -309,11 +315,11 @@ class ProceduralTerrain:
         return Craters((i + u) * cell, (j + v) * cell, diameter, fresh, depth, rim)
 
     def crater_relief_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
-        x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+        x_m, y_m, box = points_and_box(x_m, y_m)
         h = np.zeros(x_m.shape)
-        if x_m.size == 0:
+        if box is None:
             return h
-        craters = self.craters_in((x_m.min(), x_m.max()), (y_m.min(), y_m.max()), min_diameter_m=2 * spacing_m)
+        craters = self.craters_in(*box, min_diameter_m=2 * spacing_m)
         flat_x, flat_y, flat_h = x_m.ravel(), y_m.ravel(), h.ravel()
         grid = as_regular_grid(x_m, y_m)
         if grid is not None:  # the tiles' case: one compiled pass over each crater's sub-block
@@ -349,19 +355,17 @@ class ProceduralTerrain:
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float) -> np.ndarray:
         textured_pad = self.params.pad_relief_wavelength_max_m > 0  # else a flat pad: no rocks either
+        pad_rocks, rocks = self.rock_relief_m(x_m, y_m, spacing_m, keep_on_pad=textured_pad)
         long = (
             self.crater_relief_m(x_m, y_m, spacing_m)
             + self.boulder_relief_m(x_m, y_m, spacing_m)
-            + self.rock_relief_m(x_m, y_m, spacing_m, pad=False if textured_pad else None)
+            + rocks
             + self.roughness_m(x_m, y_m, spacing_m, short=False)
         )
         pad = site_pad_weight(x_m, y_m, self.params.site_radius_m)
         for site_x, site_y in self.params.divert_sites_m:
             pad = pad * site_pad_weight(x_m - site_x, y_m - site_y, self.params.site_radius_m)
-        short = self.roughness_m(x_m, y_m, spacing_m, short=True)
-        if textured_pad:
-            short = short + self.rock_relief_m(x_m, y_m, spacing_m, pad=True)
-        return long * pad + short
+        return long * pad + (self.roughness_m(x_m, y_m, spacing_m, short=True) + pad_rocks)
 
 
 @njit(cache=True, nogil=True)

@@ -347,13 +347,11 @@ class TileSet:
         quadtree's end (`min_spacing_m`: the finest geometry) the levels go on: the terrain
         resolves its roughness down to two texels there too, so that the last seconds of a
         flight see detail down to their pixels, not the finest tile's relief magnified."""
+        if levels < 1:
+            raise ValueError(f"shading texture: expected 1 or more levels finer than the tile, got {levels}")
         level = key[0]
-        tile = self.tile(key)
         n = self.lod.cells * 2**levels
-        if levels == 0:
-            out = np.concatenate([tile.normals[: (n + 1) ** 2], tile.lit[: (n + 1) ** 2, None]], axis=1)
-            return out.reshape(n + 1, n + 1, 4).astype(np.float32)
-        origin, field = self._origin(key), tile.shadow
+        origin, field = self._origin(key), self.tile(key).shadow
         for down in range(1, levels + 1):
             x, y, lo_x, lo_y = self._extended_axes(level + down, origin, self.lod.cells * 2**down)
             xx, yy = np.meshgrid(x, y, indexing="ij")
