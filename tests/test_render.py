@@ -672,7 +672,12 @@ def test_a_magnified_tiles_quarters_draw_what_its_whole_finer_texture_draws(text
         for levels, px in ((1, 1e-6), (2, 0.0))
     )  # fmt: skip
     assert np.array_equal(quartered.depth_m, whole.depth_m) and (whole.depth_m > 0).all()
-    np.testing.assert_allclose(quartered.radiance, whole.radiance, rtol=1e-4, atol=1e-4 * whole.radiance.max())
+    apart = ~np.isclose(quartered.radiance, whole.radiance, rtol=1e-4, atol=1e-4 * whole.radiance.max())
+    # llvmpipe: none apart. A GPU weighs texels with 8-bit fractions (1/256), so a last-bit
+    # difference in a texel coordinate moves a pixel by up to 1/512 of the texels' contrast:
+    # on an H200 (EGL) 2 pixels in 2304, by 0.0025 (8e-4 relative).
+    assert apart.sum() <= (0.005 * apart.size if BACKEND == "egl" else 0)
+    np.testing.assert_allclose(quartered.radiance, whole.radiance, atol=whole.radiance.max() / 512)
 
 
 def test_tiles_whose_texels_the_camera_magnifies_take_the_finer_texture_and_give_it_back(monkeypatch):

@@ -56,8 +56,10 @@ def test_flat_ground_seen_obliquely_is_the_same_supersampled(distortion):
     assert four.radiance.shape == four.depth_m.shape == (40, 48) and four.radiance.dtype == np.float32
     assert (one.depth_m > 0).all() and (four.depth_m > 0).all()
     # Measured: depth 2e-7 apart (the lens's resampling 1.2e-5), where the samples' mean
-    # depth would be 2.2e-5 (4.3e-5) apart; radiance 0.8e-4 (1.1e-4).
-    depth_rtol = 2e-6 if distortion.is_pinhole else 2.5e-5
+    # depth would be 2.2e-5 (4.3e-5) apart; radiance 0.8e-4 (1.1e-4). A GPU rasterises
+    # depth at its own precision: 2.7e-5 apart on an H200 (EGL), so there the mean-inverse
+    # law rests on test_a_planes_depth_comes_back_at_each_pixels_centre.
+    depth_rtol = 5e-5 if BACKEND == "egl" else 2e-6 if distortion.is_pinhole else 2.5e-5
     np.testing.assert_allclose(four.depth_m, one.depth_m, rtol=depth_rtol)
     np.testing.assert_allclose(four.radiance, one.radiance, rtol=5e-4)
 
