@@ -98,17 +98,17 @@ def test_adaptive_timing_plans_the_measured_extra_frames():
 
 
 def test_the_paper_plan_is_what_its_commands_measured():
-    # bench/workflow_cost.py on the paper config's braking and descent clips: events.h5
-    # 1.44 MB per 1024^2 frame (4.79 TB for the config), 256 core-hours (two runs, 2026-11-27).
+    # bench/flight_events.py over whole flights of the paper config: events.h5 2.40 MB per
+    # 1024^2 frame, 8.0 TB (2026-11-28); bench/workflow_cost.py: 256 core-hours (2026-11-27).
     plan = dataset_plan(load_config(ROOT / "config" / "paper.yaml"))
-    assert plan.disk_bytes["events.h5"] == pytest.approx(4.79e12, rel=0.1)
+    assert plan.disk_bytes["events.h5"] == pytest.approx(8.0e12, rel=0.1)
     assert 220 < plan.total_core_hours < 290
 
 
 def test_events_grow_faster_than_the_pixels_as_measured():
-    # 0.76 bytes per pixel over the default dataset at 128^2, 1.37 at 1024^2 (paper config clips)
-    assert events_bytes_per_px(128) == pytest.approx(0.76)
-    assert events_bytes_per_px(1024) == pytest.approx(1.37, rel=0.03)
+    # 0.91 bytes per pixel over the default dataset at 128^2, 2.29 over the paper config's whole flights
+    assert events_bytes_per_px(128) == pytest.approx(0.91)
+    assert events_bytes_per_px(1024) == pytest.approx(2.29, rel=0.03)
 
 
 def test_every_per_trajectory_rule_is_in_the_slurm_profiles_trajectory_group():
