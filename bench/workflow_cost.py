@@ -13,8 +13,9 @@ then has enough of them to fit) and
 its children's included (the encoders), is fitted as a + b frames over the clip lengths:
 b is the cost per frame, a the cost per job (start-up, tile building). Every command runs
 once untimed on the first clip first, so that no timed run compiles kernels. Disk per frame of
-each output comes from the longest clip. Then the config's dataset (`traj2events.plan`'s
-frame, field and trajectory counts, t_f = tf_guess_s) at those rates: CPU core-hours per
+each output comes from the longest clip: mid-flight, where events.h5 per frame is 0.37-1.15x
+a whole flight's mean (bench/flight_events.py measures whole flights). Then the config's
+dataset (`traj2events.plan`'s frame, field and trajectory counts, t_f = tf_guess_s) at those rates: CPU core-hours per
 stage and in all, and disk per output kind. Rates are averaged over the trajectories
 given. The trajectory solves are left out (~0.02 core-hours for 500, docs/performance.md).
 The header names the OpenGL backend the render command takes (`render.backend`); with
