@@ -602,7 +602,7 @@ def test_invalid_config_stops_before_any_job(tmp_path):
     "change, message",
     [
         ({"render": {"tile_cache": "/proc/nonexistent/cache"}}, "render.tile_cache: cannot create a file in /proc"),
-        ({"camera": {"width": 8192, "height": 8192}}, "the dataset does not fit: ~"),  # 46 TB planned (< 50)
+        ({"camera": {"width": 6144, "height": 6144}}, "the dataset does not fit: ~"),  # 32 TB planned (< 50)
     ],
 )
 def test_what_the_working_directory_cannot_give_stops_before_any_job(tmp_path, change, message):
