@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT / "src"))
 
 from traj2events.config import load_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.plan import COSTS, job_resources, render_s_per_frame  # noqa: E402
+from traj2events.plan import COSTS, events_s_per_frame, job_resources, render_s_per_frame  # noqa: E402
 
 PER_FRAME_RULES = ("render", "events")
 
@@ -77,7 +77,7 @@ def main() -> None:
             plan = (
                 render_s_per_frame(config, pixels)
                 if rule == "render"
-                else COSTS["cpu_s"]["events_per_frame"][0] + COSTS["cpu_s"]["events_per_frame"][1] * pixels
+                else events_s_per_frame(config["camera"]["width"], pixels)
             )
             measured = statistics.median(rates)
             per_frame = f"{measured:.4f} / {plan:.4f} ({measured / plan:.2f}x)"

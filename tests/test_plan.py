@@ -4,7 +4,15 @@ import pytest
 
 from conftest import ROOT
 from traj2events.config import ConfigError, load_config, resolve_config
-from traj2events.plan import BYTES_PER_PX, DRAWN_MB_PER_PX, RENDER_S, dataset_plan, events_bytes_per_px, job_resources
+from traj2events.plan import (
+    BYTES_PER_PX,
+    DRAWN_MB_PER_PX,
+    RENDER_S,
+    dataset_plan,
+    events_bytes_per_px,
+    events_s_per_frame,
+    job_resources,
+)
 
 ONE = {"scenarios": {"descent": {"n_trajectories": 3, "tf_guess_s": 10.0}}}
 
@@ -103,6 +111,14 @@ def test_the_paper_plan_is_what_its_commands_measured():
     plan = dataset_plan(load_config(ROOT / "config" / "paper.yaml"))
     assert plan.disk_bytes["events.h5"] == pytest.approx(8.0e12, rel=0.1)
     assert 220 < plan.total_core_hours < 290
+
+
+def test_the_events_commands_cost_follows_its_events_as_measured():
+    # Whole paper-config flights: 67 core-hours over 3 334 500 planned 1024^2 frames
+    # (bench/flight_events.py); the default dataset's events jobs at 128^2: 1.3 ms per frame
+    # (their benchmark files, bench/job_costs.py), both 2026-11-28.
+    assert events_s_per_frame(1024, 1024**2) == pytest.approx(67 * 3600 / 3_334_500, rel=0.15)
+    assert events_s_per_frame(128, 128**2) == pytest.approx(0.0013, rel=0.15)
 
 
 def test_events_grow_faster_than_the_pixels_as_measured():

@@ -21,7 +21,8 @@ EXPORT_BYTES_PER_EVENTS_BYTE = COSTS["export_bytes_per_events_byte"]
 IMU_BYTES_PER_SAMPLE = COSTS["imu_bytes_per_sample"]
 RENDER_S = tuple(COSTS["cpu_s"]["render_per_frame"])  # (per frame, per pixel), encoders included
 PREVIEW_S_PER_PX = COSTS["cpu_s"]["preview_per_px"]  # of RENDER_S: the preview's encoder
-EVENTS_S = tuple(COSTS["cpu_s"]["events_per_frame"])  # (per frame, per pixel): decoding, emulation, writing
+EVENTS_S = tuple(COSTS["cpu_s"]["events_per_frame"])  # (per frame, per pixel): decoding, the pixels' pass
+EVENTS_S_PER_BYTE = COSTS["cpu_s"]["events_per_byte"]  # per byte of events.h5: emitting, ordering, writing
 FIELD_S_PER_PX = COSTS["cpu_s"]["motion_field_per_px"]
 MANOEUVRE_S = COSTS["manoeuvre_s"]  # seconds of flight a hover (beyond its hold) or a divert adds
 STAR_S = COSTS["cpu_s"]["star_in_view"]  # per star a frame projects (scene.stars.stars_in_view)
@@ -115,6 +116,12 @@ def events_bytes_per_px(width: int) -> float:
     return a * (width / 128.0) ** q
 
 
+def events_s_per_frame(width: int, pixels: int) -> float:
+    """One core's seconds of the events command per frame: a fixed part, the pixels' pass,
+    and the events it emits (as many as events.h5's bytes per frame say)."""
+    return EVENTS_S[0] + EVENTS_S[1] * pixels + EVENTS_S_PER_BYTE * events_bytes_per_px(width) * pixels
+
+
 def rendered_per_frame(config: dict) -> float:
     """Frames rendered per camera frame: 1 with fixed timing; with adaptive timing, the
     measured extra frames 1 + a (width / 128)^q bound^-p (the bound: max_log_change, or
@@ -167,7 +174,7 @@ def dataset_plan(config: dict) -> Plan:
         disk["frames.h5"] = BYTES_PER_PX["frames.h5"] * px_frames * rendered
     hours = {
         "render": rendered * frames * render_s_per_frame(config, pixels) / 3600,
-        "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels) / 3600,
+        "events": rendered * frames * events_s_per_frame(camera["width"], pixels) / 3600,
         "motion field": px_fields * FIELD_S_PER_PX / 3600,
     }
     return Plan(trajectories, frames, max(per_trajectory), fields, disk,
@@ -209,7 +216,7 @@ def job_resources(config: dict, stage: str, scenario: str | None, threads: int =
     rendered = rendered_per_frame(config)
     seconds = {
         "render": rendered * frames * render_s_per_frame(config, pixels),
-        "events": rendered * frames * (EVENTS_S[0] + EVENTS_S[1] * pixels),
+        "events": rendered * frames * events_s_per_frame(camera["width"], pixels),
         "motion_field": pixels * fields * FIELD_S_PER_PX,
     }.get(stage, 60.0)
     if stage == "sample_trajectories":
