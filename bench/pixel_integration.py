@@ -14,7 +14,10 @@ radiance (render.supersample, with either filter). The reference is --reference 
 render seconds per frame (wall, one core: llvmpipe with LP_NUM_THREADS=1; the best of
 --repeats rounds, alternated variant by variant), events against the reference's, the
 per-pixel event-count error (sum |n - n_ref| / sum n_ref) and the mean |ln I - ln I_ref| of
-the emulator's input (lin-log, as the pixel sees it). With --regions, also each variant's
+the emulator's input (lin-log, as the pixel sees it). Then the Pareto front of render time
+against the per-pixel count error: per window, and over all windows (each variant's time
+against point sampling's, geometric mean, and its mean count error), the config's default
+(render.lod.texture_filter, render.supersample) marked. With --regions, also each variant's
 events against the reference's per kind of pixel (`regions`): sky and horizon, depth edges,
 shadow, shadow edges, lit ground. --magnified-texel-px sets render.lod.magnified_texel_px
 (0: no finer texels where the camera magnifies them), for the same windows with and without
@@ -99,6 +102,29 @@ def emulate(frames: np.ndarray, times: np.ndarray, scale: float) -> np.ndarray:
     return np.bincount(events["y"].astype(np.int64) * w + events["x"], minlength=h * w).reshape(h, w)
 
 
+def pareto_front(points: dict[str, tuple[float, float]]) -> list[str]:
+    """The names whose (cost, error) no other point beats in one and matches or beats in the
+    other (equal points all stay), cheapest first."""
+    front = [
+        name
+        for name, (cost, error) in points.items()
+        if not any(c <= cost and e <= error and (c, e) != (cost, error) for c, e in points.values())
+    ]
+    return sorted(front, key=lambda name: points[name])
+
+
+def print_front(label: str, points: dict[str, tuple[float, float]], default: str, cost_unit: str) -> None:
+    front = pareto_front(points)
+    shown = ", ".join(f"{n} ({points[n][0]:.4g} {cost_unit}, {points[n][1]:.2f})" for n in front)
+    if default not in points:
+        where = "not run"
+    elif default in front:
+        where = "on the front"
+    else:
+        where = f"off it ({points[default][0]:.4g} {cost_unit}, {points[default][1]:.2f})"
+    print(f"#   {label}: {shown}; the default, {default}, {where}", flush=True)
+
+
 def config_note(magnified_texel_px: float | None) -> str:
     if magnified_texel_px is None:
         return "the default's"
@@ -127,12 +153,17 @@ def main() -> None:
     print("| window | variant | s per frame | vs point | events | vs reference | per-pixel count error "
           "| mean abs d ln I |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|")
+    fronts: dict[str, dict[str, tuple[float, float]]] = {}  # window -> variant -> (s per frame, count error)
+    default = None
     for path in args.trajectories:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
         lod = {} if args.magnified_texel_px is None else {"magnified_texel_px": args.magnified_texel_px}
         config = resolve_config({"camera": {"width": args.size, "height": args.size}, "render": {"lod": lod}})
         settings = RenderSettings.from_config(config, scenario)
+        render = config["render"]
+        default = render["lod"]["texture_filter"] + (f", {render['supersample']}x{render['supersample']}"
+                                                     if render["supersample"] > 1 else "")  # fmt: skip
         camera = settings.build()[0]
         scale = dn_per_radiance(SensorParams.from_config(config["events"]["sensor"]))
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
@@ -158,6 +189,7 @@ def main() -> None:
                 print(f"| {scenario} {window} | {name} | {seconds:.4f} | {seconds / point_s:.2f}x | {counts.sum()} "
                       f"| {counts.sum() / max(ref_counts.sum(), 1):.2f}x | {count_error:.2f} | {log_error:.4f} |",
                       flush=True)  # fmt: skip
+                fronts.setdefault(f"{scenario} {window}", {})[name] = (seconds, float(count_error))
             print(f"| {scenario} {window} | reference {args.reference}x{args.reference} | | | {ref_counts.sum()} "
                   "| 1.00x | 0 | 0 |", flush=True)  # fmt: skip
             if args.regions:  # where each variant's events fall, against the reference's
@@ -167,6 +199,19 @@ def main() -> None:
                     ratios = {r: counts[m].sum() / max(ref_counts[m].sum(), 1) for r, m in masks.items()}
                     split = ", ".join(f"{r} ({masks[r].mean():.0%} of pixels) {x:.2f}x" for r, x in ratios.items())
                     print(f"#   {scenario} {window}, {name}: {split}", flush=True)
+    print("# Pareto front, render time against the per-pixel event-count error, cheapest first:")
+    for window, points in fronts.items():
+        print_front(window, points, default, "s")
+    if "point" in next(iter(fronts.values()), {}):  # over all windows: time as a multiple of point sampling's
+        names = [n for n in next(iter(fronts.values())) if all(n in p for p in fronts.values())]
+        pooled = {
+            n: (
+                float(np.exp(np.mean([np.log(p[n][0] / p["point"][0]) for p in fronts.values()]))),
+                float(np.mean([p[n][1] for p in fronts.values()])),
+            )
+            for n in names
+        }
+        print_front(f"all {len(fronts)} windows (x point sampling's time)", pooled, default, "x")
 
 
 if __name__ == "__main__":
