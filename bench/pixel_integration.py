@@ -1,7 +1,7 @@
 """Benchmark: pixels that integrate their area, run time against error.
 
   python bench/pixel_integration.py results/braking/0000/trajectory.h5 results/descent/0000/trajectory.h5 \\
-      [--size 128] [--reference 16] [--frames 31] [--fps 100] [--repeats 2]
+      [--size 128] [--reference 16] [--frames 31] [--fps 100] [--repeats 2] [--windows "last second"]
 
 Windows of each trajectory (mid-flight from t_f / 2; the last second from t_f - 1 s),
 --frames frames at --fps, rendered with the tiles the camera's own size selects (the same
@@ -59,6 +59,8 @@ VARIANTS = [
     ("trilinear, 2x2", "trilinear", 2),  # render.supersample: 2 with the default filter
     ("trilinear, 4x4", "trilinear", 4),
 ]
+
+WINDOWS = ("mid-flight", "last second")  # from t_f / 2, and from t_f - 1 s
 
 
 def render_window(settings, camera, states, times, texture_filter: str, samples: int, point_sun: bool = False):
@@ -140,6 +142,7 @@ def main() -> None:
     parser.add_argument("--fps", type=float, default=100.0)
     parser.add_argument("--repeats", type=int, default=2, help="rounds of the timed variants (best kept)")
     parser.add_argument("--variants", nargs="+", help="names of VARIANTS to run (default: all)")
+    parser.add_argument("--windows", nargs="+", choices=WINDOWS, default=WINDOWS, help="which windows (default: both)")
     parser.add_argument("--regions", action="store_true", help="also each variant's events per kind of pixel")
     parser.add_argument("--point-sun", action="store_true", help="shadows of a point Sun, without penumbrae")
     parser.add_argument("--magnified-texel-px", type=float, help="render.lod.magnified_texel_px (0: no finer texels)")
@@ -168,7 +171,7 @@ def main() -> None:
         scale = dn_per_radiance(SensorParams.from_config(config["events"]["sensor"]))
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
-        for window, t0 in (("mid-flight", tf / 2), ("last second", tf - 1.0)):
+        for window, t0 in ((w, {"mid-flight": tf / 2, "last second": tf - 1.0}[w]) for w in args.windows):
             times = t0 + np.arange(args.frames) / args.fps
             reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference,
                                                           args.point_sun)  # fmt: skip
