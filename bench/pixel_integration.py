@@ -21,7 +21,10 @@ against point sampling's, geometric mean, and its mean count error), the config'
 events against the reference's per kind of pixel (`regions`): sky and horizon, depth edges,
 shadow, shadow edges, lit ground. --magnified-texel-px sets render.lod.magnified_texel_px
 (0: no finer texels where the camera magnifies them), for the same windows with and without
-them; --point-sun draws shadows without penumbrae.
+them; --point-sun draws shadows without penumbrae. --reference-lod-scale F draws the
+reference with the tiles and finer texels of a camera F times the size (a finer scene),
+and prints the camera's own tiles' reference against it: how far the default level of
+detail stands from a finer one.
 """
 
 from __future__ import annotations
@@ -63,15 +66,19 @@ VARIANTS = [
 WINDOWS = ("mid-flight", "last second")  # from t_f / 2, and from t_f - 1 s
 
 
-def render_window(settings, camera, states, times, texture_filter: str, samples: int, point_sun: bool = False):
+def render_window(
+    settings, camera, states, times, texture_filter: str, samples: int, point_sun: bool = False, lod_scale: int = 1
+):
     """(frames (n, h, w) float32 radiance, seconds per frame, the first frame's depth) of one
-    variant; `point_sun`: shadows of a point Sun (no penumbrae)."""
+    variant; `point_sun`: shadows of a point Sun (no penumbrae); `lod_scale`: the tiles and
+    finer texels a camera with lod_scale x lod_scale times the pixels would draw (a finer scene)."""
     _, tiles, sun, reflectance = settings.build()
     if point_sun:
         tiles.sun_radius_rad = 0.0  # before any tile is built
     frames = []
+    lod = {} if lod_scale == 1 else {"lod_camera": camera.scaled(lod_scale).pinhole_cover()}
     with sensor_renderer(
-        tiles, camera, sun, reflectance, texture_filter=texture_filter, supersample=samples
+        tiles, camera, sun, reflectance, texture_filter=texture_filter, supersample=samples, **lod
     ) as renderer:
         poses = [camera.pose(s) for s in states.states(times)]
         depth_m = renderer.render(poses[0]).depth_m  # tiles built and uploaded before the clock starts
@@ -143,6 +150,9 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=2, help="rounds of the timed variants (best kept)")
     parser.add_argument("--variants", nargs="+", help="names of VARIANTS to run (default: all)")
     parser.add_argument("--windows", nargs="+", choices=WINDOWS, default=WINDOWS, help="which windows (default: both)")
+    parser.add_argument("--reference-lod-scale", type=int, default=1, metavar="F",
+                        help="the reference drawn with the tiles of a camera F times the size (the level of detail's "
+                        "convergence); the same tiles' reference is then printed against it too")  # fmt: skip
     parser.add_argument("--regions", action="store_true", help="also each variant's events per kind of pixel")
     parser.add_argument("--point-sun", action="store_true", help="shadows of a point Sun, without penumbrae")
     parser.add_argument("--magnified-texel-px", type=float, help="render.lod.magnified_texel_px (0: no finer texels)")
@@ -174,8 +184,15 @@ def main() -> None:
         for window, t0 in ((w, {"mid-flight": tf / 2, "last second": tf - 1.0}[w]) for w in args.windows):
             times = t0 + np.arange(args.frames) / args.fps
             reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference,
-                                                          args.point_sun)  # fmt: skip
+                                                          args.point_sun, args.reference_lod_scale)  # fmt: skip
             ref_counts = emulate(reference, times, scale)
+            if args.reference_lod_scale > 1:  # the default tiles' own reference, against the finer scene's
+                same = emulate(render_window(settings, camera, states, times, "point", args.reference,
+                                             args.point_sun)[0], times, scale)  # fmt: skip
+                n_ref = max(ref_counts.sum(), 1)
+                print(f"| {scenario} {window} | reference {args.reference}x{args.reference}, the camera's own tiles "
+                      f"| | | {same.sum()} | {same.sum() / n_ref:.2f}x | {np.abs(same - ref_counts).sum() / n_ref:.2f} "
+                      "| |", flush=True)  # fmt: skip
             ref_log = log_intensity_8bit(reference * scale)
             results = {}
             for _ in range(args.repeats):  # alternated: every variant once per round
@@ -193,8 +210,9 @@ def main() -> None:
                       f"| {counts.sum() / max(ref_counts.sum(), 1):.2f}x | {count_error:.2f} | {log_error:.4f} |",
                       flush=True)  # fmt: skip
                 fronts.setdefault(f"{scenario} {window}", {})[name] = (seconds, float(count_error))
-            print(f"| {scenario} {window} | reference {args.reference}x{args.reference} | | | {ref_counts.sum()} "
-                  "| 1.00x | 0 | 0 |", flush=True)  # fmt: skip
+            tiles_note = f", tiles of {args.reference_lod_scale}x the size" if args.reference_lod_scale > 1 else ""
+            print(f"| {scenario} {window} | reference {args.reference}x{args.reference}{tiles_note} | | "
+                  f"| {ref_counts.sum()} | 1.00x | 0 | 0 |", flush=True)  # fmt: skip
             if args.regions:  # where each variant's events fall, against the reference's
                 masks = regions(reference[0] * scale, reference_depth)
                 for name, (frames, _) in results.items():
