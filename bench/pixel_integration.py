@@ -24,7 +24,7 @@ shadow, shadow edges, lit ground. --magnified-texel-px sets render.lod.magnified
 them; --point-sun draws shadows without penumbrae. --reference-lod-scale F draws the
 reference with the tiles and finer texels of a camera F times the size (a finer scene),
 and prints the camera's own tiles' reference against it: how far the default level of
-detail stands from a finer one.
+detail stands from a finer one (with --regions, also per kind of pixel).
 """
 
 from __future__ import annotations
@@ -186,6 +186,7 @@ def main() -> None:
             reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference,
                                                           args.point_sun, args.reference_lod_scale)  # fmt: skip
             ref_counts = emulate(reference, times, scale)
+            same = None
             if args.reference_lod_scale > 1:  # the default tiles' own reference, against the finer scene's
                 same = emulate(render_window(settings, camera, states, times, "point", args.reference,
                                              args.point_sun)[0], times, scale)  # fmt: skip
@@ -215,8 +216,10 @@ def main() -> None:
                   f"| {ref_counts.sum()} | 1.00x | 0 | 0 |", flush=True)  # fmt: skip
             if args.regions:  # where each variant's events fall, against the reference's
                 masks = regions(reference[0] * scale, reference_depth)
-                for name, (frames, _) in results.items():
-                    counts = emulate(frames, times, scale)
+                counted = {name: emulate(frames, times, scale) for name, (frames, _) in results.items()}
+                if same is not None:
+                    counted["reference, the camera's own tiles"] = same
+                for name, counts in counted.items():
                     ratios = {r: counts[m].sum() / max(ref_counts[m].sum(), 1) for r, m in masks.items()}
                     split = ", ".join(f"{r} ({masks[r].mean():.0%} of pixels) {x:.2f}x" for r, x in ratios.items())
                     print(f"#   {scenario} {window}, {name}: {split}", flush=True)
