@@ -1,5 +1,6 @@
 """The planned size printed before a run, and the refusal of a dataset beyond reach."""
 
+import numpy as np
 import pytest
 
 from conftest import ROOT
@@ -7,6 +8,7 @@ from traj2events.config import ConfigError, load_config, resolve_config
 from traj2events.plan import (
     BYTES_PER_PX,
     DRAWN_MB_PER_PX,
+    MEMORY_MB,
     RENDER_S,
     dataset_plan,
     events_bytes_per_px,
@@ -171,3 +173,25 @@ def test_faint_stars_are_planned_as_the_frames_they_cost():
     extra = render_s_per_frame(config, pixels) - base
     assert extra == pytest.approx(STAR_S * (stars_in_view(12.0, camera) - stars_in_view(7.0, camera)), rel=1e-9)
     assert extra > 0.03  # at 32^2 the stars then cost more than the frame
+
+
+def test_a_render_jobs_memory_holds_its_texture_array_while_it_doubles_to_its_cap():
+    """A render job's memory is its shading texture array (docs/cluster.md). It doubles up
+    to its cap, and while it grows the old and new arrays are both held; llvmpipe (Mesa
+    22.3) stores each level in whole 64 x 64 texel blocks. With what a render process holds
+    before its first texture (349 MiB measured), the last doubling's peak is the 1746-1788
+    MiB measured over the approach flight, and the plan covers it at every image size."""
+    from traj2events.renderer import draw, footprint
+    from traj2events.renderer.shading_array import layer_limit
+
+    lod = resolve_config({})["render"]["lod"]
+    side = lod["cells"] * 2 ** lod["shading_levels"] + 1
+    limit = layer_limit(side, lod["texture_filter"], draw._SHADING_BYTES, max_layers=2048)  # llvmpipe's layers
+    before = 2 ** int(np.log2(limit - 1))  # 1, 2, 4, ... then the cap
+    padded_bytes = sum(8 * (-(-n // 64) * 64) ** 2 for n in footprint.sampled_levels(lod["texture_filter"], side))
+    peak_mib = 349 + (before + limit) * padded_bytes / 2**20
+    assert (limit, before) == (763, 512) and peak_mib == pytest.approx(1788, rel=0.03)  # the workflow's benchmark
+    assert MEMORY_MB["render"][0] >= peak_mib
+    for width in (128, 1024):
+        config = resolve_config({"camera": {"width": width, "height": width}})
+        assert peak_mib < job_resources(config, "render", "approach")["mem_mb"] < 1.5 * MEMORY_MB["render"][0]

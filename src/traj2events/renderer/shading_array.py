@@ -13,15 +13,21 @@ from ..scene.tiles import border_ring
 from . import footprint
 
 
+def layer_limit(side: int, texture_filter: str, max_bytes: int, max_layers: int) -> int:
+    """The layers of (side x side) RGBA16F texels, with every level `texture_filter`
+    samples, that `max_bytes` holds: at least 1, at most OpenGL's `max_layers`."""
+    layer_bytes = sum(8 * n**2 for n in footprint.sampled_levels(texture_filter, side))
+    return max(1, min(max_layers, max_bytes // layer_bytes))
+
+
 class ShadingArray:
     def __init__(self, gl, unit: int, side: int, texture_filter: str, max_bytes: int):
         """Layers of (side x side) texels on texture unit `unit`, sampled with
         `texture_filter` (footprint.TEXTURE_FILTERS), at most `max_bytes` in all levels."""
         self.gl, self.unit, self.side, self.texture_filter = gl, unit, side, texture_filter
         self.level_sides = footprint.sampled_levels(texture_filter, side)
-        layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
-        layer_bytes = sum(8 * n**2 for n in self.level_sides)  # RGBA16F texels, every level
-        self.layer_limit = max(1, min(layers, max_bytes // layer_bytes))
+        max_layers = int(gl.glGetIntegerv(gl.GL_MAX_ARRAY_TEXTURE_LAYERS))
+        self.layer_limit = layer_limit(side, texture_filter, max_bytes, max_layers)
         self.capacity, self.texture = 0, 0
 
     def allocate(self, layers: int) -> None:
