@@ -181,8 +181,9 @@ def main() -> None:
         scale = dn_per_radiance(SensorParams.from_config(config["events"]["sensor"]))
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
         tf = float(tr.t_nodes[-1])
-        for window, t0 in ((w, {"mid-flight": tf / 2, "last second": tf - 1.0}[w]) for w in args.windows):
-            times = t0 + np.arange(args.frames) / args.fps
+        starts = {"mid-flight": tf / 2, "last second": tf - 1.0}  # WINDOWS
+        for window in args.windows:
+            times = starts[window] + np.arange(args.frames) / args.fps
             reference, _, reference_depth = render_window(settings, camera, states, times, "point", args.reference,
                                                           args.point_sun, args.reference_lod_scale)  # fmt: skip
             ref_counts = emulate(reference, times, scale)
