@@ -204,8 +204,9 @@ def main() -> None:
                     best = min(seconds, results[name][1]) if name in results else seconds
                     results[name] = (frames, best)
             point_s = results.get(variants[0][0], (None, np.nan))[1]
+            counted = {}  # variant -> events per pixel, emulated once
             for name, (frames, seconds) in results.items():
-                counts = emulate(frames, times, scale)
+                counts = counted[name] = emulate(frames, times, scale)
                 count_error = np.abs(counts - ref_counts).sum() / max(ref_counts.sum(), 1)
                 log_error = float(np.abs(log_intensity_8bit(frames * scale) - ref_log).mean())
                 print(f"| {scenario} {window} | {name} | {seconds:.4f} | {seconds / point_s:.2f}x | {counts.sum()} "
@@ -217,7 +218,6 @@ def main() -> None:
                   f"| {ref_counts.sum()} | 1.00x | 0 | 0 |", flush=True)  # fmt: skip
             if args.regions:  # where each variant's events fall, against the reference's
                 masks = regions(reference[0] * scale, reference_depth)
-                counted = {name: emulate(frames, times, scale) for name, (frames, _) in results.items()}
                 if same is not None:
                     counted["reference, the camera's own tiles"] = same
                 for name, counts in counted.items():

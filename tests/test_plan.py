@@ -182,10 +182,10 @@ def test_a_render_jobs_memory_holds_its_texture_array_while_it_doubles_to_its_ca
     before its first texture (349 MiB measured), the last doubling's peak is the 1746-1788
     MiB measured over the approach flight, and the plan covers it at every image size."""
     from traj2events.renderer import draw, footprint
-    from traj2events.renderer.shading_array import layer_limit
+    from traj2events.renderer.shading_array import layer_limit, shading_coordinates
 
     lod = resolve_config({})["render"]["lod"]
-    side = lod["cells"] * 2 ** lod["shading_levels"] + 1
+    _, side = shading_coordinates(lod["cells"], lod["shading_levels"])
     limit = layer_limit(side, lod["texture_filter"], draw._SHADING_BYTES, max_layers=2048)  # llvmpipe's layers
     before = 2 ** int(np.log2(limit - 1))  # 1, 2, 4, ... then the cap
     padded_bytes = sum(8 * (-(-n // 64) * 64) ** 2 for n in footprint.sampled_levels(lod["texture_filter"], side))
