@@ -123,12 +123,17 @@ class Stream:
         return self.events[0]
 
 
+def pixel_polarity(ev: np.ndarray, width: int) -> np.ndarray:
+    """(n,) int64: one number per pixel and polarity of each event."""
+    return (ev["y"].astype(np.int64) * width + ev["x"]) * 2 + ev["p"]
+
+
 def matched_timing_errors_us(events: np.ndarray, reference: np.ndarray, width: int) -> np.ndarray:
     """|t - t_ref| (us) of events matched to the reference's: per pixel and polarity, the
     i-th event with the i-th (as many as both have)."""
 
     def keyed(ev):
-        group = (ev["y"].astype(np.int64) * width + ev["x"]) * 2 + ev["p"]
+        group = pixel_polarity(ev, width)
         order = np.lexsort((ev["t"], group))
         g, t = group[order], ev["t"][order]
         first = np.r_[0, np.flatnonzero(np.diff(g)) + 1]
@@ -147,20 +152,18 @@ def nearest_timing_errors_us(events: np.ndarray, reference: np.ndarray, width: i
     polarity (events with none left out): the timing error apart from missing or extra
     events, which shift every later rank `matched_timing_errors_us` pairs."""
 
-    def keyed(ev):
-        group = (ev["y"].astype(np.int64) * width + ev["x"]) * 2 + ev["p"]
-        return (group << 40) + ev["t"].astype(np.int64)  # t: whole microseconds, < 2^40
+    def keyed(ev):  # t: whole microseconds, < 2^40
+        return (pixel_polarity(ev, width) << 40) + ev["t"].astype(np.int64)
 
-    ref = np.sort(keyed(reference))
-    key = keyed(events)
+    if not len(reference):
+        return np.empty(0)
+    ref, key = np.sort(keyed(reference)), keyed(events)
     at = np.searchsorted(ref, key)
-    group = key >> 40
     best = np.full(len(key), np.inf)
     for side in (at - 1, at):  # the reference events just before and just after
-        ok = (side >= 0) & (side < len(ref))
-        same = np.zeros(len(key), bool)
-        same[ok] = (ref[side[ok]] >> 40) == group[ok]
-        best[same] = np.minimum(best[same], np.abs(ref[side[same]] - key[same]))
+        found = ref[np.clip(side, 0, len(ref) - 1)]
+        same = (side >= 0) & (side < len(ref)) & (found >> 40 == key >> 40)
+        best[same] = np.minimum(best[same], np.abs(found[same] - key[same]))
     return best[np.isfinite(best)]
 
 

@@ -89,15 +89,26 @@ def render_window(
     return np.stack(frames), seconds, depth_m
 
 
-def regions(radiance_dn: np.ndarray, depth_m: np.ndarray) -> dict[str, np.ndarray]:
-    """Pixel masks of the reference's first frame: sky and horizon (a sky sample in the
-    pixel), depth edges (depths in its 3 x 3 neighbourhood more than 10 % apart), shadow
-    (under 5 % of the median ground radiance), shadow edges (next to shadow), lit ground."""
+def silhouettes(depth_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sky and horizon, depth edges) pixel masks of a depth image (0: sky): a sky pixel in
+    the 3 x 3 neighbourhood; ground depths there more than 10 % apart. There the pixel
+    footprint's one sample per pixel fires events of its own (docs/rendering.md)."""
     from scipy.ndimage import maximum_filter, minimum_filter
 
     ground = depth_m > 0
     sky = ~ground | (minimum_filter(depth_m, 3) == 0)
     edge = (maximum_filter(depth_m, 3) > 1.1 * minimum_filter(np.where(ground, depth_m, np.inf), 3)) & ~sky
+    return sky, edge
+
+
+def regions(radiance_dn: np.ndarray, depth_m: np.ndarray) -> dict[str, np.ndarray]:
+    """Pixel masks of the reference's first frame: sky and horizon, depth edges
+    (`silhouettes`), shadow (under 5 % of the median ground radiance), shadow edges (next
+    to shadow), lit ground."""
+    from scipy.ndimage import maximum_filter
+
+    ground = depth_m > 0
+    sky, edge = silhouettes(depth_m)
     dark = (radiance_dn < 0.05 * np.median(radiance_dn[ground])) & ~sky & ~edge
     near_dark = maximum_filter(dark, 3) & ~dark & ~sky & ~edge
     return {"sky and horizon": sky, "depth edges": edge, "shadow": dark, "shadow edges": near_dark,

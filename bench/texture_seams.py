@@ -32,6 +32,7 @@ os.environ.setdefault("LP_NUM_THREADS", "1")
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 import numpy as np  # noqa: E402
+from pixel_integration import silhouettes  # noqa: E402  (bench/, beside this file)
 
 import traj2events.renderer.draw as draw  # noqa: E402
 from traj2events.config import resolve_config  # noqa: E402
@@ -67,16 +68,6 @@ def distance_shader(source_of):
         return text
 
     return source
-
-
-def inside(depth_m: np.ndarray) -> np.ndarray:
-    """Pixels whose 3 x 3 neighbourhood is all ground at depths within 10 %: not the sky
-    (cleared to 0: no distance), the horizon or a depth edge, where the footprint's one
-    sample per pixel fires events of its own (docs/rendering.md "Pixel footprint")."""
-    from scipy.ndimage import maximum_filter, minimum_filter
-
-    nearest = minimum_filter(np.where(depth_m > 0, depth_m, np.inf), 3)
-    return (minimum_filter(depth_m, 3) > 0) & (maximum_filter(depth_m, 3) <= 1.1 * nearest)
 
 
 def events_per_frame(logs_dn: list[np.ndarray], times: list[float]) -> np.ndarray:
@@ -130,14 +121,15 @@ def main() -> None:
             finally:
                 draw.shader_source = plain
             coded = np.array([f.radiance.astype(np.float64) for f in frames])
-            terrain = np.array([inside(f.depth_m) for f in frames])
+            # Not the sky (cleared to 0: no distance), the horizon or depth edges.
+            terrain = np.array([~np.logical_or(*silhouettes(f.depth_m)) for f in frames])
             seam_px = np.floor(coded / 1000.0)
             edge_px = coded - 1000.0 * seam_px
             near = {"a tile edge": terrain & (edge_px < 1.0), "a quarter seam": terrain & (seam_px < 1.0)}
+            total = {name: c.sum() for name, c in counts.items()}
+            scale = total["footprint"] / max(total["reference"], 1)  # excess beyond the frame's own ratio
             for what, mask in near.items():
                 there = {name: c[mask].sum() for name, c in counts.items()}
-                total = {name: c.sum() for name, c in counts.items()}
-                scale = total["footprint"] / max(total["reference"], 1)  # excess beyond the frame's own ratio
                 excess = (there["footprint"] - scale * there["reference"]) / max(total["footprint"], 1)
                 print(
                     f"| {scenario} {window} | {what} | {mask.mean():.1%} | {there['footprint']:.0f} / "
