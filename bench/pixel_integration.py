@@ -8,8 +8,9 @@ Windows of each trajectory (mid-flight from t_f / 2; the last second from t_f - 
 scene for every variant), through the sensor model, emulated with the clean preset (no
 noise: every event is the scene's or the sampling's). Variants: the shading texture sampled
 bilinearly at each pixel's centre (point sampling), trilinearly from its levels averaged
-over the pixel's footprint, and brute force: S x S samples per pixel averaged in linear
-radiance (render.supersample, with either filter). The reference is --reference x
+over the pixel's footprint, the pixel's box over one level's texels (box), and brute
+force: S x S samples per pixel averaged in linear radiance (render.supersample, with
+either filter). The reference is --reference x
 --reference point samples per pixel. Per variant:
 render seconds per frame (wall, one core: llvmpipe with LP_NUM_THREADS=1; the best of
 --repeats rounds, alternated variant by variant), events against the reference's, the
@@ -57,6 +58,7 @@ from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
 VARIANTS = [
     ("point", "point", 1),
     ("trilinear", "trilinear", 1),
+    ("box", "box", 1),
     ("point, 2x2", "point", 2),
     ("point, 4x4", "point", 4),
     ("trilinear, 2x2", "trilinear", 2),  # render.supersample: 2 with the default filter

@@ -65,14 +65,11 @@ def timed(log: list[float], function):
 # Probes of the textured fragment shader: (committed text, replacement), each taking one
 # part out; together they split a frame's time (docs/performance.md).
 _LAW = "    float per_mu0 = law_per_mu0(mu0, mu, frag_phase);"
-_READ = "    vec4 texel = textureLod(shading, at, level);"
-_FOOTPRINT = _READ.join(
-    [
-        "    vec2 across = dFdx(texel_at), down = dFdy(texel_at);  // texels per pixel\n"
-        "    float rho2 = 0.5 * (dot(across, across) + dot(down, down));\n"
-        "    float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;\n",
-        "",
-    ]
+_AT = "vec3((texel_at + 0.5) / texture_side, layer)"
+_READ = f"    return textureLod(shading, {_AT}, level);"  # the trilinear read (shaders/footprint.glsl)
+_FOOTPRINT = (
+    "    float rho2 = 0.5 * (dot(across, across) + dot(down, down));\n"
+    "    float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;\n" + _READ
 )
 _EARTHSHINE = "    float earthshine = earthshine_radiance(normal);"
 _RADIANCE = "    float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);"
@@ -80,9 +77,9 @@ PROBED_SHADER = "terrain_textured.frag"
 PROBES = {
     "no law": (_LAW, "    float per_mu0 = mu0 + mu + frag_phase;"),
     "no earthshine": (_EARTHSHINE, "    float earthshine = 0.0;"),
-    "one level (no footprint)": (_FOOTPRINT, "    vec4 texel = textureLod(shading, at, 0.0);"),
-    "one layer (in cache)": (_READ, "    vec4 texel = textureLod(shading, vec3(at.xy, 0.0), level);"),
-    "no texture read": (_READ, "    vec4 texel = vec4(at.xy, level, at.z + 1.0);"),
+    "one level (no footprint)": (_FOOTPRINT, f"    return textureLod(shading, {_AT}, 0.0);"),
+    "one layer (in cache)": (_READ, _READ.replace("layer)", "0.0)")),
+    "no texture read": (_READ, "    return vec4(texel_at, level, layer + 1.0);"),
     "constant radiance": (_RADIANCE, "    float radiance = 1.0;"),
 }
 

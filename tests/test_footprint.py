@@ -1,9 +1,11 @@
 """The shading texture's levels: each texel the area mean of the texels under it, where the
-GPU samples it; the integral kept; an edge's texel gets the edge's area fraction."""
+GPU samples it; the integral kept; an edge's texel gets the edge's area fraction; the box
+read as wide as the pixel's box."""
 
 import numpy as np
 import pytest
 
+from traj2events.renderer import footprint
 from traj2events.renderer.footprint import area_weights, level_sides, mip_levels, sunlit
 
 
@@ -62,3 +64,44 @@ def test_the_direct_light_is_averaged_where_a_mean_normal_would_lose_it():
     assert coarse[3] == pytest.approx(float(facing @ sun) * 9 / 17, rel=1e-5)  # 9 of 17 columns face the Sun
     mean_normal = coarse[:3] / np.linalg.norm(coarse[:3])
     assert mean_normal @ sun < 0.5 * coarse[3]  # what averaging normals alone would give
+
+
+def box_response(width_px: float, texels_per_px: float, at_texel: float) -> tuple[np.ndarray, np.ndarray]:
+    """(pixel centres in level-0 texels, the box read's value there) over a level-0 texture
+    lit by one texel column (`at_texel`), for pixels `width_px` wide with `texels_per_px`:
+    box_footprint's level and widths, each level's texels as constants (the shader's read)."""
+    side = 257
+    texture = np.zeros((side, side, 1), np.float32)
+    texture[:, int(at_texel)] = 1.0
+    width = width_px * texels_per_px
+    k, box = footprint.box_footprint(np.array([width, width]), len(footprint.level_sides(side)))
+    level = footprint.mip_levels(texture)[k][0, :, 0]  # along s
+    side_k = len(level)
+    centres = np.linspace(at_texel - 3 * width - 4, at_texel + 3 * width + 4, 4001)
+    values = []
+    for c in centres:
+        ck = (c + 0.5) * side_k / side - 0.5  # in level-k texels
+        lo, hi = ck - box[0] / 2, ck + box[0] / 2
+        i = np.arange(side_k)
+        overlap = np.clip(np.minimum(hi, i + 0.5) - np.maximum(lo, i - 0.5), 0.0, None)
+        values.append((overlap * level).sum() / box[0])
+    return centres, np.array(values)
+
+
+@pytest.mark.parametrize("texels_per_px", [0.5, 1.0, 1.7, 3.0, 6.0, 11.0, 24.0])
+def test_the_box_is_as_wide_as_the_pixels_box_over_level_0s_surface(texels_per_px):
+    # A pixel's mean of level 0's surface (bilinear between texels: a tent) responds to one
+    # lit texel with the pixel's box under that tent: variance w^2 / 12 + 1 / 6 texels^2
+    # (w the pixel's width in texels). The box read, a box over the constant texels of a
+    # coarser level whose own texels average the ones below, responds as widely (within
+    # 12 % in standard deviation, over where the texel falls on the coarser texels) and
+    # keeps the light (its integral over the pixel centres: one texel).
+    stds = []
+    for at_texel in (100.0, 101.0, 102.0, 103.0):
+        centres, response = box_response(1.0, texels_per_px, at_texel)
+        step = centres[1] - centres[0]
+        assert response.sum() * step == pytest.approx(1.0, rel=0.02)
+        mean = (centres * response).sum() / response.sum()
+        stds.append(np.sqrt(((centres - mean) ** 2 * response).sum() / response.sum()))
+    expected = np.sqrt(texels_per_px**2 / 12 + 1 / 6)
+    assert np.mean(stds) == pytest.approx(expected, rel=0.12)

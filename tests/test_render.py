@@ -586,9 +586,10 @@ def shadow_edge_fractions(
     return (images[0][row] / images[1][row])[near], analytic[near]
 
 
+@pytest.mark.parametrize("texture_filter", ["trilinear", "box"])
 @pytest.mark.parametrize("x_edge_m", [4.27, 4.6, 5.0])  # the edge at 0.30, 0.55, 0.86 of a pixel
-def test_a_pixel_across_a_shadow_edge_gets_its_lit_area_fraction(x_edge_m):
-    rendered, analytic = shadow_edge_fractions(x_edge_m, "trilinear")
+def test_a_pixel_across_a_shadow_edge_gets_its_lit_area_fraction(x_edge_m, texture_filter):
+    rendered, analytic = shadow_edge_fractions(x_edge_m, texture_filter)
     averaged, _ = shadow_edge_fractions(x_edge_m, "point", samples=16)  # the pixels' area integrals
     # The footprint's filter (a tent over texels 0.58 px wide) against the pixel's box:
     # within 0.2 of the area integral at every pixel, and the lit area across the edge the
@@ -636,29 +637,34 @@ def notch_strip_fractions(texture_filter: str, samples: int = 1, shift_px: float
     return fraction[:, columns], 2 * texel / pixel_m
 
 
-def test_a_sub_pixel_bright_strip_gives_its_pixels_its_area_fraction():
+@pytest.mark.parametrize("texture_filter, bounds", [("trilinear", (0.45, 1.7)), ("box", (0.6, 1.3))])
+def test_a_sub_pixel_bright_strip_gives_its_pixels_its_area_fraction(texture_filter, bounds):
     # Across the strip (0.19 px wide), the pixels' 16 x 16-sample area integrals add up to
     # its width wherever it falls on them (within 2 %), as a pixel's box partitions it. The
-    # footprint's one trilinear read (a tent 0.58 px wide, the box's variance) does so only
-    # on average over where the strip falls (eight eighths of a pixel: within 3 %; 1.00
-    # measured); at one place the sum is 0.55-1.60x the width (docs/rendering.md "Pixel
-    # footprint"), against point sampling's all of the light or none.
+    # footprint does so only on average over where the strip falls (eight eighths of a
+    # pixel: within 3 %; 1.00 measured); at one place the sum is 0.55-1.60x the width with
+    # the trilinear read (a tent 0.58 px wide, the box's variance), 0.71-1.18x with the box
+    # (docs/rendering.md "Pixel footprint"), against point sampling's all of the light or none.
     near = slice(26, 38)  # the strip crosses the middle rows; the wall's shadow around it
     sums = []
     for eighth in range(8):
-        rendered, width_px = notch_strip_fractions("trilinear", shift_px=eighth / 8)
+        rendered, width_px = notch_strip_fractions(texture_filter, shift_px=eighth / 8)
         assert np.abs(np.sort(rendered[near], axis=0)[:-3]).max() < 0.01  # the strip: 3 rows at most; shadow around
         sums.append(rendered[near].sum(axis=0))
-        assert 0.45 * width_px < sums[-1].min() and sums[-1].max() < 1.7 * width_px
+        assert bounds[0] * width_px < sums[-1].min() and sums[-1].max() < bounds[1] * width_px
     assert np.mean(sums) == pytest.approx(width_px, rel=0.03)
+
+
+def test_a_sub_pixel_bright_strip_is_partitioned_by_averaged_samples_and_missed_by_one():
+    near = slice(26, 38)
     for shift_px in (0.0, 0.5):  # point sampling: the strip missed (0) or 4.4x its width in one pixel
-        averaged, _ = notch_strip_fractions("point", samples=16, shift_px=shift_px)
+        averaged, width_px = notch_strip_fractions("point", samples=16, shift_px=shift_px)
         assert np.allclose(averaged[near].sum(axis=0), width_px, rtol=0.02)
         point, _ = notch_strip_fractions("point", shift_px=shift_px)
         assert np.allclose(point[near].sum(axis=0), 0.0) or np.all(point[near].sum(axis=0) > 4 * width_px)
 
 
-@pytest.mark.parametrize("texture_filter", ["point", "trilinear"])
+@pytest.mark.parametrize("texture_filter", ["point", "trilinear", "box"])
 def test_a_magnified_tiles_quarters_draw_what_its_whole_finer_texture_draws(texture_filter):
     # Every tile magnified (texels 2-4 px below a nadir camera): its texture one level finer
     # drawn from four quarter layers gives the pixels that texture drawn whole, as the
@@ -739,9 +745,11 @@ def test_a_translating_shadow_edge_fires_the_events_its_pixels_area_integrals_pr
     # flies along +x, 100 fps): each pixel's area integral is the lit radiance times the
     # part of it left of the edge, a ramp over 10 frames down to the black shadow. The
     # clean emulator on those analytic rows and on the rendered ones: the same events per
-    # pixel (43 as a pixel darkens), and with the footprint the events come about one
-    # frame after the analytic ones (its filter is a little wider than the pixel: the last
-    # light fades later), half point sampling's error (all of a pixel's events at once).
+    # pixel (43 as a pixel darkens), and with the trilinear footprint the events come about
+    # one frame after the analytic ones (its filter is a little wider than the pixel: the
+    # last light fades later), half point sampling's error (all of a pixel's events at
+    # once). The box, here over texels 2-4x coarser than level 0's (a quarter of a pixel
+    # and less), is wider still by those texels: about two frames, as point sampling.
     from traj2events.config import resolve_config
     from traj2events.sensor.emulator import EventEmulator
     from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
@@ -770,7 +778,7 @@ def test_a_translating_shadow_edge_fires_the_events_its_pixels_area_integrals_pr
     lit = rows(GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0)), "trilinear")[0]
     crossed = np.flatnonzero(np.abs(centre_x - x_edge + 2.0 * pixel_m) < 1.2 * pixel_m)  # crossed in 4 px
     errors = {}
-    for texture_filter in ("trilinear", "point"):
+    for texture_filter in ("trilinear", "box", "point"):
         rendered = rows(cliff, texture_filter)
         # the edge where the rendered first frame puts it (its lit area; the march moves it ~0.2 px)
         near = np.abs(centre_x - x_edge) < 12.0
@@ -785,3 +793,4 @@ def test_a_translating_shadow_edge_fires_the_events_its_pixels_area_integrals_pr
             dt.append(np.abs(t_got.astype(float) - t_expected.astype(float)))
         errors[texture_filter] = np.median(np.concatenate(dt)) * 1e-6  # s
     assert errors["trilinear"] < 0.011 and errors["trilinear"] < 0.6 * errors["point"], errors
+    assert errors["box"] < 0.021, errors

@@ -78,7 +78,9 @@ class _GLScene:
         self.vertices_per_tile = vertices_per_tile
         self.n_indices = faces.size
         self.textured = shading_uv is not None
-        self.program = _compile_program(gl, "terrain_textured" if self.textured else "terrain")
+        # the footprint's read is chosen here, when the program is compiled (shaders/footprint.glsl)
+        defines = ("FOOTPRINT_BOX",) if texture_filter == "box" else ()
+        self.program = _compile_program(gl, "terrain_textured" if self.textured else "terrain", defines)
         self.locations = {}
         self.vao = gl.glGenVertexArrays(1)
         gl.glBindVertexArray(self.vao)
@@ -293,12 +295,18 @@ def shader_source(name: str) -> str:
     return expand_includes((resources.files("traj2events.renderer") / "shaders" / name).read_text())
 
 
-def _compile_program(gl, stem: str) -> int:
-    """The program of shaders/`stem`.vert and shaders/`stem`.frag."""
+def with_defines(source: str, defines: tuple[str, ...]) -> str:
+    """GLSL `source` with a `#define` line for each of `defines` after its `#version` line."""
+    version, rest = source.split("\n", 1)
+    return "".join(f"{line}\n" for line in (version, *(f"#define {name}" for name in defines))) + rest
+
+
+def _compile_program(gl, stem: str, defines: tuple[str, ...] = ()) -> int:
+    """The program of shaders/`stem`.vert and shaders/`stem`.frag, with `defines` set."""
     program = gl.glCreateProgram()
     for kind, name in ((gl.GL_VERTEX_SHADER, f"{stem}.vert"), (gl.GL_FRAGMENT_SHADER, f"{stem}.frag")):
         shader = gl.glCreateShader(kind)
-        gl.glShaderSource(shader, shader_source(name))
+        gl.glShaderSource(shader, with_defines(shader_source(name), defines))
         gl.glCompileShader(shader)
         if not gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS):
             raise RuntimeError(f"shaders/{name}: {gl.glGetShaderInfoLog(shader).decode()}")

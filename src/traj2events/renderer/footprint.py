@@ -14,8 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 # How a pixel samples the shading texture (render.lod.texture_filter): `point` at its centre
-# (bilinear between texels); `trilinear` from the levels below, averaged over its footprint.
-TEXTURE_FILTERS = ("point", "trilinear")
+# (bilinear between texels); `trilinear` from the levels below, averaged over its footprint;
+# `box` the pixel's box over one level's texels (`box_footprint`).
+TEXTURE_FILTERS = ("point", "trilinear", "box")
 # The level a pixel samples, relative to the one whose texels match its footprint (log2):
 # a trilinear sample at level size t (pixels) is a t-wide box (the level's own averaging)
 # under a bilinear tent of half-width t, variance t^2 / 12 + t^2 / 6 = t^2 / 4; a pixel's
@@ -29,6 +30,30 @@ TEXTURE_FILTERS = ("point", "trilinear")
 # rho^2 = (|a|^2 + |b|^2) / 2. OpenGL's reference takes the longer side, which blurs ground
 # seen obliquely along its short side (docs/rendering.md "Pixel footprint").
 LOD_BIAS = float(np.log2(1.0 / np.sqrt(3.0)))  # -0.79
+
+# The box: a pixel's footprint is a parallelogram of sides a, b (texels); along each of the
+# texture's axes it has the variance of a box w = sqrt(a_s^2 + b_s^2) wide (a_t, b_t for t).
+# Its mean is taken over the texels of level k as constants, exactly (each texel weighted by
+# its overlap with the box), k the coarsest level where the longer side spans >= sqrt 2
+# texels, so that the box touches at most four texels a side. It is as wide in variance as
+# the pixel's box over level 0's surface (bilinear between level-0 texels: a tent, 1 / 6),
+# the texels' own width (1 / 12 each, as constants; above level 0 once more, as means of
+# the level below) taken out: w_k'^2 = w_k^2 + 1 at level 0, w_k^2 - 2 above, and at least
+# one texel (narrower, a box over constant texels shows their steps). Where the trilinear
+# read's tent changes slope at every texel a moving pixel crosses, the box's mean changes
+# only as its edges cross texels (docs/rendering.md "Pixel footprint").
+BOX_MIN_TEXELS = float(np.sqrt(2.0))
+
+
+def box_footprint(width_texels: np.ndarray, levels: int) -> tuple[int, np.ndarray]:
+    """(level k, the box's widths in level-k texels) for a footprint `width_texels` (s, t)
+    level-0 texels wide (sqrt(a_s^2 + b_s^2), sqrt(a_t^2 + b_t^2)); `levels` the texture's
+    levels (k at most levels - 1). shaders/footprint.glsl draws the same."""
+    width = np.asarray(width_texels, np.float64)
+    k = int(np.clip(np.floor(np.log2(max(width.max(), 1e-12) / BOX_MIN_TEXELS)), 0, levels - 1))
+    width_k = width / 2.0**k
+    box = np.sqrt(width_k**2 + 1.0) if k == 0 else np.sqrt(np.maximum(width_k**2 - 2.0, 1.0))
+    return k, box
 
 
 def sunlit(texture: np.ndarray, sun_dir: np.ndarray) -> np.ndarray:

@@ -12,35 +12,27 @@ in float frag_phase;
 in float frag_scattered;
 
 uniform sampler2DArray shading;  // per slot: normal xyz, lit fraction times mu0 (0..1)
-uniform float texture_side;      // its texels a side (cells 2^levels + 1)
 uniform float radiance_max;      // the law's maximum for this Sun (W m^-2 sr^-1)
-uniform float level_bias;        // log2 of the filter's width against the footprint (footprint.LOD_BIAS)
 
 out vec4 frag_color;             // (radiance, depth, -, -): only R and G are stored
 
 #include "reflectance.glsl"
+#include "footprint.glsl"
 
 const float MU_LIMB = 1e-4;      // cos(emission) of relief seen edge-on
 
 void main()
 {
-    // Over the pixel's footprint: the mean normal, and the mean of lit * mu0 (footprint.py),
-    // from the level whose texels match the footprint's size rho (texels per pixel): the
-    // root mean square of its two sides, an isotropic filter as wide in variance as the
-    // footprint (footprint.LOD_BIAS). Chosen here, not by the sampler: GPUs approximate
-    // the footprint their own way (an NVIDIA H200's gave 18 % fewer events than llvmpipe's).
-    // Where the tile has its texture one level finer (magnified texels), that one, held as
-    // four quarters that share their middle texels: the texel coordinates run on across
-    // them (so do their derivatives), and one read takes the quarter's layer.
+    // Over the pixel's footprint: the mean normal, and the mean of lit * mu0 (footprint.py,
+    // footprint.glsl). Where the tile has its texture one level finer (magnified texels),
+    // that one, held as four quarters that share their middle texels: the texel coordinates
+    // run on across them (so do their derivatives), and the reads take the quarter's layer.
     bool fine = frag_fine_slots.x >= 0.0;
     vec2 texel_at = (frag_uv * texture_side - 0.5) * (fine ? 2.0 : 1.0);
     vec2 quarter = fine ? step(vec2(texture_side - 1.0), texel_at) : vec2(0.0);
     float layer = fine ? frag_fine_slots[int(quarter.y) * 2 + int(quarter.x)] : frag_layer;
-    vec3 at = vec3((texel_at - quarter * (texture_side - 1.0) + 0.5) / texture_side, layer);
     vec2 across = dFdx(texel_at), down = dFdy(texel_at);  // texels per pixel
-    float rho2 = 0.5 * (dot(across, across) + dot(down, down));
-    float level = 0.5 * log2(max(rho2, 1e-20)) + level_bias;
-    vec4 texel = textureLod(shading, at, level);
+    vec4 texel = footprint_mean(shading, texel_at - quarter * (texture_side - 1.0), layer, across, down);
     vec3 normal = normalize(texel.xyz);
     // The triangle drawn here faces the camera; relief in its texture that faces away is
     // seen edge-on (its limb, mu -> 0), not black: a cut to 0 at mu = 0 flickered between
