@@ -66,6 +66,7 @@ def test_render_fingerprint_includes_the_shaders():
         "terrain_textured.vert",
         "terrain_textured.frag",
         "reflectance.glsl",
+        "footprint.glsl",
     }
 
 
