@@ -3,6 +3,7 @@ a ray cast on the mesh, a landmark where the camera model puts it, radiance on a
 against the reflectance law, determinism, sky, the backends and the tile slots.
 TRAJ2EVENTS_TEST_BACKEND=egl draws them through EGL instead (a GPU's, where there is one)."""
 
+import functools
 import os
 import subprocess
 import sys
@@ -561,6 +562,7 @@ def cliff_casting_an_edge_at(x_edge_m: float) -> GridTerrain:
     return GridTerrain(np.where(x[:, None] >= cliff_x, height, 0.0) * np.ones((1, x.size)), spacing, (x[0], x[0]))
 
 
+@functools.cache  # the 16 x 16 average and point sampling serve each filter's test
 def shadow_edge_fractions(
     x_edge_m: float, texture_filter: str, samples: int = 1, **lod
 ) -> tuple[np.ndarray, np.ndarray]:
