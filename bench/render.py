@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import os
 import platform
 import statistics
@@ -66,14 +67,18 @@ def poses(state: np.ndarray, n: int, fps: float = 100.0) -> list:
 
 
 @contextlib.contextmanager
-def stretch_renderer(state, sun, extent, size, n_frames, budget, backend, terrain=None, shading_levels=0):
+def stretch_renderer(
+    state, sun, extent, size, n_frames, budget, backend, terrain=None, shading_levels=0, texture_filter=None
+):
     """A renderer over one case's stretch of `n_frames` poses (`size`^2, 45 deg field of
     view, Hapke, `budget` px/cell, shaded per vertex unless `shading_levels`), every tile
     the stretch needs built beforehand, as a trajectory's first frames would: yields
-    (renderer, poses, seconds the tiles took to build). `terrain`: one shared between calls (None: seed 1's)."""
+    (renderer, poses, seconds the tiles took to build). `terrain`: one shared between calls (None: seed 1's);
+    `texture_filter`: render.lod.texture_filter (None: the default)."""
     camera = Camera(size, size, 45.0)
     terrain = ProceduralTerrain(TerrainParams(seed=1)) if terrain is None else terrain
     lod = LodSettings(pixels_per_cell=budget, shading_levels=shading_levels)
+    lod = lod if texture_filter is None else dataclasses.replace(lod, texture_filter=texture_filter)
     tiles = TileSet(terrain, sun.direction, R_MOON, extent, lod)
     path = poses(state, n_frames)
     with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as renderer:

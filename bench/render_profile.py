@@ -1,6 +1,6 @@
 """Benchmark: where one frame's render time goes, per backend.
 
-  python bench/render_profile.py [--backend egl] [--frames 100] [--size 1024]
+  python bench/render_profile.py [--backend egl] [--frames 100] [--size 1024] [--texture-filter box]
       [--pixels-per-cell 8] [--shading-levels 3]
 
 For bench/render.py's two poses at the default level of detail (render.lod: 8 px per cell
@@ -21,7 +21,9 @@ the rasteriser discarding everything: the vertex stage alone (shading, clipping)
   taskset -c 1 python bench/render_profile.py --probes [--rounds 2] [--frames 20] [--size 1024]
 
 instead times the braking stretch (after 5 warm-up frames, --frames poses x 3 rounds,
-median ms per frame) with the committed shaders and with each probe of PROBES: the
+median ms per frame) with the committed shaders and with each probe of PROBES, all with
+`render.lod.texture_filter: trilinear` (the probes edit its read; the default `box` is
+compiled from other text): the
 shaders with one part taken out (the law, earthshine, the footprint's level, the texture
 array's layers: every read from the first, the same reads with their texels in the cache,
 the texture read, everything: a constant radiance), each run as its own process, all of them
@@ -47,6 +49,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
 
 from traj2events.renderer import draw as render_module  # noqa: E402
+from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
 from traj2events.scene.tiles import LodSettings  # noqa: E402
 
 
@@ -106,7 +109,9 @@ def probe_ms(probe: str, size: int, frames: int) -> float:
         render_module.shader_source = probed_shader_source(*PROBES[probe])
     state, sun, extent = CASES["braking, 2 km, pitch 55 deg"]
     budget, levels = LodSettings.pixels_per_cell, LodSettings.shading_levels
-    with stretch_renderer(state, sun, extent, size, frames, budget, "osmesa", None, levels) as (r, path, _):
+    # the probes take the trilinear read apart (the box's is compiled from other text)
+    lod = {"shading_levels": levels, "texture_filter": "trilinear"}
+    with stretch_renderer(state, sun, extent, size, frames, budget, "osmesa", **lod) as (r, path, _):
         for pose in path[:5]:
             r.render(pose)
         times = []
@@ -187,6 +192,12 @@ def main() -> None:
     parser.add_argument(
         "--shading-levels", type=int, default=LodSettings.shading_levels, help="render.lod.shading_levels"
     )
+    parser.add_argument(
+        "--texture-filter",
+        choices=TEXTURE_FILTERS,
+        default=LodSettings.texture_filter,
+        help="render.lod.texture_filter: how a pixel reads the shading texture",
+    )
     parser.add_argument("--probes", action="store_true", help="time the shader probes instead (OSMesa)")
     parser.add_argument("--rounds", type=int, default=2, help="with --probes: alternations")
     parser.add_argument("--probe", choices=["committed", *PROBES], help=argparse.SUPPRESS)  # one probe's process
@@ -200,7 +211,8 @@ def main() -> None:
         return
     budget, levels = args.pixels_per_cell, args.shading_levels
     for name, (state, sun, extent) in CASES.items():
-        stretch = stretch_renderer(state, sun, extent, args.size, args.frames, budget, args.backend, None, levels)
+        lod = {"shading_levels": levels, "texture_filter": args.texture_filter}
+        stretch = stretch_renderer(state, sun, extent, args.size, args.frames, budget, args.backend, **lod)
         with stretch as (r, path, _):
             tiles = r.tiles
             for pose in path[:5]:
@@ -212,7 +224,8 @@ def main() -> None:
                 frame = timed(total, r.render)(pose)
             ms = {k: 1e3 * statistics.median(v) for k, v in dict(total=total, start=start, finish=finish).items()}
             print(
-                f"\n{name}, {args.size}^2, {budget:g} px per cell shaded {levels} levels finer: {r.backend} "
+                f"\n{name}, {args.size}^2, {budget:g} px per cell shaded {levels} levels finer, "
+                f"{args.texture_filter} footprint: {r.backend} "
                 f"({r.gl_renderer}); {frame.n_tiles} tiles, "
                 f"{frame.n_triangles} triangles; median ms per frame: render {ms['total']:.2f} = start "
                 f"{ms['start']:.2f} (selection {1e3 * statistics.median(select):.2f}) + finish {ms['finish']:.2f}"
