@@ -6,7 +6,7 @@
 The windows events.png draws (--window-ms, centred on t_f/4, t_f/2 and 3 t_f/4), emulated as
 the workflow does (the default config: the paper preset on the sensor input, at the
 camera's fps) from --history seconds of frames before each window, rendered three ways with
-the same tiles: point sampling, the default (the trilinear footprint) and --reference x
+the same tiles: point sampling, the default (render.lod.texture_filter) and --reference x
 --reference point samples per pixel averaged in linear radiance. Per window and variant:
 events, against the reference's, the share of isolated events (no event in the 8 pixels
 around: the salt and pepper of an event frame), and how the variant's event pixels and the

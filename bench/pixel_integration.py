@@ -61,7 +61,7 @@ VARIANTS = [
     ("box", "box", 1),
     ("point, 2x2", "point", 2),
     ("point, 4x4", "point", 4),
-    ("trilinear, 2x2", "trilinear", 2),  # render.supersample: 2 with the default filter
+    ("trilinear, 2x2", "trilinear", 2),  # render.supersample: 2 with trilinear
     ("trilinear, 4x4", "trilinear", 4),
 ]
 
