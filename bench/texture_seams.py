@@ -9,11 +9,11 @@ edge or a quarter's seam reads that level's edge texel, and the two sides step b
 one such texel's contrast. This measures what the step costs in events. For windows of
 --seconds from t_f / 2 (mid-flight) and from t_f - 0.9 s (the last second), at --fps
 (dense: the events are the frames', not the frame timing's), the clean preset's events on
-the emulator's display-scale input, from the footprint (trilinear) and from --reference x
---reference point samples averaged (no levels: no step), counted per frame on the pixels
-within 1 px of a tile edge and of a quarter seam, away from the sky, the horizon and depth
-edges (found by drawing each frame a second
-time with a shader that writes the distance, in pixels, instead of the radiance).
+the emulator's display-scale input, from the footprint (--texture-filter, default the
+config's) and from --reference x --reference point samples averaged (no levels: no step),
+counted per frame on the pixels within 1 px of a tile edge and of a quarter seam, away from
+the sky, the horizon and depth edges (found by drawing each frame a second time with a
+shader that writes the distance, in pixels, instead of the radiance).
 Prints per window: the share of pixel-frames near each, each variant's events there and
 in all, and the footprint's excess there as a share of its frame's events.
 """
@@ -37,6 +37,7 @@ from pixel_integration import silhouettes  # noqa: E402  (bench/, beside this fi
 import traj2events.renderer.draw as draw  # noqa: E402
 from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
+from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
 from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
@@ -88,10 +89,17 @@ def main() -> None:
     parser.add_argument("--reference", type=int, default=8, help="point samples per pixel side of the reference")
     parser.add_argument("--seconds", type=float, default=0.1, help="window length, s")
     parser.add_argument("--fps", type=int, default=2000, help="frame rate in the windows")
+    parser.add_argument(
+        "--texture-filter",
+        choices=[f for f in TEXTURE_FILTERS if f != "point"],
+        help="the footprint measured (render.lod.texture_filter; default the config's)",
+    )
     args = parser.parse_args()
+    texture_filter = args.texture_filter or resolve_config({})["render"]["lod"]["texture_filter"]
     print(
-        f"# texture seams: {args.size}^2, {args.seconds} s at {args.fps} fps, clean preset, footprint against "
-        f"{args.reference}x{args.reference} point samples; {platform.node()}, {time.strftime('%Y-%m-%d')}"
+        f"# texture seams: {args.size}^2, {args.seconds} s at {args.fps} fps, clean preset, {texture_filter} "
+        f"footprint against {args.reference}x{args.reference} point samples; {platform.node()}, "
+        f"{time.strftime('%Y-%m-%d')}"
     )
     print("| window | near | pixel-frames | footprint events there / all | reference's | footprint excess, of all |")
     print("|---|---|---|---|---|---|")
@@ -108,7 +116,7 @@ def main() -> None:
             poses = [camera.pose(states.states([t])[0]) for t in times]
             counts = {}
             for name, kwargs in (
-                ("footprint", {"texture_filter": "trilinear"}),
+                ("footprint", {"texture_filter": texture_filter}),
                 ("reference", {"texture_filter": "point", "supersample": args.reference}),
             ):
                 with sensor_renderer(tiles, camera, sun, reflectance, **kwargs) as renderer:
@@ -116,7 +124,7 @@ def main() -> None:
                 counts[name] = events_per_frame(dn, times)
             draw.shader_source, plain = distance_shader(draw.shader_source), draw.shader_source
             try:
-                with draw.TerrainRenderer(tiles, camera, sun, reflectance, texture_filter="trilinear") as renderer:
+                with draw.TerrainRenderer(tiles, camera, sun, reflectance, texture_filter=texture_filter) as renderer:
                     frames = [renderer.render(p) for p in poses]
             finally:
                 draw.shader_source = plain
