@@ -39,6 +39,7 @@ from traj2events.config import resolve_config  # noqa: E402
 from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
 from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
+from traj2events.scene.tiles import LodSettings  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
 from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
 from traj2events.stages.events import preset_params  # noqa: E402
@@ -92,12 +93,12 @@ def main() -> None:
     parser.add_argument(
         "--texture-filter",
         choices=[f for f in TEXTURE_FILTERS if f != "point"],
+        default=LodSettings.texture_filter,
         help="the footprint measured (render.lod.texture_filter; default the config's)",
     )
     args = parser.parse_args()
-    texture_filter = args.texture_filter or resolve_config({})["render"]["lod"]["texture_filter"]
     print(
-        f"# texture seams: {args.size}^2, {args.seconds} s at {args.fps} fps, clean preset, {texture_filter} "
+        f"# texture seams: {args.size}^2, {args.seconds} s at {args.fps} fps, clean preset, {args.texture_filter} "
         f"footprint against {args.reference}x{args.reference} point samples; {platform.node()}, "
         f"{time.strftime('%Y-%m-%d')}"
     )
@@ -116,7 +117,7 @@ def main() -> None:
             poses = [camera.pose(states.states([t])[0]) for t in times]
             counts = {}
             for name, kwargs in (
-                ("footprint", {"texture_filter": texture_filter}),
+                ("footprint", {"texture_filter": args.texture_filter}),
                 ("reference", {"texture_filter": "point", "supersample": args.reference}),
             ):
                 with sensor_renderer(tiles, camera, sun, reflectance, **kwargs) as renderer:
@@ -124,7 +125,8 @@ def main() -> None:
                 counts[name] = events_per_frame(dn, times)
             draw.shader_source, plain = distance_shader(draw.shader_source), draw.shader_source
             try:
-                with draw.TerrainRenderer(tiles, camera, sun, reflectance, texture_filter=texture_filter) as renderer:
+                distances = draw.TerrainRenderer(tiles, camera, sun, reflectance, texture_filter=args.texture_filter)
+                with distances as renderer:
                     frames = [renderer.render(p) for p in poses]
             finally:
                 draw.shader_source = plain
