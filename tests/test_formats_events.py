@@ -9,6 +9,7 @@ import pytest
 from traj2events.formats.events import (
     EVENT_DTYPE,
     EVENT_LABELS,
+    EventsReader,
     EventsWriter,
     read_events,
     read_events_window,
@@ -91,6 +92,26 @@ def test_chunking_does_not_change_the_file(tmp_path):
     window = read_events_window(tmp_path / "one.h5", 1_000_500, 1_010_500)
     expected = events[(events["t"] >= 1_000_500) & (events["t"] < 1_010_500)]
     assert window.tobytes() == expected.tobytes() and len(expected) > 0
+
+
+def test_one_open_reader_gives_every_window_the_whole_file_holds(tmp_path):
+    # Windows in random order through one reader (its chunk cache warm from the previous
+    # window's), across chunk boundaries, before the first event and past the recording's end.
+    events = random_events(n=20_000)
+    write(tmp_path / "a.h5", events, chunks=3)
+    starts = np.random.default_rng(2).integers(-100_000, 2_700_000, 300)
+    with EventsReader(tmp_path / "a.h5") as reader:
+        assert reader.n_events == len(events) and reader.attrs["width"] == 40 and reader.t_offset_us == 0
+        for t0, width in zip(starts, np.resize([1, 999, 50_000, 1_000_000], len(starts))):
+            expected = events[(events["t"] >= t0) & (events["t"] < t0 + width)]
+            assert reader.window(int(t0), int(t0 + width)).tobytes() == expected.tobytes(), (t0, width)
+        assert len(reader.window(0, 2_600_000)) == len(events)
+    with pytest.raises(FileNotFoundError, match=r"b\.h5: no such file \(expected events\.h5"):
+        EventsReader(tmp_path / "b.h5")
+    with h5py.File(tmp_path / "a.h5", "a") as f:
+        del f["ms_to_idx"]
+    with pytest.raises(ValueError, match=r"a\.h5: .*ms_to_idx.*\(expected events\.h5"):
+        EventsReader(tmp_path / "a.h5")
 
 
 def test_labels_are_a_parallel_dataset_read_by_window(tmp_path):

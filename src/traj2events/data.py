@@ -13,7 +13,8 @@
     radiance, depth = landing.frame(100)     # frames.h5, when kept
 
 Each `Landing` reads only what is asked, when it is asked (event windows through
-`ms_to_idx`), so a dataset far larger than memory iterates fine; a torch `DataLoader`
+`ms_to_idx`, from an events.h5 this process keeps open: `events_reader`), so a dataset far
+larger than memory iterates fine; a torch `DataLoader`
 can wrap `EventWindows` (map-style: `len` and `[i]`) without this module importing torch.
 """
 
@@ -21,17 +22,45 @@ from __future__ import annotations
 
 import csv
 import os
+import threading
+from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
 
 import h5py
 import numpy as np
 
-from .formats.events import read_events_attrs, read_events_window, read_labelled_window
+from .formats.events import EventsReader
 from .formats.frames import FramesFile
 from .formats.hdf5 import open_file
 from .formats.imu import read_imu
 from .formats.trajectory import read_trajectory
+
+# events.h5 files this process holds open (EventsReader), the most recently read last: a
+# window then costs its slices, not an opening. Keyed by the process too, so that a
+# DataLoader's forked workers open their own; and by the file's identity, so that a file
+# built again is read anew.
+MAX_OPEN_EVENTS_FILES = 8
+_open_events: OrderedDict[tuple, EventsReader] = OrderedDict()
+_open_events_lock = threading.Lock()
+
+
+def events_reader(path: Path) -> EventsReader:
+    """This process's open reader of the events.h5 at `path` (opened on first use; the
+    least recently used let go beyond MAX_OPEN_EVENTS_FILES)."""
+    try:
+        stat = path.stat()
+    except FileNotFoundError:
+        return EventsReader(path)  # raises, naming the file and what was expected
+    key = (os.getpid(), str(path), stat.st_dev, stat.st_ino, stat.st_mtime_ns, stat.st_size)
+    with _open_events_lock:
+        reader = _open_events.get(key)
+        if reader is None:
+            reader = _open_events[key] = EventsReader(path)
+            while len(_open_events) > MAX_OPEN_EVENTS_FILES:
+                _open_events.popitem(last=False)  # closed by h5py once no thread reads from it
+        _open_events.move_to_end(key)
+        return reader
 
 
 @dataclass(frozen=True)
@@ -85,18 +114,19 @@ class Landing:
 
     def _scene_attrs(self) -> dict:
         if (self.folder / "events.h5").exists():
-            return read_events_attrs(self.folder / "events.h5")
+            return events_reader(self.folder / "events.h5").attrs
         with FramesFile(self.folder / "frames.h5") as frames:
             return dict(frames.attrs)
 
     def events(self, t_start_s: float, t_end_s: float) -> np.ndarray:
         """Events with t in [t_start, t_end) s: structured x, y, t (us), p (1 = ON)."""
-        return read_events_window(self.folder / "events.h5", round(t_start_s * 1e6), round(t_end_s * 1e6))
+        return events_reader(self.folder / "events.h5").window(round(t_start_s * 1e6), round(t_end_s * 1e6))
 
     def labelled_events(self, t_start_s: float, t_end_s: float) -> tuple[np.ndarray, np.ndarray]:
         """As `events`, and each event's cause (uint8: 0 signal, 1 shot_noise, 2 leak,
         3 hot_pixel; `formats.events.EVENT_LABELS`), when the dataset was built with labels."""
-        return read_labelled_window(self.folder / "events.h5", round(t_start_s * 1e6), round(t_end_s * 1e6))
+        reader = events_reader(self.folder / "events.h5")
+        return reader.labelled_window(round(t_start_s * 1e6), round(t_end_s * 1e6))
 
     def motion_field(self, i: int) -> dict[str, np.ndarray]:
         """The i-th written field: every dataset of motion_field.h5 at index i (and `t`,

@@ -116,15 +116,16 @@ class Attributes(dict):
         raise FileFormatError(f"{self.path}: missing attribute '{key}'")
 
 
-def open_for_reading(path: str | os.PathLike, expected: str) -> h5py.File:
+def open_for_reading(path: str | os.PathLike, expected: str, chunk_cache_bytes: int | None = None) -> h5py.File:
     """An HDF5 file opened for reading; a missing, unreadable or truncated file is an
-    error that names the file and what was expected."""
+    error that names the file and what was expected. `chunk_cache_bytes`: HDF5's cache of
+    decompressed chunks, per dataset (None: h5py's 1 MiB)."""
     import hdf5plugin  # noqa: F401  (registers Blosc: events.h5 and motion_field.h5 use it)
 
     if not Path(path).is_file():
         raise FileNotFoundError(f"{path}: no such file (expected {expected})")
     try:
-        f = h5py.File(path, "r")
+        f = h5py.File(path, "r", rdcc_nbytes=chunk_cache_bytes)
     except OSError as exc:
         raise FileFormatError(f"{path}: not a readable HDF5 file (expected {expected}): {exc}") from None
     try:
@@ -175,15 +176,24 @@ def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
     also an error naming the file."""
     f = open_for_reading(path, expected)
     try:
-        yield f
+        with read_errors_named(path, expected):
+            yield f
+    finally:
+        f.close()
+
+
+@contextlib.contextmanager
+def read_errors_named(path: str | os.PathLike, expected: str) -> Iterator[None]:
+    """A missing dataset, group or attribute, or damaged contents, read from an open file
+    as a FileFormatError naming the file and what was expected."""
+    try:
+        yield
     except KeyError as exc:
         raise FileFormatError(f"{path}: {exc.args[0] if exc.args else exc} (expected {expected})") from None
     except (OSError, RuntimeError) as exc:
         if not is_damage(exc):
             raise
         raise FileFormatError(f"{path}: damaged HDF5 file (expected {expected}): {first_line(exc)}") from None
-    finally:
-        f.close()
 
 
 @contextlib.contextmanager

@@ -1,0 +1,80 @@
+"""Benchmark: reading event windows from a built dataset, the loader's way against a file per window.
+
+  python bench/loader.py [results] [--window-s 0.05] [--rounds 3]
+
+Every window of every landing (traj2events.data.EventWindows, as docs/dataset.md's
+DataLoader example reads them), in order and shuffled, read two ways, alternated round by
+round in one process:
+- `per window`: `formats.events.read_events_window`, which opens events.h5, checks every
+  header and attribute, and decompresses each column's chunk, every call;
+- `held open`: `Landing.events` (with `landing.image_size`, as the example asks for it),
+  through the files this process holds open (data.events_reader): checked once, chunks
+  cached.
+Prints the best round's milliseconds per window of each, their ratio, and the windows
+whose events differ between the two (the error: it must be 0).
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+
+import numpy as np  # noqa: E402
+
+from traj2events import data  # noqa: E402
+from traj2events.data import EventWindows, open_dataset  # noqa: E402
+from traj2events.formats.events import read_events_window  # noqa: E402
+
+
+def per_window(windows: EventWindows, order: np.ndarray) -> list[bytes]:
+    out = []
+    for i in order:
+        landing, start = windows.items[i]
+        path = landing.folder / "events.h5"
+        out.append(read_events_window(path, round(start * 1e6), round((start + windows.window_s) * 1e6)).tobytes())
+    return out
+
+
+def held_open(windows: EventWindows, order: np.ndarray) -> list[bytes]:
+    out = []
+    for i in order:
+        events, _, landing = windows[i]
+        landing.image_size
+        out.append(events.tobytes())
+    return out
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("results", nargs="?", default="results")
+    parser.add_argument("--window-s", type=float, default=0.05)
+    parser.add_argument("--rounds", type=int, default=3)
+    args = parser.parse_args()
+    windows = EventWindows(open_dataset(args.results), args.window_s)
+    n = len(windows)
+    print(f"{args.results}: {len(set(x for x, _ in windows.items))} landings, {n} windows of {args.window_s} s; "
+          f"{platform.node()}, Python {platform.python_version()}")  # fmt: skip
+    orders = {"in order": np.arange(n), "shuffled": np.random.default_rng(0).permutation(n)}
+    for name, order in orders.items():
+        best = {"per window": np.inf, "held open": np.inf}
+        differ = 0
+        for _ in range(args.rounds):
+            data._open_events.clear()  # each round opens its files again: their opening is counted
+            results = {}
+            for variant, read in (("per window", per_window), ("held open", held_open)):
+                start = time.perf_counter()
+                results[variant] = read(windows, order)
+                best[variant] = min(best[variant], (time.perf_counter() - start) / n * 1e3)
+            differ = sum(a != b for a, b in zip(results["per window"], results["held open"]))
+        ratio = best["per window"] / best["held open"]
+        print(f"{name:>9}: per window {best['per window']:.2f} ms, held open {best['held open']:.3f} ms "
+              f"({ratio:.0f}x faster); windows that differ: {differ}")  # fmt: skip
+
+
+if __name__ == "__main__":
+    main()
