@@ -603,24 +603,28 @@ def test_a_pixel_across_a_shadow_edge_gets_its_lit_area_fraction(x_edge_m, textu
     assert set(np.round(point, 2)) <= {0.0, 1.0}  # point sampling: all or nothing
 
 
-def notch_strip_fractions(texture_filter: str, samples: int = 1, shift_px: float = 0.0) -> tuple[np.ndarray, float]:
-    """(lit fraction of a nadir camera's pixels around a sub-pixel bright strip, the strip's
-    width in pixels): flat ground shadowed by a 10 m wall under EDGE_SUN (a point), with a
-    notch through the wall that lets a strip of light 2 texels (0.24 m, 0.19 px) wide onto
-    the shadowed ground. The notch's sides fall half-way between texel rows, so that the
-    texture's bilinear lit field holds exactly that width. Rows: along the strip's
-    width, the 5 pixel columns 1.5-6.5 m from the wall's foot (all within one tile's grid:
-    the notch is seen at the texels' spacing). Texels 1/10 px (2 px per cell, 3 levels).
+def notch_strip_fractions(
+    texture_filter: str, samples: int = 1, shifts_px: tuple[float, ...] = (0.0,)
+) -> tuple[list[np.ndarray], float]:
+    """(lit fraction of a nadir camera's pixels around a sub-pixel bright strip, per shift;
+    the strip's width in pixels): flat ground shadowed by a 10 m wall under EDGE_SUN (a
+    point), with a notch through the wall that lets a strip of light 2 texels (0.24 m,
+    0.19 px) wide onto the shadowed ground. The notch's sides fall half-way between texel
+    rows, so that the texture's bilinear lit field holds exactly that width. Rows: along the
+    strip's width, the 5 pixel columns 1.5-6.5 m from the wall's foot (all within one tile's
+    grid: the notch is seen at the texels' spacing). Texels 1/10 px (2 px per cell, 3 levels).
     `samples`: each pixel the mean of samples x samples (render.supersample);
-    `shift_px`: the camera moved along the strip's width by that part of a pixel."""
+    `shifts_px`: the camera moved along the strip's width by these parts of a pixel, one
+    frame each, drawn by one renderer per scene (as a flight's frames are)."""
     camera, sun, altitude = Camera(64, 64, 45.0), EDGE_SUN, 100.0
     lod = LodSettings(pixels_per_cell=2.0, shading_levels=3, texture_filter=texture_filter, magnified_texel_px=0.0)
     half_extent, wall_x, pixel_m = 2e3, 40.0, altitude / camera.focal_px
     flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
-    pose = camera_pose(state(x=wall_x - 4.0, y=46.0 + shift_px * pixel_m, altitude=altitude))
-    level = max(key[0] for key in TileSet(flat, sun.direction, 1e12, half_extent, lod).select(pose, camera))
+    poses = [camera_pose(state(x=wall_x - 4.0, y=46.0 + shift * pixel_m, altitude=altitude)) for shift in shifts_px]
+    for pose in poses:
+        level = max(key[0] for key in TileSet(flat, sun.direction, 1e12, half_extent, lod).select(pose, camera))
+        assert level == 7  # the tile drawn below the camera spans x, y = 31.25-62.5 m
     texel = 2 * half_extent / 2**level / lod.cells / 2**lod.shading_levels
-    assert level == 7  # the tile drawn below the camera spans x, y = 31.25-62.5 m
     row = round(46.0 / texel)  # the strip's first lit texel row
     notch = ((row - 0.5) * texel, (row + 1.5) * texel)
     spacing = 0.02
@@ -632,11 +636,11 @@ def notch_strip_fractions(texture_filter: str, samples: int = 1, shift_px: float
     for terrain in terrains:
         tiles = TileSet(terrain, sun.direction, 1e12, half_extent, lod, scattered_azimuths=0, sun_radius_rad=0.0)
         with sensor_renderer(tiles, camera, sun, ReflectanceParams(), backend=BACKEND, supersample=samples) as r:
-            images.append(r.render(pose).radiance)
-    fraction = images[0] / images[1]
+            images.append([r.render(pose).radiance for pose in poses])
     ground_x = wall_x - 4.0 + camera.pixel_coordinates()[0][0] * pixel_m
     columns = np.flatnonzero((ground_x > wall_x - 6.5) & (ground_x < wall_x - 1.5))
-    return fraction[:, columns], 2 * texel / pixel_m
+    fractions = [(notched / flat_image)[:, columns] for notched, flat_image in zip(*images)]
+    return fractions, 2 * texel / pixel_m
 
 
 @pytest.mark.parametrize("texture_filter, bounds", [("trilinear", (0.45, 1.7)), ("box", (0.6, 1.3))])
@@ -649,8 +653,8 @@ def test_a_sub_pixel_bright_strip_gives_its_pixels_its_area_fraction(texture_fil
     # (docs/rendering.md "Pixel footprint"), against point sampling's all of the light or none.
     near = slice(26, 38)  # the strip crosses the middle rows; the wall's shadow around it
     sums = []
-    for eighth in range(8):
-        rendered, width_px = notch_strip_fractions(texture_filter, shift_px=eighth / 8)
+    fractions, width_px = notch_strip_fractions(texture_filter, shifts_px=tuple(np.arange(8) / 8))
+    for rendered in fractions:
         assert np.abs(np.sort(rendered[near], axis=0)[:-3]).max() < 0.01  # the strip: 3 rows at most; shadow around
         sums.append(rendered[near].sum(axis=0))
         assert bounds[0] * width_px < sums[-1].min() and sums[-1].max() < bounds[1] * width_px
@@ -659,11 +663,12 @@ def test_a_sub_pixel_bright_strip_gives_its_pixels_its_area_fraction(texture_fil
 
 def test_a_sub_pixel_bright_strip_is_partitioned_by_averaged_samples_and_missed_by_one():
     near = slice(26, 38)
-    for shift_px in (0.0, 0.5):  # point sampling: the strip missed (0) or 4.4x its width in one pixel
-        averaged, width_px = notch_strip_fractions("point", samples=16, shift_px=shift_px)
-        assert np.allclose(averaged[near].sum(axis=0), width_px, rtol=0.02)
-        point, _ = notch_strip_fractions("point", shift_px=shift_px)
-        assert np.allclose(point[near].sum(axis=0), 0.0) or np.all(point[near].sum(axis=0) > 4 * width_px)
+    # point sampling: the strip missed (0) or 4.4x its width in one pixel
+    averaged, width_px = notch_strip_fractions("point", samples=16, shifts_px=(0.0, 0.5))
+    point, _ = notch_strip_fractions("point", shifts_px=(0.0, 0.5))
+    for averaged_sums, point_sums in zip(*(np.array([f[near].sum(axis=0) for f in x]) for x in (averaged, point))):
+        assert np.allclose(averaged_sums, width_px, rtol=0.02)
+        assert np.allclose(point_sums, 0.0) or np.all(point_sums > 4 * width_px)
 
 
 @pytest.mark.parametrize("texture_filter", ["point", "trilinear", "box"])

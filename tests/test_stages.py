@@ -44,7 +44,15 @@ def config():
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory, config):
+def tile_cache(tmp_path_factory) -> str:
+    """One tile cache for the module's renders, as the workflow's render jobs share one: the
+    fixture's render fills it, the tests' renders of the same flight read it (exact: the
+    same bytes, formats/tile_cache.py), in a third of the time."""
+    return str(tmp_path_factory.mktemp("tile_cache"))
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory, config, tile_cache):
     """The chain of stages for the descent scenario's trajectory 0000."""
     d = tmp_path_factory.mktemp("stages")
     s = ScenarioSettings.from_config(config, "descent")
@@ -58,6 +66,7 @@ def built(tmp_path_factory, config):
         d / "frames.h5",
         d / "video.mkv",
         d / "p.mp4",
+        tile_cache=tile_cache,
     )
     return d
 
@@ -186,9 +195,11 @@ def test_render_writes_frames_and_a_lossless_video_of_them(built):
     assert np.abs(video.astype(int) - display_frame(radiance, white, gamma).astype(int)).max() <= 1
 
 
-def test_without_the_preview_the_other_files_are_the_same(built, config, tmp_path):
+def test_without_the_preview_the_other_files_are_the_same(built, config, tmp_path, tile_cache):
     settings = RenderSettings.from_config(config, "descent")
-    render_trajectory(built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None)
+    render_trajectory(
+        built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None, tile_cache=tile_cache
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["frames.h5", "video.mkv"]  # no preview, no leftovers
     assert (built / "p.mp4").stat().st_size > 0  # the fixture's render wrote one
     assert (tmp_path / "video.mkv").read_bytes() == (built / "video.mkv").read_bytes()
@@ -386,7 +397,7 @@ def test_kept_files_describe_themselves(built, config):
     assert '"seed": 1' in attrs["terrain"]  # the terrain's settings, as JSON
 
 
-def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path):
+def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path, tile_cache):
     import json
 
     from traj2events.video import read_video
@@ -394,7 +405,14 @@ def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path)
     timing = {"mode": "adaptive", "max_log_change": 0.5, "max_displacement_px": 0.5, "max_fps": 40.0}
     adaptive = resolve_config({**CONFIG_OVERLAY, "render": {"timing": timing}})
     settings = RenderSettings.from_config(adaptive, "descent")
-    render_trajectory(built / "trajectory.h5", settings, tmp_path / "f.h5", tmp_path / "v.mkv", tmp_path / "p.mp4")
+    render_trajectory(
+        built / "trajectory.h5",
+        settings,
+        tmp_path / "f.h5",
+        tmp_path / "v.mkv",
+        tmp_path / "p.mp4",
+        tile_cache=tile_cache,
+    )
     tr = read_trajectory(built / "trajectory.h5")
     with h5py.File(tmp_path / "f.h5") as f, h5py.File(built / "frames.h5") as fixed:
         t, index = f["t"][()], f["frame_index"][()]
@@ -409,7 +427,7 @@ def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path)
     assert n_frames == len(t)  # the emulator takes every frame, in time order
 
 
-def test_render_and_emulate_in_one_job_gives_the_two_jobs_files(built, config, tmp_path):
+def test_render_and_emulate_in_one_job_gives_the_two_jobs_files(built, config, tmp_path, tile_cache):
     """The streamed job: the same events.h5 datasets and video bytes as `render` then
     `events`, and a frames.h5 of depth only that the motion field reads as before and the
     events command refuses by name."""
@@ -421,7 +439,8 @@ def test_render_and_emulate_in_one_job_gives_the_two_jobs_files(built, config, t
     settings = events_settings(config)
     events_command(built / "frames.h5", tmp_path / "two.h5", settings, 5)
     render_and_emulate(built / "trajectory.h5", RenderSettings.from_config(config, "descent"), settings, 5,
-                       tmp_path / "frames.h5", tmp_path / "video.mkv", None, tmp_path / "one.h5")  # fmt: skip
+                       tmp_path / "frames.h5", tmp_path / "video.mkv", None, tmp_path / "one.h5",
+                       tile_cache=tile_cache)  # fmt: skip
     with h5py.File(tmp_path / "two.h5") as two, h5py.File(tmp_path / "one.h5") as one:
         assert len(two["events/t"]) > 100
         for name in ("events/x", "events/y", "events/t", "events/p", "events/label", "ms_to_idx"):
@@ -443,7 +462,7 @@ def test_render_and_emulate_in_one_job_gives_the_two_jobs_files(built, config, t
 
 
 @pytest.mark.slow  # a render, solves or a whole motion field: the full suite's
-def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(built, config, tmp_path):
+def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(built, config, tmp_path, tile_cache):
     """camera.distortion: frames.h5 rendered through the lens, the motion field's rays and
     the range meter's through it, and every file saying which lens."""
     from traj2events.settings.camera import camera_settings
@@ -452,7 +471,9 @@ def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(bu
     lens_config = resolve_config({**CONFIG_OVERLAY, "camera": {**CONFIG_OVERLAY["camera"], "distortion": lens}})
     settings = RenderSettings.from_config(lens_config, "descent")
     assert "distortion" not in RenderSettings.from_config(config, "descent").to_json()  # a pinhole's jobs unchanged
-    render_trajectory(built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None)
+    render_trajectory(
+        built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None, tile_cache=tile_cache
+    )
     camera = Camera.from_settings(camera_settings(lens_config))
     motion_field(built / "trajectory.h5", camera, 1_737_400.0, 7, tmp_path / "mf.h5", tmp_path / "flow",
                  tmp_path / "frames.h5")  # fmt: skip
@@ -487,12 +508,14 @@ def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(bu
 
 
 @pytest.mark.slow  # a whole trajectory rendered again
-def test_supersampled_frames_say_so_and_keep_the_scenes_light(built, config, tmp_path):
+def test_supersampled_frames_say_so_and_keep_the_scenes_light(built, config, tmp_path, tile_cache):
     """render.supersample: frames.h5 holds the camera's pixels, each the mean of S x S
     samples, and says how many; the default's jobs are as before (no new setting)."""
     assert "supersample" not in RenderSettings.from_config(config, "descent").to_json()
     settings = RenderSettings.from_config(resolve_config({**CONFIG_OVERLAY, "render": {"supersample": 3}}), "descent")
-    render_trajectory(built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None)
+    render_trajectory(
+        built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None, tile_cache=tile_cache
+    )
     with h5py.File(tmp_path / "frames.h5") as f, h5py.File(built / "frames.h5") as one:
         assert f.attrs["samples_per_pixel"] == 3 and one.attrs["samples_per_pixel"] == 1
         assert f["radiance"].shape == one["radiance"].shape == (len(one["t"]), SIZE, SIZE)
