@@ -1,5 +1,7 @@
-"""Shared fixtures: the default vehicle, small problems that solve in well under a second."""
+"""Shared fixtures: the default vehicle, small problems that solve in well under a second;
+the order the files run in."""
 
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -55,3 +57,11 @@ def solved30(problem30):
     sol = problem30.solve(landing_bc())
     assert sol.success, sol.status
     return sol
+
+
+def pytest_collection_modifyitems(items):
+    """The files with the most slow tests first, each file's tests in their order: with
+    `--dist loadfile` a file runs on one worker, so the end-to-end files (minutes each) start
+    at once on both workers instead of last (xdist's own order: most tests first)."""
+    slow = Counter(item.path for item in items if item.get_closest_marker("slow"))
+    items.sort(key=lambda item: -slow[item.path])
