@@ -11,7 +11,9 @@ round in one process:
   through the files this process holds open (data.events_reader): checked once, chunks
   cached.
 Prints the best round's milliseconds per window of each, their ratio, and the windows
-whose events differ between the two (the error: it must be 0).
+whose events differ between the two (the error: it must be 0). Then the same for every
+motion field (`Landing.motion_field`) and every pose's frame (`Landing.frame`), against
+opening motion_field.h5 or frames.h5 for each.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ import numpy as np  # noqa: E402
 from traj2events import data  # noqa: E402
 from traj2events.data import EventWindows, open_dataset  # noqa: E402
 from traj2events.formats.events import read_events_window  # noqa: E402
+from traj2events.formats.flow import MotionFieldReader  # noqa: E402
+from traj2events.formats.frames import FramesFile  # noqa: E402
 
 
 def per_window(windows: EventWindows, order: np.ndarray) -> list[bytes]:
@@ -49,6 +53,32 @@ def held_open(windows: EventWindows, order: np.ndarray) -> list[bytes]:
     return out
 
 
+def field_per_call(landing, i: int) -> bytes:
+    with MotionFieldReader(landing.folder / "motion_field.h5") as reader:
+        return b"".join(v.tobytes() for v in reader.field(i).values())
+
+
+def frame_per_call(landing, k: int) -> bytes:
+    with FramesFile(landing.folder / "frames.h5") as frames:
+        row = frames.row_of_pose(k)
+        return frames.radiance(row).tobytes() + frames.depth_m(row).tobytes()
+
+
+def compare_reads(name: str, items: list, per_call, held, rounds: int) -> None:
+    """Every item read per call and through the held files, alternated; best round each."""
+    best = {"per call": np.inf, "held open": np.inf}
+    for _ in range(rounds):
+        data._open_files.clear()
+        results = {}
+        for variant, read in (("per call", per_call), ("held open", held)):
+            start = time.perf_counter()
+            results[variant] = [read(landing, i) for landing, i in items]
+            best[variant] = min(best[variant], (time.perf_counter() - start) / len(items) * 1e3)
+    differ = sum(a != b for a, b in zip(results["per call"], results["held open"]))
+    print(f"{name:>14}: per call {best['per call']:.2f} ms, held open {best['held open']:.3f} ms "
+          f"({best['per call'] / best['held open']:.0f}x faster; {len(items)} read); differ: {differ}")  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("results", nargs="?", default="results")
@@ -64,7 +94,7 @@ def main() -> None:
         best = {"per window": np.inf, "held open": np.inf}
         differ = 0
         for _ in range(args.rounds):
-            data._open_events.clear()  # each round opens its files again: their opening is counted
+            data._open_files.clear()  # each round opens its files again: their opening is counted
             results = {}
             for variant, read in (("per window", per_window), ("held open", held_open)):
                 start = time.perf_counter()
@@ -74,6 +104,17 @@ def main() -> None:
         ratio = best["per window"] / best["held open"]
         print(f"{name:>9}: per window {best['per window']:.2f} ms, held open {best['held open']:.3f} ms "
               f"({ratio:.0f}x faster); windows that differ: {differ}")  # fmt: skip
+    landings = list(open_dataset(args.results))
+    fields, frames = [], []
+    for landing in landings:
+        with MotionFieldReader(landing.folder / "motion_field.h5") as reader:
+            fields += [(landing, i) for i in range(reader.n_fields)]
+        with FramesFile(landing.folder / "frames.h5") as f:
+            frames += [(landing, k) for k in range(f.n_poses)]
+    held_field = lambda landing, i: b"".join(v.tobytes() for v in landing.motion_field(i).values())  # noqa: E731
+    held_frame = lambda landing, k: b"".join(x.tobytes() for x in landing.frame(k))  # noqa: E731
+    compare_reads("motion fields", fields, field_per_call, held_field, args.rounds)
+    compare_reads("frames", frames, frame_per_call, held_frame, args.rounds)
 
 
 if __name__ == "__main__":

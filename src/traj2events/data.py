@@ -13,7 +13,7 @@
     radiance, depth = landing.frame(100)     # frames.h5, when kept
 
 Each `Landing` reads only what is asked, when it is asked (event windows through
-`ms_to_idx`, from an events.h5 this process keeps open: `events_reader`), so a dataset far
+`ms_to_idx`; each file opened once per process: `held_open`), so a dataset far
 larger than memory iterates fine; a torch `DataLoader`
 can wrap `EventWindows` (map-style: `len` and `[i]`) without this module importing torch.
 """
@@ -24,43 +24,45 @@ import csv
 import os
 import threading
 from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
-import h5py
 import numpy as np
 
 from .formats.events import EventsReader
+from .formats.flow import MotionFieldReader
 from .formats.frames import FramesFile
-from .formats.hdf5 import open_file
 from .formats.imu import read_imu
 from .formats.trajectory import read_trajectory
 
-# events.h5 files this process holds open (EventsReader), the most recently read last: a
-# window then costs its slices, not an opening. Keyed by the process too, so that a
-# DataLoader's forked workers open their own; and by the file's identity, so that a file
-# built again is read anew.
-MAX_OPEN_EVENTS_FILES = 8
-_open_events: OrderedDict[tuple, EventsReader] = OrderedDict()
-_open_events_lock = threading.Lock()
+# Files this process holds open (events.h5, motion_field.h5, frames.h5 readers), the most
+# recently read last: a read then costs its slices, not an opening and its check. Keyed by
+# the process too, so that a DataLoader's forked workers open their own; and by the file's
+# identity, so that a file built again is read anew.
+MAX_OPEN_FILES = 16
+Reader = TypeVar("Reader")
+_open_files: OrderedDict[tuple, object] = OrderedDict()
+_open_files_lock = threading.Lock()
 
 
-def events_reader(path: Path) -> EventsReader:
-    """This process's open reader of the events.h5 at `path` (opened on first use; the
-    least recently used let go beyond MAX_OPEN_EVENTS_FILES)."""
+def held_open(path: Path, reader: Callable[[Path], Reader]) -> Reader:
+    """This process's `reader(path)`, opened on first use and kept (the least recently used
+    let go beyond MAX_OPEN_FILES)."""
     try:
         stat = path.stat()
     except FileNotFoundError:
-        return EventsReader(path)  # raises, naming the file and what was expected
-    key = (os.getpid(), str(path), stat.st_dev, stat.st_ino, stat.st_mtime_ns, stat.st_size)
-    with _open_events_lock:
-        reader = _open_events.get(key)
-        if reader is None:
-            reader = _open_events[key] = EventsReader(path)
-            while len(_open_events) > MAX_OPEN_EVENTS_FILES:
-                _open_events.popitem(last=False)  # closed by h5py once no thread reads from it
-        _open_events.move_to_end(key)
-        return reader
+        return reader(path)  # raises, naming the file and what was expected
+    key = (os.getpid(), reader, str(path), stat.st_dev, stat.st_ino, stat.st_mtime_ns, stat.st_size)
+    with _open_files_lock:
+        held = _open_files.get(key)
+        if held is None:
+            held = _open_files[key] = reader(path)
+            while len(_open_files) > MAX_OPEN_FILES:
+                _open_files.popitem(last=False)  # closed by h5py once no thread reads from it
+        _open_files.move_to_end(key)
+        return held
 
 
 @dataclass(frozen=True)
@@ -114,40 +116,34 @@ class Landing:
 
     def _scene_attrs(self) -> dict:
         if (self.folder / "events.h5").exists():
-            return events_reader(self.folder / "events.h5").attrs
-        with FramesFile(self.folder / "frames.h5") as frames:
-            return dict(frames.attrs)
+            return held_open(self.folder / "events.h5", EventsReader).attrs
+        return dict(held_open(self.folder / "frames.h5", FramesFile).attrs)
 
     def events(self, t_start_s: float, t_end_s: float) -> np.ndarray:
         """Events with t in [t_start, t_end) s: structured x, y, t (us), p (1 = ON)."""
-        return events_reader(self.folder / "events.h5").window(round(t_start_s * 1e6), round(t_end_s * 1e6))
+        return held_open(self.folder / "events.h5", EventsReader).window(round(t_start_s * 1e6), round(t_end_s * 1e6))
 
     def labelled_events(self, t_start_s: float, t_end_s: float) -> tuple[np.ndarray, np.ndarray]:
         """As `events`, and each event's cause (uint8: 0 signal, 1 shot_noise, 2 leak,
         3 hot_pixel; `formats.events.EVENT_LABELS`), when the dataset was built with labels."""
-        reader = events_reader(self.folder / "events.h5")
+        reader = held_open(self.folder / "events.h5", EventsReader)
         return reader.labelled_window(round(t_start_s * 1e6), round(t_end_s * 1e6))
 
     def motion_field(self, i: int) -> dict[str, np.ndarray]:
         """The i-th written field: every dataset of motion_field.h5 at index i (and `t`,
         `frame_index`), e.g. `displacement_terrain` (H, W, 2) px and `status_terrain`."""
-        with open_file(self.folder / "motion_field.h5", "motion_field.h5") as f:
-            n = len(f["t"])
-            if not -n <= i < n:
-                raise IndexError(f"{self.folder / 'motion_field.h5'}: field {i} of {n}")
-            return {name: f[name][i] for name in f if isinstance(f[name], h5py.Dataset) and len(f[name]) == n}
+        return held_open(self.folder / "motion_field.h5", MotionFieldReader).field(i)
 
     def range_meter(self) -> tuple[np.ndarray, np.ndarray]:
         """The range meter at every pose (motion_field.h5): t (s) and the slant range along
         the central pixel's ray to the rendered terrain (m, 0 = sky)."""
-        with open_file(self.folder / "motion_field.h5", "motion_field.h5") as f:
-            return f["range_meter/t"][()], f["range_meter/slant_range_m"][()]
+        return held_open(self.folder / "motion_field.h5", MotionFieldReader).range_meter()
 
     def frame(self, k: int) -> tuple[np.ndarray, np.ndarray]:
         """Pose k's frame: linear radiance (H, W) W m^-2 sr^-1 and depth (H, W) m (frames.h5 kept)."""
-        with FramesFile(self.folder / "frames.h5") as frames:
-            row = frames.row_of_pose(k)
-            return frames.radiance(row), frames.depth_m(row)
+        frames = held_open(self.folder / "frames.h5", FramesFile)
+        row = frames.row_of_pose(k)
+        return frames.radiance(row), frames.depth_m(row)
 
 
 class Dataset:

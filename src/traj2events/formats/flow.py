@@ -12,7 +12,15 @@ import h5py
 import numpy as np
 
 from .atomic import atomic_output
-from .hdf5 import ChunkWriter, create, large_dataset_filters, mark_compression, write_dataset
+from .hdf5 import (
+    ChunkWriter,
+    create,
+    large_dataset_filters,
+    mark_compression,
+    open_for_reading,
+    read_errors_named,
+    write_dataset,
+)
 
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
@@ -76,3 +84,43 @@ def motion_field_file(
             )
             writers[name] = ChunkWriter(dataset) if n else None
         yield f, writers
+
+
+class MotionFieldReader:
+    """motion_field.h5 open for many reads, checked once at opening: field i's datasets by
+    name (`field`), the range meter (`range_meter`)."""
+
+    def __init__(self, path: str | os.PathLike):
+        self.path = path
+        self._file = open_for_reading(path, "motion_field.h5")
+        try:
+            with read_errors_named(path, "motion_field.h5"):
+                self.n_fields = n = len(self._file["t"])
+                # Every dataset with a row per field (t and frame_index too), held open.
+                self._fields = {
+                    name: obj for name, obj in self._file.items() if isinstance(obj, h5py.Dataset) and len(obj) == n
+                }
+        except BaseException:
+            self._file.close()
+            raise
+
+    def field(self, i: int) -> dict[str, np.ndarray]:
+        """Field i (negative: from the end): every per-field dataset's row i, by name."""
+        if not -self.n_fields <= i < self.n_fields:
+            raise IndexError(f"{self.path}: field {i} of {self.n_fields}")
+        with read_errors_named(self.path, "motion_field.h5"):
+            return {name: dataset[i] for name, dataset in self._fields.items()}
+
+    def range_meter(self) -> tuple[np.ndarray, np.ndarray]:
+        """t (s) at every pose, and the slant range (m, 0 = sky) along the central pixel's ray."""
+        with read_errors_named(self.path, "motion_field.h5"):
+            return self._file["range_meter/t"][()], self._file["range_meter/slant_range_m"][()]
+
+    def close(self) -> None:
+        self._file.close()
+
+    def __enter__(self) -> MotionFieldReader:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
