@@ -58,6 +58,14 @@ def field_per_call(landing, i: int) -> bytes:
         return b"".join(v.tobytes() for v in reader.field(i).values())
 
 
+def field_held(landing, i: int) -> bytes:
+    return b"".join(v.tobytes() for v in landing.motion_field(i).values())
+
+
+def frame_held(landing, k: int) -> bytes:
+    return b"".join(x.tobytes() for x in landing.frame(k))
+
+
 def frame_per_call(landing, k: int) -> bytes:
     with FramesFile(landing.folder / "frames.h5") as frames:
         row = frames.row_of_pose(k)
@@ -111,10 +119,8 @@ def main() -> None:
             fields += [(landing, i) for i in range(reader.n_fields)]
         with FramesFile(landing.folder / "frames.h5") as f:
             frames += [(landing, k) for k in range(f.n_poses)]
-    held_field = lambda landing, i: b"".join(v.tobytes() for v in landing.motion_field(i).values())  # noqa: E731
-    held_frame = lambda landing, k: b"".join(x.tobytes() for x in landing.frame(k))  # noqa: E731
-    compare_reads("motion fields", fields, field_per_call, held_field, args.rounds)
-    compare_reads("frames", frames, frame_per_call, held_frame, args.rounds)
+    compare_reads("motion fields", fields, field_per_call, field_held, args.rounds)
+    compare_reads("frames", frames, frame_per_call, frame_held, args.rounds)
 
 
 if __name__ == "__main__":

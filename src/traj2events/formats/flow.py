@@ -14,10 +14,10 @@ import numpy as np
 from .atomic import atomic_output
 from .hdf5 import (
     ChunkWriter,
+    HeldFile,
     create,
     large_dataset_filters,
     mark_compression,
-    open_for_reading,
     read_errors_named,
     write_dataset,
 )
@@ -86,15 +86,14 @@ def motion_field_file(
         yield f, writers
 
 
-class MotionFieldReader:
+class MotionFieldReader(HeldFile):
     """motion_field.h5 open for many reads, checked once at opening: field i's datasets by
     name (`field`), the range meter (`range_meter`)."""
 
     def __init__(self, path: str | os.PathLike):
-        self.path = path
-        self._file = open_for_reading(path, "motion_field.h5")
+        super().__init__(path, "motion_field.h5")
         try:
-            with read_errors_named(path, "motion_field.h5"):
+            with read_errors_named(path, self.expected):
                 self.n_fields = n = len(self._file["t"])
                 # Every dataset with a row per field (t and frame_index too), held open.
                 self._fields = {
@@ -108,19 +107,10 @@ class MotionFieldReader:
         """Field i (negative: from the end): every per-field dataset's row i, by name."""
         if not -self.n_fields <= i < self.n_fields:
             raise IndexError(f"{self.path}: field {i} of {self.n_fields}")
-        with read_errors_named(self.path, "motion_field.h5"):
+        with read_errors_named(self.path, self.expected):
             return {name: dataset[i] for name, dataset in self._fields.items()}
 
     def range_meter(self) -> tuple[np.ndarray, np.ndarray]:
         """t (s) at every pose, and the slant range (m, 0 = sky) along the central pixel's ray."""
-        with read_errors_named(self.path, "motion_field.h5"):
+        with read_errors_named(self.path, self.expected):
             return self._file["range_meter/t"][()], self._file["range_meter/slant_range_m"][()]
-
-    def close(self) -> None:
-        self._file.close()
-
-    def __enter__(self) -> MotionFieldReader:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()

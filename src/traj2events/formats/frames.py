@@ -27,10 +27,10 @@ from .hdf5 import (
     ChunkReader,
     ChunkWriter,
     FileFormatError,
+    HeldFile,
     create,
     large_dataset_filters,
     mark_compression,
-    open_for_reading,
     set_attrs,
     write_dataset,
     write_errors_named,
@@ -154,14 +154,13 @@ class FramesWriter:
         return self._context.__exit__(*exc)
 
 
-class FramesFile:
+class FramesFile(HeldFile):
     """frames.h5 opened for reading: `t`, `frame_index`, `attrs`, (n, H, W) `shape`, and
     frames or depth read one at a time or in chunks (memory stays bounded). Rows count
     every rendered frame; `row_of_pose(k)` is the row of trajectory pose k."""
 
     def __init__(self, path: str | os.PathLike):
-        self.path = Path(path)
-        self._file = open_for_reading(self.path, "frames.h5")
+        super().__init__(Path(path), "frames.h5")
         if not ("radiance" in self._file or "depth_m" in self._file) or "t" not in self._file:
             self._file.close()
             raise FileFormatError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' or 'depth_m', and 't')")
@@ -234,12 +233,3 @@ class FramesFile:
             buffer = ring[n % buffers]
             radiance.read_direct(buffer, np.s_[start : start + k], np.s_[:k])
             yield buffer[:k], self.t[start : start + k]
-
-    def close(self) -> None:
-        self._file.close()
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.close()

@@ -119,7 +119,7 @@ class Attributes(dict):
 def open_for_reading(path: str | os.PathLike, expected: str, chunk_cache_bytes: int | None = None) -> h5py.File:
     """An HDF5 file opened for reading; a missing, unreadable or truncated file is an
     error that names the file and what was expected. `chunk_cache_bytes`: HDF5's cache of
-    decompressed chunks, per dataset (None: h5py's 1 MiB)."""
+    decompressed chunks, per dataset (None: h5py's default)."""
     import hdf5plugin  # noqa: F401  (registers Blosc: events.h5 and motion_field.h5 use it)
 
     if not Path(path).is_file():
@@ -180,6 +180,24 @@ def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
             yield f
     finally:
         f.close()
+
+
+class HeldFile:
+    """An HDF5 file held open for many reads (FramesFile, EventsReader, MotionFieldReader):
+    opened and checked once by open_for_reading; closed by `close` or at the end of a `with`."""
+
+    def __init__(self, path: str | os.PathLike, expected: str, chunk_cache_bytes: int | None = None):
+        self.path, self.expected = path, expected
+        self._file = open_for_reading(path, expected, chunk_cache_bytes)
+
+    def close(self) -> None:
+        self._file.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 @contextlib.contextmanager
