@@ -53,14 +53,13 @@ def test_closures_follow_the_imports():
 
 @pytest.mark.parametrize("stage", STAGES)
 def test_no_stage_depends_on_the_command_line_or_config_loading(stage):
-    assert not {"cli", "config"} & short(import_closure(f"traj2events.stages.{stage}"))
+    # Nor on this module, which the render's tile cache imports for its key.
+    assert not {"cli", "config", "fingerprint"} & short(import_closure(f"traj2events.stages.{stage}"))
 
 
 def test_render_fingerprint_includes_the_shaders():
-    import ast
-
     path = fingerprint.module_path("traj2events.renderer.draw")
-    assert {p.name for p in fingerprint.data_files(ast.parse(path.read_text()), path.parent)} == {
+    assert {p.name for p in fingerprint.data_files(fingerprint.read_source(path.read_text()), path.parent)} == {
         "terrain.vert",
         "terrain.frag",
         "terrain_textured.vert",
@@ -97,6 +96,8 @@ def test_comments_docstrings_and_formatting_change_nothing(package_copy):
     package_copy(
         "cli.py", "def cmd_events(args) -> int:", "def cmd_events(args) -> int:  # a real edit, but in the CLI"
     )
+    digest = "    digest = hashlib.sha256()\n"
+    package_copy("fingerprint.py", digest, digest + "    digest.update(b'')\n")  # code, but the fingerprint's
     assert all_fingerprints() == before
 
 
@@ -124,3 +125,15 @@ def test_a_stages_settings_rerun_that_stage_and_not_the_others(package_copy):
     again = all_fingerprints()
     changed = {s for s in STAGES if again[s] != after[s]}
     assert {"base_solution", "sample_trajectories"} <= changed and not {"render", "events", "motion_field"} & changed
+
+
+def test_each_module_is_parsed_once_for_all_the_stages(package_copy):
+    # The Snakefile asks for every rule's fingerprint; their closures share most modules.
+    fingerprint.read_source.cache_clear()
+    before = all_fingerprints()
+    modules = set().union(*(import_closure(f"traj2events.stages.{stage}") for stage in STAGES))
+    assert fingerprint.read_source.cache_info().misses == len(modules)
+    # An edited module is read anew (its text is the key), the others from the cache.
+    package_copy("sensor/pixel.py", "two_pi_dt = 2.0 * np.pi * dt", "two_pi_dt = 6.3 * dt")
+    assert all_fingerprints()["events"] != before["events"]
+    assert fingerprint.read_source.cache_info().misses == len(modules) + 1

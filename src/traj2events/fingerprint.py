@@ -2,20 +2,28 @@
 runs changes, not when a comment, a docstring or the command line's help text does.
 
 A stage module's fingerprint hashes its import closure inside this package (every module
-it imports, directly or not, at module level or inside functions), each as its syntax
-tree without docstrings (comments are not in the tree), plus the package's data files a
-module names (the shaders). The YAML files are left out: their values reach the rules as
-config, through `params`.
+it imports, directly or not, at module level or inside functions; this module aside),
+each as its syntax tree without docstrings (comments are not in the tree), plus the
+package's data files a module names (the shaders). The YAML files are left out: their
+values reach the rules as config, through `params`.
+
+Each source text is parsed once per process (`read_source`, keyed by the text): the
+Snakefile asks for 15 rules' fingerprints, whose closures share most modules.
 """
 
 from __future__ import annotations
 
 import ast
+import functools
 import hashlib
+from dataclasses import dataclass
 from pathlib import Path
 
 PACKAGE = "traj2events"
 PACKAGE_DIR = Path(__file__).resolve().parent
+# This module names code and computes none of a stage's output (the tile cache imports it
+# for its key): left out of every closure, so that its edits rerun nothing.
+NOT_IN_CLOSURES = {f"{PACKAGE}.fingerprint"}
 
 
 def module_path(name: str) -> Path | None:
@@ -32,29 +40,81 @@ def _package_of(name: str, path: Path) -> str:
     return name if path.name == "__init__.py" else name.rpartition(".")[0]
 
 
-def imported_modules(name: str, tree: ast.AST, path: Path) -> set[str]:
-    """The package's modules that `tree` (module `name`) imports, anywhere in its body."""
+@dataclass(frozen=True)
+class Source:
+    """What the fingerprint needs of one module's text."""
+
+    imports: tuple[tuple[int, str, tuple[str, ...]], ...]  # (level, module, names) of each import
+    strings: tuple[str, ...]  # the short one-line strings, which may name a data file
+    code: bytes  # the syntax tree without docstrings, dumped
+
+
+DEFINITIONS = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)  # what may have a docstring
+
+
+@functools.lru_cache(maxsize=1024)
+def read_source(text: str) -> Source:
+    """A module's text, parsed once: its imports, its short strings and its code, all
+    without its docstrings."""
+    tree = ast.parse(text)
+    imports, strings = [], set()
+    todo: list[ast.AST] = [tree]
+    while todo:  # ast.walk's visit, with each docstring cut before its node's children are seen
+        node = todo.pop()
+        if isinstance(node, DEFINITIONS) and _has_docstring(node):
+            node.body = node.body[1:] or [ast.Pass()]
+        if isinstance(node, ast.Import):
+            imports.extend((0, a.name, ()) for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            imports.append((node.level, node.module or "", tuple(a.name for a in node.names)))
+        elif (
+            isinstance(node, ast.Constant)
+            and isinstance(node.value, str)
+            and node.value
+            and len(node.value) < 256  # a file name, not a docstring or a message
+            and "/" not in node.value
+            and "\n" not in node.value
+            and not node.value.startswith(".")
+        ):
+            strings.add(node.value)
+        todo.extend(ast.iter_child_nodes(node))
+    return Source(tuple(imports), tuple(sorted(strings)), ast.dump(tree).encode())
+
+
+def _has_docstring(node: ast.AST) -> bool:
+    body = node.body
+    return (
+        bool(body)
+        and isinstance(body[0], ast.Expr)
+        and isinstance(body[0].value, ast.Constant)
+        and isinstance(body[0].value.value, str)
+    )
+
+
+def imported_modules(name: str, source: Source, path: Path) -> set[str]:
+    """The package's modules that module `name` (at `path`) imports, anywhere in its body."""
     found: set[str] = set()
     package = _package_of(name, path)
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            found.update(a.name for a in node.names if a.name.split(".")[0] == PACKAGE)
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")
-                base = base[: len(base) - (node.level - 1)]
-                target = ".".join(base + ([node.module] if node.module else []))
-            else:
-                target = node.module or ""
-            if target.split(".")[0] != PACKAGE:
-                continue
-            found.add(target)
-            found.update(f"{target}.{a.name}" for a in node.names if module_path(f"{target}.{a.name}"))
+    for level, module, names in source.imports:
+        if not level and not names:  # import a.b
+            if module.split(".")[0] == PACKAGE:
+                found.add(module)
+            continue
+        if level:
+            base = package.split(".")
+            base = base[: len(base) - (level - 1)]
+            target = ".".join(base + ([module] if module else []))
+        else:
+            target = module
+        if target.split(".")[0] != PACKAGE:
+            continue
+        found.add(target)
+        found.update(f"{target}.{n}" for n in names if module_path(f"{target}.{n}"))
     # A submodule import runs its packages' __init__ too.
     for module in list(found):
         parts = module.split(".")
         found.update(".".join(parts[:i]) for i in range(1, len(parts)))
-    return {m for m in found if module_path(m) is not None}
+    return {m for m in found if m not in NOT_IN_CLOSURES and module_path(m) is not None}
 
 
 def import_closure(name: str) -> list[str]:
@@ -69,43 +129,20 @@ def import_closure(name: str) -> list[str]:
         if path is None:
             raise ValueError(f"{module}: not a module of {PACKAGE}")
         seen.add(module)
-        todo.extend(imported_modules(module, ast.parse(path.read_text()), path) - seen)
+        todo.extend(imported_modules(module, read_source(path.read_text()), path) - seen)
     return sorted(seen)
 
 
-def _without_docstrings(tree: ast.AST) -> ast.AST:
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
-            body = node.body
-            if (
-                body
-                and isinstance(body[0], ast.Expr)
-                and isinstance(body[0].value, ast.Constant)
-                and isinstance(body[0].value.value, str)
-            ):
-                node.body = body[1:] or [ast.Pass()]
-    return tree
-
-
-def data_files(tree: ast.AST, folder: Path = PACKAGE_DIR) -> list[Path]:
+def data_files(source: Source, folder: Path = PACKAGE_DIR) -> list[Path]:
     """Package data (files, or the files of a folder) named by a string in the code of a
     module in `folder`; YAML excluded."""
     files: set[Path] = set()
-    for node in ast.walk(tree):
-        if (
-            isinstance(node, ast.Constant)
-            and isinstance(node.value, str)
-            and node.value
-            and len(node.value) < 256  # a file name, not a docstring or a message
-            and "/" not in node.value
-            and "\n" not in node.value
-            and not node.value.startswith(".")
-        ):
-            candidate = folder / node.value
-            if candidate.is_dir() and not (candidate / "__init__.py").exists():
-                files.update(p for p in candidate.iterdir() if p.is_file())
-            elif candidate.is_file() and candidate.suffix not in (".py", ".yaml"):
-                files.add(candidate)
+    for name in source.strings:
+        candidate = folder / name
+        if candidate.is_dir() and not (candidate / "__init__.py").exists():
+            files.update(p for p in candidate.iterdir() if p.is_file())
+        elif candidate.is_file() and candidate.suffix not in (".py", ".yaml"):
+            files.add(candidate)
     return sorted(files)
 
 
@@ -113,8 +150,9 @@ def code_fingerprint(name: str) -> str:
     """16 hex digits that change when the code module `name` runs changes (see above)."""
     digest = hashlib.sha256()
     for module in import_closure(name):
-        tree = ast.parse(module_path(module).read_text())
-        digest.update(module.encode() + b"\0" + ast.dump(_without_docstrings(tree)).encode() + b"\0")
-        for path in data_files(tree, module_path(module).parent):
-            digest.update(path.relative_to(PACKAGE_DIR).as_posix().encode() + b"\0" + path.read_bytes())
+        path = module_path(module)
+        source = read_source(path.read_text())
+        digest.update(module.encode() + b"\0" + source.code + b"\0")
+        for data in data_files(source, path.parent):
+            digest.update(data.relative_to(PACKAGE_DIR).as_posix().encode() + b"\0" + data.read_bytes())
     return digest.hexdigest()[:16]
