@@ -53,7 +53,7 @@ def test_closures_follow_the_imports():
 
 @pytest.mark.parametrize("stage", STAGES)
 def test_no_stage_depends_on_the_command_line_or_config_loading(stage):
-    # Nor on this module, which the render's tile cache imports for its key.
+    # Nor on fingerprint.py, which the render's tile cache imports for its key.
     assert not {"cli", "config", "fingerprint"} & short(import_closure(f"traj2events.stages.{stage}"))
 
 
