@@ -58,8 +58,8 @@ def test_no_stage_depends_on_the_command_line_or_config_loading(stage):
 
 
 def test_render_fingerprint_includes_the_shaders():
-    path = fingerprint.module_path("traj2events.renderer.draw")
-    assert {p.name for p in fingerprint.data_files(fingerprint.read_source(path.read_text()), path.parent)} == {
+    path, source = fingerprint.module_source("traj2events.renderer.draw")
+    assert {p.name for p in fingerprint.data_files(source, path.parent)} == {
         "terrain.vert",
         "terrain.frag",
         "terrain_textured.vert",

@@ -117,6 +117,14 @@ def imported_modules(name: str, source: Source, path: Path) -> set[str]:
     return {m for m in found if m not in NOT_IN_CLOSURES and module_path(m) is not None}
 
 
+def module_source(module: str) -> tuple[Path, Source]:
+    """A package module's file and its parsed text."""
+    path = module_path(module)
+    if path is None:
+        raise ValueError(f"{module}: not a module of {PACKAGE}")
+    return path, read_source(path.read_text())
+
+
 def import_closure(name: str) -> list[str]:
     """`name` and every package module it imports, directly or not, sorted."""
     seen: set[str] = set()
@@ -125,11 +133,9 @@ def import_closure(name: str) -> list[str]:
         module = todo.pop()
         if module in seen:
             continue
-        path = module_path(module)
-        if path is None:
-            raise ValueError(f"{module}: not a module of {PACKAGE}")
+        path, source = module_source(module)
         seen.add(module)
-        todo.extend(imported_modules(module, read_source(path.read_text()), path) - seen)
+        todo.extend(imported_modules(module, source, path) - seen)
     return sorted(seen)
 
 
@@ -150,8 +156,7 @@ def code_fingerprint(name: str) -> str:
     """16 hex digits that change when the code module `name` runs changes (see above)."""
     digest = hashlib.sha256()
     for module in import_closure(name):
-        path = module_path(module)
-        source = read_source(path.read_text())
+        path, source = module_source(module)
         digest.update(module.encode() + b"\0" + source.code + b"\0")
         for data in data_files(source, path.parent):
             digest.update(data.relative_to(PACKAGE_DIR).as_posix().encode() + b"\0" + data.read_bytes())
