@@ -213,15 +213,17 @@ class EventsReader(HeldFile):
 
     def __init__(self, path: str | os.PathLike):
         super().__init__(path, EXPECTED, self.CHUNK_CACHE_BYTES)
-
-    def _read_at_opening(self) -> None:
-        with read_errors_named(self.path, EXPECTED):
-            self.attrs = Attributes(self.path, self._file.attrs)
-            self.t_offset_us = int(self._file["t_offset"][()])
-            self.ms_to_idx = self._file["ms_to_idx"][()]
-            # Held open: a dataset's chunk cache lives as long as the dataset does.
-            self._columns = dict(self._file["events"].items())
-            self.n_events = len(self._columns["t"])
+        try:
+            with read_errors_named(path, EXPECTED):
+                self.attrs = Attributes(path, self._file.attrs)
+                self.t_offset_us = int(self._file["t_offset"][()])
+                self.ms_to_idx = self._file["ms_to_idx"][()]
+                # Held open: a dataset's chunk cache lives as long as the dataset does.
+                self._columns = dict(self._file["events"].items())
+                self.n_events = len(self._columns["t"])
+        except BaseException:
+            self._file.close()
+            raise
 
     def window(self, t_start_us: int, t_end_us: int) -> np.ndarray:
         """Events with t in [t_start, t_end) (absolute us)."""

@@ -92,14 +92,16 @@ class MotionFieldReader(HeldFile):
 
     def __init__(self, path: str | os.PathLike):
         super().__init__(path, "motion_field.h5")
-
-    def _read_at_opening(self) -> None:
-        with read_errors_named(self.path, self.expected):
-            self.n_fields = n = len(self._file["t"])
-            # Every dataset with a row per field (t and frame_index too), held open.
-            self._fields = {
-                name: obj for name, obj in self._file.items() if isinstance(obj, h5py.Dataset) and len(obj) == n
-            }
+        try:
+            with read_errors_named(path, self.expected):
+                self.n_fields = n = len(self._file["t"])
+                # Every dataset with a row per field (t and frame_index too), held open.
+                self._fields = {
+                    name: obj for name, obj in self._file.items() if isinstance(obj, h5py.Dataset) and len(obj) == n
+                }
+        except BaseException:
+            self._file.close()
+            raise
 
     def field(self, i: int) -> dict[str, np.ndarray]:
         """Field i (negative: from the end): every per-field dataset's row i, by name."""

@@ -161,15 +161,15 @@ class FramesFile(HeldFile):
 
     def __init__(self, path: str | os.PathLike):
         super().__init__(Path(path), "frames.h5")
-
-    def _read_at_opening(self) -> None:
         if not ("radiance" in self._file or "depth_m" in self._file) or "t" not in self._file:
+            self._file.close()
             raise FileFormatError(f"{self.path}: not a frames.h5 (expected datasets 'radiance' or 'depth_m', and 't')")
         self.t = self._file["t"][()]
         self.attrs = Attributes(self.path, self._file.attrs)
         self.has_radiance = "radiance" in self._file
         self.shape = self._file["radiance" if self.has_radiance else "depth_m"].shape
         if len(self.shape) != 3 or len(self.t) != self.shape[0]:
+            self._file.close()
             raise FileFormatError(f"{self.path}: radiance has shape {self.shape}, expected ({len(self.t)}, H, W)")
         # Frames are decompressed straight into their arrays (formats.hdf5.ChunkReader).
         self._radiance = ChunkReader(self._file["radiance"]) if self.has_radiance else None
@@ -177,6 +177,7 @@ class FramesFile(HeldFile):
         self.frame_index = self._file["frame_index"][()] if "frame_index" in self._file else np.arange(len(self.t))
         self._pose_rows = np.flatnonzero(self.frame_index >= 0)
         if not np.array_equal(self.frame_index[self._pose_rows], np.arange(len(self._pose_rows))):
+            self._file.close()
             raise FileFormatError(f"{self.path}: frame_index: expected poses 0, 1, 2, ... in order (and -1)")
 
     @property

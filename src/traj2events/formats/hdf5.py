@@ -184,20 +184,11 @@ def open_file(path: str | os.PathLike, expected: str) -> Iterator[h5py.File]:
 
 class HeldFile:
     """An HDF5 file held open for many reads (FramesFile, EventsReader, MotionFieldReader):
-    opened by open_for_reading and checked once, by the reader's `_read_at_opening`, which
-    closes the file again if the check fails; closed by `close` or at the end of a `with`."""
+    opened and checked once by open_for_reading; closed by `close` or at the end of a `with`."""
 
     def __init__(self, path: str | os.PathLike, expected: str, chunk_cache_bytes: int | None = None):
         self.path, self.expected = path, expected
         self._file = open_for_reading(path, expected, chunk_cache_bytes)
-        try:
-            self._read_at_opening()
-        except BaseException:
-            self._file.close()
-            raise
-
-    def _read_at_opening(self) -> None:
-        """What the reader checks and keeps in memory once, at opening (none here)."""
 
     def close(self) -> None:
         self._file.close()
