@@ -5,10 +5,10 @@
 Every window of every landing (traj2events.data.EventWindows, as docs/dataset.md's
 DataLoader example reads them), in order and shuffled, read two ways, alternated round by
 round in one process:
-- `per window`: `formats.events.read_events_window`, which opens events.h5, checks every
+- `per call`: `formats.events.read_events_window`, which opens events.h5, checks every
   header and attribute, and decompresses each column's chunk, every call;
 - `held open`: `Landing.events` (with `landing.image_size`, as the example asks for it),
-  through the files this process holds open (data.events_reader): checked once, chunks
+  through the files this process holds open (data.held_open): checked once, chunks
   cached.
 Prints the best round's milliseconds per window of each, their ratio, and the windows
 whose events differ between the two (the error: it must be 0). Then the same for every
@@ -35,22 +35,16 @@ from traj2events.formats.flow import MotionFieldReader  # noqa: E402
 from traj2events.formats.frames import FramesFile  # noqa: E402
 
 
-def per_window(windows: EventWindows, order: np.ndarray) -> list[bytes]:
-    out = []
-    for i in order:
-        landing, start = windows.items[i]
-        path = landing.folder / "events.h5"
-        out.append(read_events_window(path, round(start * 1e6), round((start + windows.window_s) * 1e6)).tobytes())
-    return out
+def window_per_call(windows: EventWindows, i: int) -> bytes:
+    landing, start = windows.items[i]
+    path = landing.folder / "events.h5"
+    return read_events_window(path, round(start * 1e6), round((start + windows.window_s) * 1e6)).tobytes()
 
 
-def held_open(windows: EventWindows, order: np.ndarray) -> list[bytes]:
-    out = []
-    for i in order:
-        events, _, landing = windows[i]
-        landing.image_size
-        out.append(events.tobytes())
-    return out
+def window_held(windows: EventWindows, i: int) -> bytes:
+    events, _, landing = windows[i]
+    landing.image_size
+    return events.tobytes()
 
 
 def field_per_call(landing, i: int) -> bytes:
@@ -73,14 +67,15 @@ def frame_per_call(landing, k: int) -> bytes:
 
 
 def compare_reads(name: str, items: list, per_call, held, rounds: int) -> None:
-    """Every item read per call and through the held files, alternated; best round each."""
+    """Every item (what to read from, index) read per call and through the held files,
+    alternated; best round each. Each round opens its files again: their opening is counted."""
     best = {"per call": np.inf, "held open": np.inf}
     for _ in range(rounds):
         data._open_files.clear()
         results = {}
         for variant, read in (("per call", per_call), ("held open", held)):
             start = time.perf_counter()
-            results[variant] = [read(landing, i) for landing, i in items]
+            results[variant] = [read(source, i) for source, i in items]
             best[variant] = min(best[variant], (time.perf_counter() - start) / len(items) * 1e3)
     differ = sum(a != b for a, b in zip(results["per call"], results["held open"]))
     print(f"{name:>14}: per call {best['per call']:.2f} ms, held open {best['held open']:.3f} ms "
@@ -99,19 +94,7 @@ def main() -> None:
           f"{platform.node()}, Python {platform.python_version()}")  # fmt: skip
     orders = {"in order": np.arange(n), "shuffled": np.random.default_rng(0).permutation(n)}
     for name, order in orders.items():
-        best = {"per window": np.inf, "held open": np.inf}
-        differ = 0
-        for _ in range(args.rounds):
-            data._open_files.clear()  # each round opens its files again: their opening is counted
-            results = {}
-            for variant, read in (("per window", per_window), ("held open", held_open)):
-                start = time.perf_counter()
-                results[variant] = read(windows, order)
-                best[variant] = min(best[variant], (time.perf_counter() - start) / n * 1e3)
-            differ = sum(a != b for a, b in zip(results["per window"], results["held open"]))
-        ratio = best["per window"] / best["held open"]
-        print(f"{name:>9}: per window {best['per window']:.2f} ms, held open {best['held open']:.3f} ms "
-              f"({ratio:.0f}x faster); windows that differ: {differ}")  # fmt: skip
+        compare_reads(f"windows, {name}", [(windows, i) for i in order], window_per_call, window_held, args.rounds)
     landings = list(open_dataset(args.results))
     fields, frames = [], []
     for landing in landings:
