@@ -39,7 +39,9 @@ LOD_BIAS = float(np.log2(1.0 / np.sqrt(3.0)))  # -0.79
 # the pixel's box over level 0's surface (bilinear between level-0 texels: a tent, 1 / 6),
 # the texels' own width (1 / 12 each, as constants; above level 0 once more, as means of
 # the level below) taken out: w_k'^2 = w_k^2 + 1 at level 0, w_k^2 - 2 above, and at least
-# one texel (narrower, a box over constant texels shows their steps). Where the trilinear
+# one texel (narrower, a box over constant texels shows their steps). `- 2` is the limit far
+# above level 0: the exact match, `- 2 + 3 / 4^k`, is 0.75 wider at level 1, and fires fewer
+# events than a 16 x 16 average (docs/rendering.md "Pixel footprint"). Where the trilinear
 # read's tent changes slope at every texel a moving pixel crosses, the box's mean changes
 # only as its edges cross texels (docs/rendering.md "Pixel footprint").
 BOX_MIN_TEXELS = float(np.sqrt(2.0))
