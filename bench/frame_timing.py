@@ -91,7 +91,7 @@ WHOLE = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "
 # --flight: the bounds whose frame counts fall among the fixed rates' (50-400 fps); 1 and 2
 # bring adaptive timing to about fixed 100 fps's frame count.
 FLIGHT = ("adaptive, log 2", "adaptive, log 1", "adaptive, log 0.5 (ESIM)", "adaptive, log 0.2")
-# Clips (two per trajectory): the bounds measured since session 9.
+# Clips (two per trajectory): the bounds docs/events.md reports for clips.
 CLIPS = ("adaptive, log 0.5 (ESIM)", "adaptive, log 0.2", "adaptive, log 0.1", "adaptive, log 0.05", "adaptive, 1 px")
 
 

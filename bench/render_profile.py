@@ -4,7 +4,7 @@
       [--pixels-per-cell 8] [--shading-levels 3]
 
 For bench/render.py's two poses at the default level of detail (render.lod: 8 px per cell
-shaded per pixel 3 levels finer; budget 2 unshaded was the default before session 15),
+shaded per pixel 3 levels finer),
 tiles built beforehand, the median
 milliseconds per frame of `TerrainRenderer.render`, split into its two halves: `_start`
 (tile selection, uploads, issuing the draw and the read-back; the selection alone is also

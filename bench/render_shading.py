@@ -5,8 +5,8 @@ seconds per frame and tile building against image error.
   LP_NUM_THREADS=1 taskset -c 1 python bench/render_shading.py --trajectory results/descent/0000/trajectory.h5 \\
       [--config config/paper.yaml] [--every 250]
 
-Variants are (pixels per cell, shading levels): "8:3" is the default since session 15,
-"2:0" the one before (the law per vertex of 2 px cells). "8:2" draws 8 px cells shaded
+Variants are (pixels per cell, shading levels): "8:3" is the default,
+"2:0" an older one (the law per vertex of 2 px cells). "8:2" draws 8 px cells shaded
 per pixel from a texture 2 levels finer (shading every ~2 px), "8:3" from one 3 levels
 finer (~1 px). The error is against a
 reference at 1 px per cell, shaded per vertex, drawn at --supersample times the size and

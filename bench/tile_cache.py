@@ -7,7 +7,7 @@ At the config's camera size, the tiles every `--every`-th pose of each trajector
 are selected (and so built), and each drawn tile's shading texture made once (when the
 config shades per pixel, `render.lod.shading_levels` > 0), as a render job does. The first
 trajectory fills an empty cache; then the second runs twice, alternated: with that cache,
-with only its heights (the cache before session 16), and without one. For each run: tiles
+with only its heights (an older cache's form), and without one. For each run: tiles
 built (terrain evaluated), tiles read from the cache, shading textures made and read,
 seconds, cache size on disk; and whether the cached run's drawn tiles (vertices) and
 textures are the same bytes as the uncached run's.
@@ -36,7 +36,7 @@ from traj2events.stages.render import RenderSettings  # noqa: E402
 def fly(trajectory: Path, config: dict, every: int, cache: Path | None, textures_cached: bool = True):
     """(tiles, {drawn key: its shading texture's digest}, seconds) of selecting every
     `every`-th pose's tiles and making each drawn tile's shading texture once;
-    `textures_cached` False: the cache keeps heights only (as before session 16)."""
+    `textures_cached` False: the cache keeps heights only (an older cache's form)."""
     tr = read_trajectory(trajectory)
     camera, tiles, _, _ = RenderSettings.from_config(config, str(tr.attrs["scenario"])).build(cache)
     if not textures_cached:

@@ -71,7 +71,7 @@ def test_supersampling_plans_its_drawn_pixels_cpu_and_memory():
 
 def test_default_dataset_plan_is_near_what_it_measured():
     # Measured 2026-11-23 (docs/performance.md): 18 671 frames, ~5 min of rendering on one core;
-    # session 9 (sensor model, stars): 19 115 frames, 1.59 GB under results/.
+    # with the sensor model and stars: 19 115 frames, 1.59 GB under results/.
     plan = dataset_plan(load_config(ROOT / "config" / "config.yaml"))
     assert 0.9 < plan.frames / 18_671 < 1.25
     assert 0.8 < plan.total_disk_bytes / 1.59e9 < 1.3

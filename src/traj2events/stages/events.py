@@ -39,8 +39,8 @@ from ..video import iter_video, video_info
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".tif", ".tiff", ".bmp")
 
 # Frames read at a time. Each interval's events are emulated and written as it comes, so
-# a chunk only batches the reading; a 1024^2 float32 chunk of 16 is 64 MB, and 64 (before
-# session 18) cost ~0.2 GB more memory and ~0.4 s of page faults per job for no speed.
+# a chunk only batches the reading; a 1024^2 float32 chunk of 16 is 64 MB; 64 frames
+# cost ~0.2 GB more memory and ~0.4 s of page faults per job for no speed.
 CHUNK_FRAMES = 16
 SENSOR_KIND = "linear radiance as photocurrent (events.sensor)"  # a FrameSource's kind through the sensor
 # Chunks in memory at once: the one being emulated and the next, read meanwhile.
