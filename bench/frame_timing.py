@@ -4,6 +4,7 @@
       [--size 512] [--reference-fps 2000] [--fps 50]
   python bench/frame_timing.py --whole TRAJECTORY.h5 ... [--size 128]
   python bench/frame_timing.py --flight 12 TRAJECTORY.h5 ... [--size 256] [--window 0.2]
+  python bench/frame_timing.py --count-frames 12 TRAJECTORY.h5 ... [--size 1024] [--fps 100]
 
 --flight N: N short windows (--window s each) spread evenly over each whole flight instead
 of two 1 s clips, each measured as a clip is (below), pooled per trajectory and over all.
@@ -17,6 +18,11 @@ what any timing rule can buy there: the best fixed rate per window, chosen knowi
 window's errors (a small knapsack), for the smallest pooled median at no more frames than
 fixed 100 fps. A rule that sets its rate from the scene cannot beat that by much: it can
 only also vary the rate inside a 0.2 s window.
+
+--count-frames N: only the frames each adaptive bound (--adaptive) would render, from --fps,
+counted through the render stage's own schedule (`render_between`) over N windows of
+--window s spread over each flight and its last second, and scaled to the whole flight:
+no reference, so it runs at 1024^2 in ~20 min per trajectory on one core.
 
 --whole: the render stage itself (`stages.render.render_trajectory`) over whole
 trajectories with fixed timing and with each adaptive bound: frames rendered, seconds,
@@ -280,6 +286,42 @@ def whole_trajectories(paths: list[Path], size: int, fps: int) -> None:
             )
 
 
+def count_frames(paths: list[Path], size: int, fps: int, n_windows: int, window_s: float, adaptive) -> None:
+    """Per trajectory and adaptive bound: frames per fixed frame over the windows and over
+    the last second, and over the whole flight (the windows' rate until the last second)."""
+    print(f"# adaptive frames from {fps} fps, {size}^2, {n_windows} windows of {window_s} s and the last second; "
+          f"{platform.node()}, {time.strftime('%Y-%m-%d')}")  # fmt: skip
+    print("| trajectory | timing | x fixed, windows | x fixed, last second | x fixed, whole flight |")
+    print("|---|---|---|---|---|")
+    for path in paths:
+        tr = read_trajectory(path)
+        scenario = str(tr.attrs["scenario"])
+        config = resolve_config({"camera": {"width": size, "height": size, "fps": fps}})
+        settings = RenderSettings.from_config(config, scenario)
+        camera, tiles, sun, reflectance = settings.build()
+        states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+        tf, white = float(tr.t_nodes[-1]), settings.display_white_w_m2_sr
+        parts = [list(flight_windows(tf, n_windows, window_s, fps).values()), [(tf - 1.0, tf)]]
+        fixed, added = [0, 0], {name: [0, 0] for name in adaptive}
+        with sensor_renderer(tiles, camera, sun, reflectance) as renderer:
+            for part, spans in enumerate(parts):
+                for t0, t1 in spans:
+                    for t in t0 + np.arange(int(round((t1 - t0) * fps))) / fps:  # each fixed interval's start
+                        state = states.states([t])[0]
+                        frame = renderer.render(camera.pose(state))
+                        fixed[part] += 1
+                        for name in adaptive:
+                            between = render_between(
+                                renderer, camera, states, frame, state, t, min(t + 1 / fps, tf), ADAPTIVE[name], white
+                            )
+                            added[name][part] += sum(1 for _ in between)
+        for name, (windows, last) in added.items():
+            rate = (fixed[0] + windows) / fixed[0]
+            whole = (rate * (tf - 1.0) * fps + fixed[1] + last) / (tf * fps)
+            print(f"| {scenario} {int(tr.attrs['id']):04d} ({tf:.0f} s) | {name} | {rate:.2f} | "
+                  f"{(fixed[1] + last) / fixed[1]:.2f} | {whole:.2f} |", flush=True)  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("trajectories", type=Path, nargs="+", help="trajectory.h5 files (results/SCENARIO/ID/)")
@@ -289,6 +331,7 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=1.0, help="clip length, s")
     parser.add_argument("--whole", action="store_true", help="whole trajectories through the render stage")
     parser.add_argument("--flight", type=int, metavar="N", help="N windows spread over each whole flight")
+    parser.add_argument("--count-frames", type=int, metavar="N", help="only count adaptive frames over N windows")
     parser.add_argument("--window", type=float, default=0.2, help="--flight: window length, s")
     parser.add_argument("--supersample", type=int, default=1, metavar="S", help="frames averaged from S x S samples")
     parser.add_argument("--adaptive", nargs="+", choices=list(ADAPTIVE), help="the adaptive variants to run")
@@ -296,6 +339,10 @@ def main() -> None:
     args = parser.parse_args()
     if args.whole:
         whole_trajectories(args.trajectories, args.size, args.fps)
+        return
+    if args.count_frames:
+        adaptive = args.adaptive or ("adaptive, log 2", "adaptive, log 1")
+        count_frames(args.trajectories, args.size, args.fps, args.count_frames, args.window, adaptive)
         return
     if args.supersample < 1:
         parser.error(f"--supersample: expected >= 1, got {args.supersample}")
