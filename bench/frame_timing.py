@@ -286,7 +286,9 @@ def whole_trajectories(paths: list[Path], size: int, fps: int) -> None:
             )
 
 
-def count_frames(paths: list[Path], size: int, fps: int, n_windows: int, window_s: float, adaptive) -> None:
+def count_frames(
+    paths: list[Path], size: int, fps: int, n_windows: int, window_s: float, adaptive, texture_filter: str | None
+) -> None:
     """Per trajectory and adaptive bound: frames per fixed frame over the windows and over
     the last second, and over the whole flight (the windows' rate until the last second)."""
     print(f"# adaptive frames from {fps} fps, {size}^2, {n_windows} windows of {window_s} s and the last second; "
@@ -303,7 +305,7 @@ def count_frames(paths: list[Path], size: int, fps: int, n_windows: int, window_
         tf, white = float(tr.t_nodes[-1]), settings.display_white_w_m2_sr
         parts = [list(flight_windows(tf, n_windows, window_s, fps).values()), [(tf - 1.0, tf)]]
         fixed, added = [0, 0], {name: [0, 0] for name in adaptive}
-        with sensor_renderer(tiles, camera, sun, reflectance) as renderer:
+        with sensor_renderer(tiles, camera, sun, reflectance, texture_filter=texture_filter) as renderer:
             for part, spans in enumerate(parts):
                 for t0, t1 in spans:
                     for t in t0 + np.arange(int(round((t1 - t0) * fps))) / fps:  # each fixed interval's start
@@ -332,7 +334,7 @@ def main() -> None:
     parser.add_argument("--whole", action="store_true", help="whole trajectories through the render stage")
     parser.add_argument("--flight", type=int, metavar="N", help="N windows spread over each whole flight")
     parser.add_argument("--count-frames", type=int, metavar="N", help="only count adaptive frames over N windows")
-    parser.add_argument("--window", type=float, default=0.2, help="--flight: window length, s")
+    parser.add_argument("--window", type=float, default=0.2, help="--flight, --count-frames: window length, s")
     parser.add_argument("--supersample", type=int, default=1, metavar="S", help="frames averaged from S x S samples")
     parser.add_argument("--adaptive", nargs="+", choices=list(ADAPTIVE), help="the adaptive variants to run")
     parser.add_argument("--texture-filter", choices=TEXTURE_FILTERS, help="render.lod.texture_filter")
@@ -342,7 +344,9 @@ def main() -> None:
         return
     if args.count_frames:
         adaptive = args.adaptive or ("adaptive, log 2", "adaptive, log 1")
-        count_frames(args.trajectories, args.size, args.fps, args.count_frames, args.window, adaptive)
+        count_frames(
+            args.trajectories, args.size, args.fps, args.count_frames, args.window, adaptive, args.texture_filter
+        )
         return
     if args.supersample < 1:
         parser.error(f"--supersample: expected >= 1, got {args.supersample}")
