@@ -286,6 +286,15 @@ def whole_trajectories(paths: list[Path], size: int, fps: int) -> None:
             )
 
 
+def flight_scene(tr, size: int, fps: int):
+    """(render settings, (camera, tiles, sun, reflectance), re-integrated states) of a
+    trajectory drawn at size x size px and fps, the config's defaults otherwise."""
+    config = resolve_config({"camera": {"width": size, "height": size, "fps": fps}})
+    settings = RenderSettings.from_config(config, str(tr.attrs["scenario"]))
+    states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+    return settings, settings.build(), states
+
+
 def count_frames(
     paths: list[Path], size: int, fps: int, n_windows: int, window_s: float, adaptive, texture_filter: str | None
 ) -> None:
@@ -298,10 +307,7 @@ def count_frames(
     for path in paths:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
-        config = resolve_config({"camera": {"width": size, "height": size, "fps": fps}})
-        settings = RenderSettings.from_config(config, scenario)
-        camera, tiles, sun, reflectance = settings.build()
-        states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+        settings, (camera, tiles, sun, reflectance), states = flight_scene(tr, size, fps)
         tf, white = float(tr.t_nodes[-1]), settings.display_white_w_m2_sr
         parts = [list(flight_windows(tf, n_windows, window_s, fps).values()), [(tf - 1.0, tf)]]
         fixed, added = [0, 0], {name: [0, 0] for name in adaptive}
@@ -368,10 +374,7 @@ def main() -> None:
     for path in args.trajectories:
         tr = read_trajectory(path)
         scenario = str(tr.attrs["scenario"])
-        config = resolve_config({"camera": {"width": args.size, "height": args.size, "fps": args.fps}})
-        settings = RenderSettings.from_config(config, scenario)
-        camera, tiles, sun, reflectance = settings.build()
-        states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
+        settings, (camera, tiles, sun, reflectance), states = flight_scene(tr, args.size, args.fps)
         tf = float(tr.t_nodes[-1])
         if args.flight:
             clips = flight_windows(tf, args.flight, args.window, args.fps)
