@@ -309,7 +309,9 @@ def count_frames(
         scenario = str(tr.attrs["scenario"])
         settings, (camera, tiles, sun, reflectance), states = flight_scene(tr, size, fps)
         tf, white = float(tr.t_nodes[-1]), settings.display_white_w_m2_sr
-        parts = [list(flight_windows(tf, n_windows, window_s, fps).values()), [(tf - 1.0, tf)]]
+        # The windows before the last second (with many windows the last ones reach into it).
+        windows = [(t0, t1) for t0, t1 in flight_windows(tf, n_windows, window_s, fps).values() if t1 <= tf - 1.0]
+        parts = [windows, [(tf - 1.0, tf)]]
         fixed, added = [0, 0], {name: [0, 0] for name in adaptive}
         with sensor_renderer(tiles, camera, sun, reflectance, texture_filter=texture_filter) as renderer:
             for part, spans in enumerate(parts):
