@@ -83,13 +83,13 @@ from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
 
 FIXED_FPS = (50, 80, 100, 125, 200, 250, 400, 500, 1000)
 ADAPTIVE = {
-    "adaptive, log 2": FrameTiming("adaptive", max_log_change=2.0),
-    "adaptive, log 1": FrameTiming("adaptive", max_log_change=1.0),
-    "adaptive, log 0.5 (ESIM)": FrameTiming("adaptive", max_log_change=0.5),
-    "adaptive, log 0.2": FrameTiming("adaptive", max_log_change=0.2),
-    "adaptive, log 0.1": FrameTiming("adaptive", max_log_change=0.1),
-    "adaptive, log 0.05": FrameTiming("adaptive", max_log_change=0.05),
-    "adaptive, 1 px": FrameTiming("adaptive", max_log_change=None, max_displacement_px=1.0),
+    "adaptive, log 2": FrameTiming(mode="adaptive", max_log_change=2.0),
+    "adaptive, log 1": FrameTiming(mode="adaptive", max_log_change=1.0),
+    "adaptive, log 0.5 (ESIM)": FrameTiming(mode="adaptive", max_log_change=0.5),
+    "adaptive, log 0.2": FrameTiming(mode="adaptive", max_log_change=0.2),
+    "adaptive, log 0.1": FrameTiming(mode="adaptive", max_log_change=0.1),
+    "adaptive, log 0.05": FrameTiming(mode="adaptive", max_log_change=0.05),
+    "adaptive, 1 px": FrameTiming(mode="adaptive", max_log_change=None, max_displacement_px=1.0),
 }
 
 # --whole renders every adaptive frame of whole flights: the bounds that stay affordable.

@@ -33,9 +33,10 @@ import hdf5plugin  # noqa: E402, F401
 import numpy as np  # noqa: E402
 from optics import clip, clip_arguments, timed_events  # noqa: E402
 
-from traj2events.defaults import default_config, preset  # noqa: E402
+from traj2events.defaults import preset  # noqa: E402
 from traj2events.formats.events import SIGNAL  # noqa: E402
 from traj2events.sensor.emulator import EventEmulator  # noqa: E402
+from traj2events.settings.tree import default_config  # noqa: E402
 from traj2events.stages.events import preset_params  # noqa: E402
 
 PRESETS = ("paper", "imx636", "davis346")

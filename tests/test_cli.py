@@ -10,7 +10,7 @@ import pytest
 from traj2events.cli import build_parser, main
 from traj2events.formats.frames import FramesWriter
 from traj2events.formats.trajectory import vehicle_attrs, write_trajectory
-from traj2events.trajectory.vehicle import Vehicle
+from traj2events.settings.vehicle import Vehicle
 
 SUBCOMMANDS = ["check-config", "base", "sample", "upsample", "render", "motion-field", "events", "picture", "index",
                "summary"]  # fmt: skip

@@ -91,7 +91,7 @@ def all_fingerprints():
 def test_comments_docstrings_and_formatting_change_nothing(package_copy):
     before = all_fingerprints()
     package_copy("sensor/laws.py", "KNEE_DN = 20.0  #", "KNEE_DN = 20.0  # (edited) ")
-    package_copy("sensor/emulator.py", '"""The pixel model\'s parameters:', '"""The parameters of the pixel model;')
+    package_copy("sensor/emulator.py", '"""Event-camera emulator: frames', '"""The event-camera emulator: frames')
     package_copy("renderer/context.py", "\nimport os\n", "\n\nimport os  # formatting\n\n")
     package_copy(
         "cli.py", "def cmd_events(args) -> int:", "def cmd_events(args) -> int:  # a real edit, but in the CLI"

@@ -44,12 +44,12 @@ def test_emulator_log_is_the_emulators_mapping():
 
 
 def test_the_tighter_bound_sets_the_interval():
-    both = FrameTiming("adaptive", max_log_change=0.5, max_displacement_px=1.0, max_fps=1000.0)
+    both = FrameTiming(mode="adaptive", max_log_change=0.5, max_displacement_px=1.0, max_fps=1000.0)
     assert next_interval_s(10.0, 20.0, both) == pytest.approx(0.05)  # 0.5 / 10 < 1 / 20
     assert next_interval_s(10.0, 100.0, both) == pytest.approx(0.01)  # 1 px at 100 px/s
     assert next_interval_s(1e6, 1e6, both) == pytest.approx(1e-3)  # never under 1 / max_fps
     assert next_interval_s(0.0, 0.0, both) == math.inf  # nothing moves: nothing to add
-    log_only = FrameTiming("adaptive", max_log_change=0.5, max_displacement_px=None)
+    log_only = FrameTiming(mode="adaptive", max_log_change=0.5, max_displacement_px=None)
     assert next_interval_s(10.0, 1e6, log_only) == pytest.approx(0.05)
 
 

@@ -7,6 +7,7 @@ import pytest
 
 from traj2events.config import load_config, resolve_config
 from traj2events.settings.poses import scenario_hover, scenario_manoeuvre
+from traj2events.settings.vehicle import Vehicle
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.hover import Hover, holding, hover_drift_m, hover_flight
 from traj2events.trajectory.imu import specific_force_body
@@ -14,7 +15,6 @@ from traj2events.trajectory.ocp import LandingProblem
 from traj2events.trajectory.scenarios import ScenarioSettings, base_conditions
 from traj2events.trajectory.state import MASS, POSITION, VELOCITY
 from traj2events.trajectory.upsample import ReintegratedStates, upsample
-from traj2events.trajectory.vehicle import Vehicle
 
 OVERLAY = {"ocp": {"n_nodes": 30, "refine_n_nodes": 60}}
 HOVER = Hover(80.0, 12.0, 40.0, 60.0, (40.0 * np.cos(np.radians(60.0)), 40.0 * np.sin(np.radians(60.0))))

@@ -8,6 +8,7 @@ import pytest
 from traj2events.config import default_config
 from traj2events.formats.imu import read_imu
 from traj2events.formats.trajectory import read_trajectory, vehicle_attrs, write_trajectory
+from traj2events.settings.vehicle import Vehicle
 from traj2events.stages.imu import imu_command
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.imu import (
@@ -19,7 +20,6 @@ from traj2events.trajectory.imu import (
 )
 from traj2events.trajectory.state import BODY_RATES, MASS, POSITION, VELOCITY, rotation_body_to_inertial
 from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls
-from traj2events.trajectory.vehicle import Vehicle
 
 VEHICLE = Vehicle()
 DYNAMICS = Dynamics(VEHICLE)

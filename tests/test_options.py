@@ -6,10 +6,11 @@ import json
 import pytest
 
 from traj2events.cli import build_parser
-from traj2events.defaults import default_config, preset, with_preset
+from traj2events.defaults import preset, with_preset
 from traj2events.options import settings_from
 from traj2events.settings.camera import MOTION_FIELD
 from traj2events.settings.events import EVENTS
+from traj2events.settings.tree import default_config
 
 FIELD = ["motion-field", "t.h5", "-o", "m.h5", "--flo-dir", "f"]
 EVENTS_ARGV = ["events", "in.mkv", "-o", "e.h5"]
@@ -94,4 +95,4 @@ def test_every_pixel_key_is_an_option_with_its_description_and_default(capsys):
     text = " ".join(capsys.readouterr().out.split())
     for key, value in preset("paper")["pixel"].items():
         assert f"--{key.replace('_', '-')}" in text and f"[events.pixel.{key}, default {value}]" in text
-    assert "ON contrast threshold, ln units" in text and "--preset {clean,davis346,imx636,paper}" in text
+    assert "ON contrast threshold [ln]" in text and "--preset {clean,davis346,imx636,paper}" in text

@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 
 from traj2events.config import resolve_config
-from traj2events.defaults import default_config, preset, preset_names, with_preset
+from traj2events.defaults import preset, preset_names, with_preset
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.laws import bandwidth_hz_scalar
+from traj2events.settings.tree import default_config
 from traj2events.stages.events import preset_params
 
 LUMINOUS_EFFICACY_555_LM_W = 683.0  # the lux's definition, at 555 nm

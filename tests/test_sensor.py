@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from traj2events.defaults import section
+from traj2events.config import section
 from traj2events.sensor.laws import KNEE_DN
 from traj2events.sensor.photocurrent import SensorParams, photocurrent_a, sensor_dn, solar_band
 
@@ -59,10 +59,10 @@ def test_lunar_daylight_is_far_above_the_dark_current():
 @pytest.mark.parametrize(
     "key, value, message",
     [
-        ("quantum_efficiency", 1.5, "events.sensor.quantum_efficiency: expected in (0, 1]"),
-        ("f_number", 0.0, "events.sensor.f_number: expected > 0"),
+        ("quantum_efficiency", 1.5, "events.sensor.quantum_efficiency: expected a value <= 1, got 1.5"),
+        ("f_number", 0.0, "events.sensor.f_number: expected a value > 0"),
         ("band_m", [7e-7, 4e-7], "events.sensor.band_m: expected [low, high]"),
-        ("dark_current_a", -1e-15, "events.sensor.dark_current_a: expected > 0"),
+        ("dark_current_a", -1e-15, "events.sensor.dark_current_a: expected a value > 0"),
     ],
 )
 def test_bad_sensor_values_name_the_key(key, value, message):

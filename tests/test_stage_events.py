@@ -117,7 +117,7 @@ def test_labels_through_the_command_same_events_and_reproducible(tmp_path):
 
 def test_frames_h5_through_the_sensor_is_the_display_path_at_the_sensor_s_scale(tmp_path, capsys):
     from traj2events.cli import main
-    from traj2events.defaults import section
+    from traj2events.config import section
     from traj2events.sensor.photocurrent import SensorParams, sensor_dn
 
     sensor = SensorParams.from_config(section("events")["sensor"])

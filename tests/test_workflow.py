@@ -43,7 +43,7 @@ def snakemake(workdir, *args, env=None, check=True):
 
 def two_scenario_smoke():
     """The smoke overlay plus a second, one-trajectory scenario (to see what an edit touches)."""
-    from traj2events.defaults import default_config
+    from traj2events.settings.tree import default_config
 
     config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
     other = dict(default_config()["scenarios"]["descent"], n_trajectories=1)

@@ -13,7 +13,6 @@ import importlib
 import sys
 
 from . import __version__, missing_dependency
-from .defaults import section
 from .memory import keep_freed_memory
 from .options import add_settings, inline_or_file, json_or_null, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
@@ -187,7 +186,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
     p.add_argument("--preview", help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless "
                    "render.preview is false: its encoder takes CPU beside the render); default: none")  # fmt: skip
-    p.add_argument("--backend", default=section("render")["backend"], help="OpenGL backend: egl (a GPU, headless), "
+    p.add_argument("--backend", default="auto", help="OpenGL backend: egl (a GPU, headless), "
                    "osmesa (the CPU, Mesa llvmpipe) or auto (EGL when a GPU's EGL device exists, else OSMesa); "
                    "default: %(default)s")  # fmt: skip
     p.add_argument("--tile-cache", metavar="FOLDER", help="share built tiles' terrain heights with other render jobs "

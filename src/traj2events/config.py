@@ -17,9 +17,10 @@ from typing import Any
 import jsonschema
 import yaml
 
-from .defaults import default_config, merge_config, with_preset
+from .defaults import merge_config, with_preset
+from .settings.tree import config_schema, default_config
 
-SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")
+SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")  # generated: settings/generate.py
 # Folders of results/ that are not scenarios: a scenario of that name would mix its
 # outputs with them.
 RESERVED_SCENARIO_NAMES = ("logs", "figures")
@@ -345,9 +346,14 @@ def _boulder_cover(terrain: dict) -> float:
     return math.pi / 4 * k * s * power
 
 
+def section(name: str) -> dict:
+    """One top-level section of the defaults with their preset applied, e.g. section("ocp")."""
+    return with_preset(default_config())[name]
+
+
 def validate_config(config: Any, schema: dict | None = None) -> None:
     """Raise ConfigError naming the first offending key (schema first, then semantics)."""
-    validator = _Validator(schema if schema is not None else load_yaml(SCHEMA_PATH))
+    validator = _Validator(schema if schema is not None else config_schema())
     errors = sorted(
         validator.iter_errors(config), key=lambda e: (len(e.absolute_path), list(map(str, e.absolute_path)))
     )

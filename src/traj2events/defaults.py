@@ -1,5 +1,5 @@
-"""The default configuration, defaults.yaml beside this module: the one source of every
-default. Config files are overlays on it: `merge_config(defaults, overlay)`. A named
+"""Overlays and presets on the defaults (the declarations' own, settings.tree.default_config):
+config files are overlays, `merge_config(defaults, overlay)`. A named
 preset, a file of presets/ (`events.preset`), gives the pixel model's values and, for a
 sensor that exists, its `events.sensor` and `events.readout` values; the config's own keys
 of those sections go on top: `with_preset`."""
@@ -12,23 +12,7 @@ from pathlib import Path
 
 import yaml
 
-DEFAULTS_PATH = Path(__file__).with_name("defaults.yaml")
 PRESETS_DIR = Path(__file__).with_name("presets")
-
-
-@functools.cache
-def _defaults() -> dict:
-    return yaml.safe_load(DEFAULTS_PATH.read_text())
-
-
-def default_config() -> dict:
-    """A fresh copy of defaults.yaml (the default dataset), its preset not yet applied."""
-    return copy.deepcopy(_defaults())
-
-
-def section(name: str) -> dict:
-    """One top-level section of the defaults with their preset applied, e.g. section("ocp")."""
-    return with_preset(default_config())[name]
 
 
 def preset_names() -> list[str]:

@@ -10,22 +10,21 @@ once (config.schema.yaml) and every command offers it the same way.
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 from pathlib import Path
 
 import jsonschema
 
-from .config import SCHEMA_PATH, ConfigError, describe, load_yaml
-from .defaults import default_config, preset_names, preset_sections, with_preset
+from .config import ConfigError, describe
+from .defaults import preset_names, preset_sections, with_preset
 from .settings import config_value, pick
+from .settings.tree import config_schema, default_config
 
 _PREFIX = "setting:"  # argparse dest of an option that changes one setting
 
 
-@functools.cache
 def _schema() -> dict:
-    return load_yaml(SCHEMA_PATH)
+    return config_schema()
 
 
 def _node(path: str) -> dict:

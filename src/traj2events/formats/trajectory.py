@@ -84,7 +84,7 @@ class Trajectory:
     @property
     def vehicle(self):
         """The vehicle.Vehicle of the root attributes (to re-integrate the dynamics)."""
-        from ..trajectory.vehicle import Vehicle
+        from ..settings.vehicle import Vehicle
 
         return Vehicle(
             **{k: (tuple(self.attrs[k]) if k == "inertia_kgm2" else float(self.attrs[k])) for k in VEHICLE_KEYS}

@@ -18,11 +18,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..defaults import section
+from ..settings.camera import CameraSection
+from ..settings.declare import default
 from ..trajectory.state import ATTITUDE, BODY_RATES, CONVENTIONS, POSITION, VELOCITY, rotation_matrix
 from .distortion import MODEL, PINHOLE, Distortion, distortion_from
-
-_CAMERA = section("camera")
 
 
 @dataclass(frozen=True)
@@ -30,7 +29,7 @@ class Camera:
     width: int
     height: int
     fov_deg: float  # across the width
-    mount_height_m: float = _CAMERA["mount_height_m"]  # above the trajectory point, along -z_b
+    mount_height_m: float = default(CameraSection, "mount_height_m")  # above the trajectory point, along -z_b
     distortion: Distortion = PINHOLE
 
     def __post_init__(self) -> None:

@@ -23,38 +23,11 @@ Lunar-Lambert (McEwen 1991, 1996):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ..defaults import section
+from ..settings.render import REFLECTANCE_MODELS, ReflectanceParams
 
-MODELS = ("hapke", "lunar-lambert")
-
-
-_REFLECTANCE = section("render")["reflectance"]
-
-
-@dataclass(frozen=True)
-class ReflectanceParams:
-    model: str = _REFLECTANCE["model"]
-    # Hapke: representative lunar values (w, b, c, B0, h after Helfenstein & Veverka 1987
-    # and Sato et al. 2014, LROC WAC; see docs/rendering.md).
-    single_scattering_albedo: float = _REFLECTANCE["single_scattering_albedo"]
-    phase_b: float = _REFLECTANCE["phase_b"]
-    phase_c: float = _REFLECTANCE["phase_c"]
-    opposition_b0: float = _REFLECTANCE["opposition_b0"]
-    opposition_h: float = _REFLECTANCE["opposition_h"]
-    # Lunar-Lambert: normal albedo of the maria-highland average.
-    albedo: float = _REFLECTANCE["albedo"]
-
-    def __post_init__(self) -> None:
-        if self.model not in MODELS:
-            raise ValueError(f"render.reflectance.model: expected one of {MODELS}, got {self.model!r}")
-        if not 0 < self.single_scattering_albedo < 1:
-            raise ValueError("render.reflectance.single_scattering_albedo: expected 0 < w < 1")
-        if not 0 <= self.phase_b < 1:
-            raise ValueError("render.reflectance.phase_b: expected 0 <= b < 1")
+MODELS = REFLECTANCE_MODELS
 
 
 def chandrasekhar_h(x: np.ndarray, w: float) -> np.ndarray:

@@ -39,7 +39,7 @@ from typing import Protocol
 import numpy as np
 from numba import float64, njit, vectorize
 
-from ..defaults import section
+from ..settings.render import TerrainParams
 from .populations import hemispheres_m, points_and_box, power_law_count, power_law_diameter, size_octaves
 from .terrain_kernels import (
     as_regular_grid,
@@ -48,48 +48,6 @@ from .terrain_kernels import (
     stream_key,
     value_noise,
 )
-
-_TERRAIN = section("terrain")
-
-
-@dataclass(frozen=True)
-class TerrainParams:
-    """Procedural terrain settings: config key `terrain`, defaults in defaults.yaml (which
-    gives the meaning and source of each value; see also docs/rendering.md)."""
-
-    seed: int = _TERRAIN["seed"]
-    crater_density_k: float = _TERRAIN["crater_density_k"]
-    crater_slope: float = _TERRAIN["crater_slope"]
-    crater_diameter_min_m: float = _TERRAIN["crater_diameter_min_m"]
-    crater_diameter_max_m: float = _TERRAIN["crater_diameter_max_m"]
-    depth_to_diameter: float = _TERRAIN["depth_to_diameter"]
-    rim_height_to_diameter: float = _TERRAIN["rim_height_to_diameter"]
-    fresh_fraction: float = _TERRAIN["fresh_fraction"]
-    roughness_m_at_1m: float = _TERRAIN["roughness_m_at_1m"]
-    roughness_hurst: float = _TERRAIN["roughness_hurst"]
-    roughness_wavelength_max_m: float = _TERRAIN["roughness_wavelength_max_m"]
-    site_radius_m: float = _TERRAIN["site_radius_m"]
-    pad_relief_wavelength_max_m: float = _TERRAIN["pad_relief_wavelength_max_m"]
-    boulder_density_k: float = _TERRAIN["boulder_density_k"]
-    boulder_slope: float = _TERRAIN["boulder_slope"]
-    boulder_diameter_min_m: float = _TERRAIN["boulder_diameter_min_m"]
-    boulder_diameter_max_m: float = _TERRAIN["boulder_diameter_max_m"]
-    boulder_ejecta_factor: float = _TERRAIN["boulder_ejecta_factor"]
-    rock_diameter_min_m: float = _TERRAIN["rock_diameter_min_m"]
-    # Sites diverts re-target to, (x, y) m: each gets a pad as the site's (the render
-    # settings add a trajectory's; not a config key).
-    divert_sites_m: tuple = ()
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "divert_sites_m", tuple((float(x), float(y)) for x, y in self.divert_sites_m))
-        if not 0 < self.crater_diameter_min_m <= self.crater_diameter_max_m:
-            raise ValueError("terrain.crater_diameter_min_m/max_m: expected 0 < min <= max")
-        if not 0 <= self.fresh_fraction <= 1:
-            raise ValueError(f"terrain.fresh_fraction: expected 0..1, got {self.fresh_fraction}")
-        if not 0 < self.boulder_diameter_min_m <= self.boulder_diameter_max_m:
-            raise ValueError("terrain.boulder_diameter_min_m/max_m: expected 0 < min <= max")
-        if not 0 < self.rock_diameter_min_m <= self.boulder_diameter_min_m:
-            raise ValueError("terrain.rock_diameter_min_m: expected 0 < rock_diameter_min_m <= boulder_diameter_min_m")
 
 
 class Terrain(Protocol):

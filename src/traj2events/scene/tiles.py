@@ -37,9 +37,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..defaults import section
 from ..formats.tile_cache import TileCache
 from ..geometry.camera import Camera, CameraPose
+from ..settings.declare import default
+from ..settings.render import LodSettings, ScatteredLight
 from .illumination import SUN_RADIUS_RAD, ShadowField, no_obstruction, shadow_field
 from .scattering import height_normals, scattered_sunlight
 from .terrain import Terrain, surface_points
@@ -64,22 +65,8 @@ class Tile:
     scattered: np.ndarray | None = field(default=None, repr=False)  # (n,) S of scattering.py: TileSet.scattered
 
 
-_LOD = section("render")["lod"]
-_SCATTERED_AZIMUTHS = section("render")["scattered_light"]["azimuths"]
+_SCATTERED_AZIMUTHS = default(ScatteredLight, "azimuths")
 _SCATTERED_STRIDE = 2  # grid points per marched one (bench/scattered_light.py)
-
-
-@dataclass(frozen=True)
-class LodSettings:
-    cells: int = _LOD["cells"]
-    margin: int = _LOD["margin"]  # cells of extra grid toward the Sun for the shadow march
-    pixels_per_cell: float = _LOD["pixels_per_cell"]
-    min_spacing_m: float = _LOD["min_spacing_m"]
-    shading_levels: int = _LOD["shading_levels"]  # 0: law per vertex; k: per pixel, normals k levels finer
-    texture_filter: str = _LOD["texture_filter"]  # how a pixel samples the shading texture (renderer.draw)
-    magnified_texel_px: float = _LOD["magnified_texel_px"]  # a texel wider than this (px): one level finer
-    skirt_cells: float = 2.0  # skirt depth in cells of the tile
-    foreshortening: bool = True  # measure a cell by its projected area, not its width
 
 
 class TileSet:

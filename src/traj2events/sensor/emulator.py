@@ -35,48 +35,18 @@ events) and `parallel` (the per-pixel pass split over threads).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
 from typing import Iterator
 
 import numpy as np
 
 from ..formats.events import EVENT_DTYPE
+from ..settings.events import EmulatorParams
 from .draws import HOT_PIXEL_STREAM, SHOT_NOISE_STREAM, interval_key
 from .laws import log_intensity_8bit, lowpass_gain
 from .noise import block_majorants, shot_noise_events
 from .ordering import assemble
 from .parallel import RangedPass, pixel_ranges
 from .pixel import advance, emit, hot_pixel_counts
-
-
-@dataclass(frozen=True)
-class EmulatorParams:
-    """The pixel model's parameters: a config's events.pixel (its values come from a preset,
-    src/traj2events/presets/: `stages.events.preset_params`)."""
-
-    theta_on: float  # ON contrast threshold, ln units
-    theta_off: float
-    sigma: float  # threshold mismatch (std of the per-pixel thresholds)
-    cutoff_hz: float  # photoreceptor bandwidth at full scale (255 DN); 0 disables
-    refractory_s: float
-    leak_hz: float
-    shot_noise_hz: float
-    hot_pixel_fraction: float
-    hot_pixel_hz: float
-    refractory_mode: str  # "drop" (ESIM) or "defer" (v2e): step 5
-
-    def __post_init__(self) -> None:
-        if self.refractory_mode not in ("drop", "defer"):
-            raise ValueError(f"emulator.refractory_mode: expected 'drop' or 'defer', got {self.refractory_mode!r}")
-        for key, value in asdict(self).items():
-            if key == "refractory_mode":
-                continue
-            if not value >= 0:
-                raise ValueError(f"emulator.{key}: expected >= 0, got {value}")
-        if self.theta_on < 0.01 or self.theta_off < 0.01:
-            raise ValueError("emulator.theta_on/theta_off: expected >= 0.01")
-        if self.hot_pixel_fraction > 1:
-            raise ValueError(f"emulator.hot_pixel_fraction: expected <= 1, got {self.hot_pixel_fraction}")
 
 
 def _rng(seed: int, *key: int) -> np.random.Generator:

@@ -20,10 +20,9 @@ I_ph + I_dark) and its shot-noise law (falling with x) then refer to the photocu
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
-
 import numpy as np
 
+from ..settings.events import SensorParams
 from .laws import KNEE_DN
 
 ELEMENTARY_CHARGE_C = 1.602176634e-19
@@ -32,50 +31,6 @@ LIGHT_SPEED_M_S = 299792458.0
 BOLTZMANN_J_K = 1.380649e-23
 STEFAN_BOLTZMANN_W_M2_K4 = 5.670374419e-8
 SUN_TEMPERATURE_K = 5772.0  # IAU 2015 nominal effective temperature
-
-
-@dataclass(frozen=True)
-class SensorParams:
-    """Optics and pixel of the event camera; defaults in defaults.yaml (events.sensor)."""
-
-    f_number: float
-    optics_transmittance: float
-    pixel_pitch_m: float
-    quantum_efficiency: float  # electrons per photon over the pixel's whole area (fill factor included)
-    band_m: tuple[float, float]  # the sensor's spectral band, m
-    dark_current_a: float
-    # The lens before the pixels (optics.py): off, the paper's pinhole.
-    psf_diffraction: bool = False  # the Airy pattern of the f-number over the band
-    lens_blur_um: float = 0.0  # a Gaussian blur's standard deviation at the focal plane, um
-    vignetting: bool = False  # cos^4 of the field angle
-
-    @property
-    def has_optics(self) -> bool:
-        return self.psf_diffraction or self.lens_blur_um > 0 or self.vignetting
-
-    def __post_init__(self) -> None:
-        if not self.lens_blur_um >= 0:
-            raise ValueError(f"events.sensor.lens_blur_um: expected >= 0, got {self.lens_blur_um}")
-        for key in ("f_number", "pixel_pitch_m", "dark_current_a"):
-            if not getattr(self, key) > 0:
-                raise ValueError(f"events.sensor.{key}: expected > 0, got {getattr(self, key)}")
-        for key in ("optics_transmittance", "quantum_efficiency"):
-            if not 0 < getattr(self, key) <= 1:
-                raise ValueError(f"events.sensor.{key}: expected in (0, 1], got {getattr(self, key)}")
-        low, high = self.band_m
-        if not 0 < low < high:
-            raise ValueError(f"events.sensor.band_m: expected [low, high] with 0 < low < high, got {list(self.band_m)}")
-
-    @classmethod
-    def from_config(cls, sensor: dict) -> SensorParams:
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(sensor) - known)
-        if unknown:
-            raise ValueError(f"events.sensor: unknown keys {unknown}; expected {sorted(known)}")
-        return cls(**{**sensor, "band_m": tuple(sensor["band_m"])})
-
-    def to_config(self) -> dict:
-        return {**asdict(self), "band_m": list(self.band_m)}
 
 
 def planck_spectral_radiance(wavelength_m: np.ndarray, temperature_k: float) -> np.ndarray:

@@ -36,12 +36,12 @@ OFF tail lasts seconds): `SpaceEvents` holds them until the emulator's time reac
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from scipy import special
 
 from ..formats.events import EVENT_DTYPE, GLITCH, RADIATION
+from ..settings.events import SpaceParams
 from .laws import BANDWIDTH_OFFSET_DN, bandwidth_hz, bandwidth_hz_scalar
 
 ELEMENTARY_CHARGE_C = 1.602176634e-19
@@ -53,26 +53,6 @@ STEPS_PER_PIXEL = 8  # the track's walk
 SPACE_STREAM = 0x5A0E  # the draws' own stream of the seed
 # `SpaceEvents.due` with nothing pending (most intervals): no events, and no work.
 NOTHING_DUE = {**{k: np.empty(0, EVENT_DTYPE[k]) for k in EVENT_DTYPE.names}, "label": np.empty(0, np.uint8)}
-
-
-@dataclass(frozen=True)
-class SpaceParams:
-    """events.space (defaults in defaults.yaml)."""
-
-    enabled: bool = False
-    particle_flux_cm2_s: float = 0.0
-    sensitive_depth_um: float = 5.0
-    charge_diffusion_um: float = 1.0
-    row_column_hz: float = 0.0
-    glitch_duration_s: float = 1e-4
-
-    def __post_init__(self) -> None:
-        for key in ("particle_flux_cm2_s", "row_column_hz", "glitch_duration_s"):
-            if not (getattr(self, key) >= 0 and math.isfinite(getattr(self, key))):
-                raise ValueError(f"events.space.{key}: expected a finite value >= 0, got {getattr(self, key)}")
-        for key in ("sensitive_depth_um", "charge_diffusion_um"):
-            if not (getattr(self, key) > 0 and math.isfinite(getattr(self, key))):
-                raise ValueError(f"events.space.{key}: expected a finite value > 0, got {getattr(self, key)}")
 
 
 def burst_levels(charge_ratio: float, theta_on: float, theta_off: float) -> tuple[int, np.ndarray]:

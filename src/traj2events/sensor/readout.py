@@ -18,32 +18,12 @@ Times are integer microseconds, as events.h5 stores them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 from numba import njit
 
-READOUT_MODES = ("delay", "drop")
+from ..settings.events import ReadoutParams
+
 WINDOW_US = 1000  # the drop mode's window
-
-
-@dataclass(frozen=True)
-class ReadoutParams:
-    latency_s: float = 0.0
-    jitter_s: float = 0.0
-    max_event_rate_hz: float = 0.0  # 0: no limit
-    mode: str = "delay"
-
-    def __post_init__(self) -> None:
-        for key in ("latency_s", "jitter_s", "max_event_rate_hz"):
-            if not getattr(self, key) >= 0:
-                raise ValueError(f"events.readout.{key}: expected >= 0, got {getattr(self, key)}")
-        if self.mode not in READOUT_MODES:
-            raise ValueError(f"events.readout.mode: expected one of {READOUT_MODES}, got {self.mode!r}")
-
-    @property
-    def active(self) -> bool:
-        return self.latency_s > 0 or self.jitter_s > 0 or self.max_event_rate_hz > 0
 
 
 @njit(cache=True, nogil=True)

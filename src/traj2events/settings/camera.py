@@ -1,8 +1,47 @@
-"""Settings of the camera and the Moon's sphere: the motion field and its picture."""
+"""The camera (`camera`) and the Moon's sphere (`motion_field`), declared; and the settings
+of the motion field and its picture."""
 
 from __future__ import annotations
 
 from . import pick, without_late_defaults
+from .declare import section, setting
+
+OPENCV = "OpenCV's radial-tangential model (k1, k2, p1, p2, k3) on normalised coordinates"
+
+
+@section(
+    "camera.distortion",
+    "the lens's radial-tangential distortion (OpenCV's model and order) on normalised "
+    'coordinates; all five 0: a pinhole, the paper\'s (docs/geometry.md "Lens distortion")',
+)
+class LensDistortion:
+    k1: float = setting(0.0, "", "radial, r^2 term", source=OPENCV)
+    k2: float = setting(0.0, "", "radial, r^4 term", source=OPENCV)
+    p1: float = setting(0.0, "", "tangential (decentring), first", source=OPENCV)
+    p2: float = setting(0.0, "", "tangential (decentring), second", source=OPENCV)
+    k3: float = setting(0.0, "", "radial, r^6 term", source=OPENCV)
+
+
+@section("camera", "the camera: frame rate, image, field of view, mounting, lens")
+class CameraSection:
+    fps: float = setting(50.0, "Hz", "camera frame rate (the paper: 100, config/paper.yaml; halved here to build in "
+                         "minutes)", gt=0, le=10000)  # fmt: skip
+    width: int = setting(128, "px", "image width (the paper: 1024)", ge=1, le=8192)
+    height: int = setting(128, "px", "image height (the paper: 1024)", ge=1, le=8192)
+    fov_deg: float = setting(45.0, "deg", "field of view across the width, the paper's; f = W / (2 tan(fov/2))",
+                             gt=0, lt=180)  # fmt: skip
+    mount_height_m: float = setting(3.0, "m", "camera height above the trajectory point (the landing gear's contact "
+                                    "point) along -z_b: its height above the ground at touchdown (the Apollo LM "
+                                    "descent stage: 3.2 m tall with its legs)", ge=0, lt=100)  # fmt: skip
+    distortion: LensDistortion = setting(LensDistortion, "", "the lens's distortion")
+
+
+@section("motion_field", "the motion-field ground truth")
+class MotionFieldSection:
+    every_n_frames: int = setting(50, "", "write the field of every n-th frame (50: 1 Hz at 50 fps; 1: all)", ge=1)
+    moon_radius_m: float = setting(1737400.0, "m", "radius of the sphere through the landing site: the Moon's mean "
+                                   "radius, +- its relief (-9 .. +11 km)", ge=1.70e6, le=1.76e6)  # fmt: skip
+
 
 CAMERA = {
     "width": "camera.width",

@@ -12,6 +12,14 @@ import os
 import numpy as np
 
 from . import pick, trajectory_rng
+from .declare import section, setting
+
+
+@section("upsampling", "how the solved nodes become poses at the frame rate")
+class Upsampling:
+    method: str = setting("reintegrate", "", "reintegrate (the dynamics with the optimal controls, exact) or spline "
+                          "(the paper's cubic spline, for comparison)", choices=("reintegrate", "spline"))  # fmt: skip
+
 
 POSES = {"fps": "camera.fps", "method": "upsampling.method"}
 

@@ -3,38 +3,185 @@ when to render (`render.timing`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ..geometry.camera import horizon_distance_m
 from . import trajectory_rng, without_late_defaults
+from .declare import section, setting
 from .poses import external_extents, is_external, scenario_divert
 
+HAPKE = "representative lunar values after Helfenstein & Veverka (1987) and Sato et al. (2014), LROC WAC"
+PIKE = "Pike (1977)"
+REFLECTANCE_MODELS = ("hapke", "lunar-lambert")
+TEXTURE_FILTERS = ("box", "trilinear", "point")
 TIMING_MODES = ("fixed", "adaptive")
 
 
-@dataclass(frozen=True)
-class FrameTiming:
-    """render.timing: `fixed` renders at the camera's fps only; `adaptive` adds frames
-    between those until the predicted log change per interval is at most
-    `max_log_change` and the largest displacement of a terrain pixel at most
-    `max_displacement_px` (null: no such bound), never closer than 1 / `max_fps` s."""
-
-    mode: str = "fixed"
-    max_log_change: float | None = 0.5
-    max_displacement_px: float | None = None
-    max_fps: float = 2000.0
+@section("terrain", "the procedural surface (sources in docs/rendering.md), or a DEM in its place")
+class TerrainParams:
+    seed: int = setting(1, "", "seed of the procedural craters, boulders and roughness", ge=0)
+    crater_density_k: float = setting(0.08, "m^-2", "K in N(>D) = K D^-slope craters per m^2, D in m: ~equilibrium "
+                                      "for small lunar craters", source="Gault (1970)", ge=0)  # fmt: skip
+    crater_slope: float = setting(2.0, "", "cumulative crater size-frequency slope", gt=0)
+    crater_diameter_min_m: float = setting(0.5, "m", "smallest crater", gt=0)
+    crater_diameter_max_m: float = setting(2000.0, "m", "largest crater", gt=0)
+    depth_to_diameter: float = setting(0.2, "", "fresh simple craters, rim crest to floor", source=PIKE, ge=0, le=1)
+    rim_height_to_diameter: float = setting(0.036, "", "fresh craters' rim height", source=PIKE, ge=0, le=1)
+    fresh_fraction: float = setting(0.2, "", "fraction of craters that are fresh (rims, ejecta); the rest degraded",
+                                    ge=0, le=1)  # fmt: skip
+    roughness_m_at_1m: float = setting(0.02, "m", "RMS height of the 1 m wavelength", ge=0)
+    roughness_hurst: float = setting(0.8, "", "Hurst exponent of the roughness (RMS grows as wavelength^H)", ge=0,
+                                     le=1)  # fmt: skip
+    roughness_wavelength_max_m: float = setting(64.0, "m", "longest roughness wavelength", gt=0)
+    site_radius_m: float = setting(30.0, "m", "landing pad around the site, level at the lander's scale (the "
+                                   "trajectories touch down at z = 0)", ge=0)  # fmt: skip
+    boulder_density_k: float = setting(3.0e-4, "m^-2", "K in N(>D) = K D^-slope boulders per m^2, D in m, away from "
+                                       "fresh craters: 300 boulders >= 1 m per km^2, the order of mare surfaces; 0: "
+                                       "none", source="Cintala & McBride (1995)", ge=0)  # fmt: skip
+    boulder_slope: float = setting(2.5, "", "cumulative boulder size-frequency slope (-2.5 .. -4 measured around "
+                                   "lunar craters)", source="Bart & Melosh (2010)", gt=0)  # fmt: skip
+    boulder_diameter_min_m: float = setting(0.5, "m", "smallest boulder", gt=0)
+    boulder_diameter_max_m: float = setting(8.0, "m", "largest boulder", gt=0, le=100)
+    boulder_ejecta_factor: float = setting(30.0, "", "boulder density on fresh craters' ejecta (1-3 radii, craters "
+                                           ">= 20 m) relative to elsewhere", ge=1, le=1000)  # fmt: skip
+    rock_diameter_min_m: float = setting(0.02, "m", "smallest rock: the boulders' law goes on below "
+                                         "boulder_diameter_min_m down to here (pebbles and small rocks, seen where "
+                                         "the shading textures resolve them; those up to 0.2 m stay on the pad); "
+                                         "equal to boulder_diameter_min_m: none", gt=0)  # fmt: skip
+    pad_relief_wavelength_max_m: float = setting(2.0, "m", "roughness this short stays on the pad (regolith texture, "
+                                                 "~4 cm RMS; at 2 m a 128^2 camera 60 m up still resolves it); 0: a "
+                                                 "flat pad", ge=0)  # fmt: skip
+    elevation_grid: str | None = setting(None, "", "a DEM file (.npy, .npz, .tif) in place of the procedural surface")
+    grid_spacing_m: float | None = setting(None, "m", "the DEM's spacing where its file does not give it", gt=0)
+    # Sites diverts re-target to, (x, y) m: each gets a pad as the site's (the render
+    # settings add a trajectory's; not a config key).
+    divert_sites_m: tuple = ()
 
     def __post_init__(self) -> None:
-        if self.mode not in TIMING_MODES:
-            raise ValueError(f"render.timing.mode: expected one of {TIMING_MODES}, got {self.mode!r}")
-        for key in ("max_log_change", "max_displacement_px"):
-            value = getattr(self, key)
-            if value is not None and not value > 0:
-                raise ValueError(f"render.timing.{key}: expected > 0 or null, got {value}")
-        if not self.max_fps > 0:
-            raise ValueError(f"render.timing.max_fps: expected > 0, got {self.max_fps}")
+        object.__setattr__(self, "divert_sites_m", tuple((float(x), float(y)) for x, y in self.divert_sites_m))
+        for kind in ("crater", "boulder"):
+            if getattr(self, f"{kind}_diameter_min_m") > getattr(self, f"{kind}_diameter_max_m"):
+                raise ValueError(f"terrain.{kind}_diameter_min_m: expected at most terrain.{kind}_diameter_max_m")
+        if self.rock_diameter_min_m > self.boulder_diameter_min_m:
+            raise ValueError("terrain.rock_diameter_min_m: expected at most terrain.boulder_diameter_min_m")
+
+
+@section("render.reflectance", 'the regolith\'s reflectance law (docs/rendering.md "Reflectance")')
+class ReflectanceParams:
+    model: str = setting("hapke", "", "hapke or lunar-lambert", choices=REFLECTANCE_MODELS)
+    single_scattering_albedo: float = setting(0.21, "", "Hapke's single-scattering albedo w", source=HAPKE, gt=0, lt=1)
+    phase_b: float = setting(0.26, "", "Hapke's double Henyey-Greenstein lobe width b", source=HAPKE, ge=0, lt=1)
+    phase_c: float = setting(0.4, "", "Hapke's lobe weight c (> 0: backscatter)", source=HAPKE, ge=-1, le=1)
+    opposition_b0: float = setting(1.0, "", "Hapke's opposition-surge amplitude B0", source=HAPKE, ge=0)
+    opposition_h: float = setting(0.07, "", "Hapke's opposition-surge width h", source=HAPKE, gt=0)
+    albedo: float = setting(0.12, "", "lunar-lambert only: the normal albedo, the maria-highland average", gt=0, le=1)
+
+
+@section("render.lod", "the terrain's level of detail and its shading textures (docs/rendering.md)")
+class LodSettings:
+    cells: int = setting(32, "", "grid cells per tile side", ge=4, le=256)
+    margin: int = setting(32, "", "extra cells toward the Sun, for the shadow march", ge=0, le=256)
+    pixels_per_cell: float = setting(8.0, "px", "split a tile while one cell covers more pixels than this", gt=0)
+    min_spacing_m: float = setting(0.05, "m", "the finest geometry's grid spacing; its shading textures hold detail "
+                                   "3-4 levels finer (docs/rendering.md \"Detail at touchdown\")", gt=0)  # fmt: skip
+    shading_levels: int = setting(3, "", "0: the law per vertex of the drawn tiles; k > 0: per pixel, from a texture "
+                                  "of the normals and lit fractions k levels finer (docs/rendering.md \"Shading\")",
+                                  ge=0, le=4)  # fmt: skip
+    texture_filter: str = setting("box", "", "how a pixel samples that texture: box (its mean over the pixel's box on "
+                                  "one level's texels), trilinear (a tent from two levels: blurs the last seconds, "
+                                  "0.6-0.8x box's CPU time) or point (at the pixel's centre: aliases; "
+                                  "docs/rendering.md \"Pixel footprint\")", choices=TEXTURE_FILTERS)  # fmt: skip
+    magnified_texel_px: float = setting(
+        0.5,
+        "px",
+        "a drawn tile whose texels cover more pixels than this (at its "
+        "nearest point) takes its shading texture one level finer; 0: never",
+        ge=0,
+    )
+    skirt_cells: float = 2.0  # skirt depth in cells of the tile
+    foreshortening: bool = True  # measure a cell by its projected area, not its width
+
+
+@section(
+    "render.scattered_light",
+    'sunlight scattered once by the sunlit terrain into shadows (docs/rendering.md "Light in shadows")',
+)
+class ScatteredLight:
+    azimuths: int = setting(16, "", "directions of the horizon march from each tile vertex; 0: none (black shadows, "
+                            "as the paper's renders)", ge=0, le=256)  # fmt: skip
+
+
+@section(
+    "render.stars",
+    "stars in the black sky, in physical radiance: Sun-like, counts from the whole sky's law, "
+    'seeded (docs/rendering.md "Stars")',
+)
+class Stars:
+    enabled: bool = setting(True, "", "draw the stars")
+    magnitude_limit: float = setting(
+        7.0,
+        "mag",
+        "the faintest V magnitude drawn: ~13 000 stars over the whole sky "
+        "(12: ~3 M); fainter ones are far below the dark current",
+        ge=-1,
+        le=12,
+    )
+    seed: int = setting(1, "", "the star field's seed", ge=0)
+
+
+@section(
+    "render.timing",
+    'when to render for the emulator: at the camera\'s fps, or adaptive frames between (docs/events.md "Event timing")',
+)
+class FrameTiming:
+    """`fixed` renders at the camera's fps only; `adaptive` adds frames between those until
+    the predicted log change per interval is at most `max_log_change` and the largest
+    displacement of a terrain pixel at most `max_displacement_px` (null: no such bound),
+    never closer than 1 / `max_fps` s."""
+
+    mode: str = setting("fixed", "", "fixed: at camera.fps; adaptive: also frames between, for the emulator only",
+                        choices=TIMING_MODES)  # fmt: skip
+    max_log_change: float | None = setting(
+        0.2,
+        "",
+        "adaptive: the predicted largest |d ln I| over an interval, "
+        "max |grad ln I . flow| dt (ESIM's lambda); null: no such bound",
+        gt=0,
+    )
+    max_displacement_px: float | None = setting(None, "px", "adaptive: the largest displacement of a terrain pixel "
+                                                "over an interval; null: no such bound", gt=0)  # fmt: skip
+    max_fps: float = setting(2000.0, "Hz", "adaptive: the shortest interval is 1 / max_fps", gt=0)
+
+    def __post_init__(self) -> None:
         if self.mode == "adaptive" and self.max_log_change is None and self.max_displacement_px is None:
             raise ValueError("render.timing: adaptive needs max_log_change or max_displacement_px (both are null)")
+
+
+@section("render", "the scene's rendering, its videos and where it runs")
+class RenderSection:
+    reflectance: ReflectanceParams = setting(ReflectanceParams, "", "the reflectance law")
+    lod: LodSettings = setting(LodSettings, "", "the level of detail")
+    supersample: int = setting(1, "", "each pixel the mean of S x S samples drawn at S times the size with the same "
+                               "tiles: the pixel footprint's reference, ~S^2 the render time; 1: one sample, "
+                               "integrated by the footprint's filter (docs/rendering.md \"Supersampling\")", ge=1,
+                               le=16)  # fmt: skip
+    scattered_light: ScatteredLight = setting(ScatteredLight, "", "light in shadows")
+    stars: Stars = setting(Stars, "", "the stars")
+    display_white_w_m2_sr: float = setting(40.0, "W m^-2 sr^-1", "radiance shown as white in video.mkv and "
+                                           "preview.mp4", gt=0)  # fmt: skip
+    display_gamma: float = setting(2.2, "", "gamma of the 8-bit videos (display only: the events take the linear "
+                                   "radiance)", gt=0)  # fmt: skip
+    backend: str = setting("auto", "", "OpenGL: egl (a GPU, headless), osmesa (the CPU, Mesa llvmpipe) or auto (EGL "
+                           "when a GPU's EGL device exists, else OSMesa; docs/rendering.md \"Backends\")",
+                           choices=("auto", "egl", "osmesa"))  # fmt: skip
+    tile_cache: str | None = setting("results/tile_cache", "", "a folder where the render jobs share built tiles' "
+                                     "terrain heights and shading textures; content-addressed, safe to delete; null: "
+                                     "none (docs/rendering.md \"Tile cache\")", schema={"minLength": 1})  # fmt: skip
+    keep_frames: bool = setting(True, "", "keep frames.h5 (linear radiance + depth, ~50 kB per 128^2 frame), so that "
+                                "an emulator or motion-field setting reruns only that stage; false (config/paper.yaml: "
+                                "2-3 MB per 1024^2 frame): the render jobs emulate the events too, from the frames "
+                                "in memory")  # fmt: skip
+    preview: bool = setting(True, "", "write preview.mp4 (H.264, to look at) beside video.mkv; false saves its "
+                            "encoder's CPU (docs/performance.md), not video.mkv's")  # fmt: skip
+    timing: FrameTiming = setting(FrameTiming, "", "when to render")
 
 
 def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> dict:

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from ..settings.vehicle import Vehicle
 from .state import (
     BODY_RATES,
     CONTROL_NAMES,
@@ -38,7 +39,6 @@ from .state import (
     rotation_body_to_inertial,
     rotation_matrix,
 )
-from .vehicle import Vehicle
 
 __all__ = [
     "CONTROL_NAMES",

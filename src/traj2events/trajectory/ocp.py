@@ -21,16 +21,14 @@ new boundary conditions.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
 
-from ..defaults import section
+from ..settings.solve import OcpSettings
 from .dynamics import N_STATE, Vehicle, split_control_dynamics
 from .state import MASS, MASS_KG, PITCH, ROLL, STATE_SCALE, TIME_S, YAW, Z
-
-TRANSCRIPTIONS = ("hermite-simpson", "trapezoidal")
 
 COST_SCALE = 1000.0  # J is divided by this so that it is O(1)
 
@@ -44,46 +42,6 @@ def landing_cost(fuel_kg, effort, epsilon: float):
 # Final state: position, velocity, roll, pitch and body rates are fixed (pinpoint,
 # upright, at rest); yaw and mass are free.
 FINAL_FIXED = np.array([i for i in range(N_STATE) if i not in (YAW, MASS)])
-
-
-_OCP = section("ocp")
-
-
-@dataclass(frozen=True)
-class OcpSettings:
-    n_nodes: int = _OCP["n_nodes"]
-    transcription: str = _OCP["transcription"]
-    mesh_clustering: float = _OCP["mesh_clustering"]
-    epsilon: float = _OCP["epsilon"]
-    max_iter: int = _OCP["max_iter"]
-    base_max_iter: int = _OCP["base_max_iter"]
-    tol: float = _OCP["tol"]
-    tf_min_s: float = _OCP["tf_min_s"]
-    tf_max_s: float = _OCP["tf_max_s"]
-    # A sample is accepted when re-integrating its controls lands within these errors;
-    # one that converges but misses them is re-solved with refine_n_nodes (0: never).
-    accept_error_m: float = _OCP["accept_error_m"]
-    accept_error_m_s: float = _OCP["accept_error_m_s"]
-    refine_n_nodes: int = _OCP["refine_n_nodes"]
-    # Pitch never increases (at the nodes and the midpoints): the paper's braking and
-    # approach, which a mass-optimal landing does not do by itself (docs/trajectories.md).
-    # Set per scenario (scenarios.<name>.pitch_decreasing).
-    pitch_decreasing: bool = False
-
-    def __post_init__(self) -> None:
-        if self.transcription not in TRANSCRIPTIONS:
-            raise ValueError(f"ocp.transcription: expected one of {TRANSCRIPTIONS}, got {self.transcription!r}")
-        if not 0.0 <= self.mesh_clustering < 1.0:
-            raise ValueError(f"ocp.mesh_clustering: expected 0 <= value < 1, got {self.mesh_clustering}")
-        if self.n_nodes < 3:
-            raise ValueError(f"ocp.n_nodes: expected >= 3, got {self.n_nodes}")
-        if self.refine_n_nodes and self.refine_n_nodes <= self.n_nodes:
-            raise ValueError(f"ocp.refine_n_nodes: expected 0 or more than n_nodes = {self.n_nodes}")
-        if not 0.0 < self.epsilon <= 1.0:
-            raise ValueError(f"ocp.epsilon: expected 0 < epsilon <= 1, got {self.epsilon}")
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,39 @@
+"""The lander (`vehicle`), declared: ESA ACT's 12-DoF lander model (esa/SpaceAMPL
+lander/hs/main_12dof.mod, 2021; docs/trajectories.md). Its own module: every stage that
+flies the dynamics imports it, and editing the solves' settings reruns none of those."""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+
+from .declare import section, setting
+
+SPACE_AMPL = "ESA ACT's 12-DoF lander, SpaceAMPL main_12dof.mod"
+
+
+@section("vehicle", "the lander's constants (SI; sources in docs/trajectories.md)")
+class Vehicle:
+    mass_kg: float = setting(9472.06, "kg", "initial (wet) mass m0", source=SPACE_AMPL, gt=0)
+    dry_mass_kg: float = setting(6000.0, "kg", "the mass may not drop below this", source="assumed", gt=0)
+    thrust_main_N: float = setting(44000.0, "N", "main engine's maximum thrust F_a", source=SPACE_AMPL, gt=0)
+    thrust_rcs_N: float = setting(22.0, "N", "one attitude thruster's thrust F_b: 2 L F_b = 132 N m, that model's "
+                                  "44 N x 3 m per axis", source=SPACE_AMPL, gt=0)  # fmt: skip
+    lever_arm_m: float = setting(3.0, "m", "attitude thrusters' lever arm L", source=SPACE_AMPL, gt=0)
+    inertia_kgm2: tuple[float, float, float] = setting((18941.0, 20468.68, 20972.12), "kg m^2",
+                                                       "diagonal of the inertia tensor (Ixx, Iyy, Izz): 0.62 x "
+                                                       "(30550, 33014, 33826)", source=SPACE_AMPL, gt=0)  # fmt: skip
+    isp_s: float = setting(310.91, "s", "specific impulse of the engine and thrusters: v_eff = 3049 m/s",
+                           source=SPACE_AMPL, gt=0)  # fmt: skip
+    g_m_s2: float = setting(1.6242, "m/s^2", "lunar gravity, GM / R^2 with GM = 4.9028e12 m^3/s^2, R = 1 737 400 m",
+                            ge=0, le=30)  # fmt: skip
+    g0_m_s2: float = setting(9.80665, "m/s^2", "standard gravity, of the specific impulse", gt=0)
+    tilt_max_deg: float = setting(80.0, "deg", "the tilt limit: cos(roll) cos(pitch) >= cos(tilt_max); above the "
+                                  "paper's largest initial pitch (75 deg)", source="assumed", gt=0, le=89)  # fmt: skip
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "inertia_kgm2", tuple(float(v) for v in self.inertia_kgm2))
+        if not self.dry_mass_kg < self.mass_kg:
+            raise ValueError("vehicle.dry_mass_kg: expected less than vehicle.mass_kg")
+
+    def to_dict(self) -> dict:
+        return {**asdict(self), "inertia_kgm2": list(self.inertia_kgm2)}
