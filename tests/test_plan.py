@@ -86,6 +86,13 @@ def test_the_paper_config_is_allowed_and_a_far_larger_one_is_refused():
     with pytest.raises(ConfigError, match="allow_large_dataset: true"):
         resolve_config(huge)
     assert resolve_config({**huge, "allow_large_dataset": True})["allow_large_dataset"] is True
+    # As a user types it on Snakemake's command line (--config allow_large_dataset=true): text.
+    assert resolve_config({**huge, "allow_large_dataset": "true"})["allow_large_dataset"] is True
+    with pytest.raises(ConfigError, match="--config allow_large_dataset=true"):
+        resolve_config({**huge, "allow_large_dataset": "false"})
+    with pytest.raises(ConfigError, match="'allow_large_dataset': expected boolean, got str 'yes'"):
+        resolve_config({**huge, "allow_large_dataset": "yes"})
+    assert resolve_config(huge, refuse_large=False)["camera"]["width"] == 8192  # a dry run: the caller warns
 
 
 def test_adaptive_timing_plans_the_measured_extra_frames():

@@ -623,9 +623,13 @@ def test_what_the_working_directory_cannot_give_stops_before_any_job(tmp_path, c
     for key, value in change.items():
         config.setdefault(key, {}).update(value)
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
-    run = snakemake(tmp_path, "-n", check=False)
+    run = snakemake(tmp_path, check=False)
     assert run.returncode != 0 and message in run.stdout + run.stderr, run.stderr[-2000:]
     assert not (tmp_path / "results").exists()
+    dry = snakemake(tmp_path, "-n", check=False)  # a dry run prints the plan; only a size gets a warning
+    refused = "does not fit" not in message
+    assert (dry.returncode != 0) == refused and message in dry.stdout + dry.stderr, dry.stderr[-2000:]
+    assert refused or "warning: a real run would stop here" in dry.stderr
 
 
 def test_a_config_file_that_is_not_utf8_is_named(tmp_path):

@@ -382,28 +382,48 @@ def load_yaml(path: str | Path, missing_ok: bool = False) -> Any:
         raise ConfigError(f"config file '{path}' is not valid YAML: {exc}") from None
 
 
-def resolve_config(overlay: Any) -> dict:
-    """The defaults with `overlay` (a config mapping, possibly empty) merged on top, validated."""
+def _command_line_booleans(overlay: dict) -> dict:
+    """`overlay` with a top-level boolean key given as the text true/false (Snakemake's
+    `--config allow_large_dataset=true` passes the text) read as the boolean."""
+    from .settings.declare import declared_fields
+    from .settings.tree import Config
+
+    booleans = {f.name for f in declared_fields(Config) if f.type in ("bool", bool)}
+    spelled = {k: v.strip().lower() for k, v in overlay.items() if k in booleans and isinstance(v, str)}
+    return {**overlay, **{k: v == "true" for k, v in spelled.items() if v in ("true", "false")}}
+
+
+def resolve_config(overlay: Any, refuse_large: bool = True) -> dict:
+    """The defaults with `overlay` (a config mapping, possibly empty) merged on top, validated.
+    A dataset planned beyond the limits is refused unless it allows it (allow_large_dataset),
+    or `refuse_large` is false (a dry run: the caller warns)."""
     if overlay is not None and not isinstance(overlay, dict):
         raise ConfigError(f"config: expected a mapping of keys to values, got {type(overlay).__name__}")
+    overlay = _command_line_booleans(overlay or {})
     config = merge_config(default_config(), overlay)
     events = config.get("events")
     if isinstance(events, dict) and isinstance(events.get("preset"), str) and isinstance(events.get("pixel"), dict):
         try:
-            own = (overlay or {}).get("events")
+            own = overlay.get("events")
             config = with_preset(config, own if isinstance(own, dict) else {})
         except ValueError as exc:  # an unknown preset
             raise ConfigError(str(exc)) from None
     validate_config(config)
+    reason = too_large_reason(config)
+    if reason and refuse_large:
+        raise ConfigError(reason)
+    return config
+
+
+def too_large_reason(config: dict) -> str | None:
+    """Why a dataset is refused as too large (None: it is not, or the config allows it)."""
     from .plan import dataset_plan, too_large
 
     reason = too_large(dataset_plan(config))
-    if reason and not config["allow_large_dataset"]:
-        raise ConfigError(
-            f"config: the dataset is planned at {reason}; if you mean it, set 'allow_large_dataset: true' "
-            f"(`traj2events check-config` prints the plan)"
-        )
-    return config
+    if not reason or config["allow_large_dataset"]:
+        return None
+    return (f"config: the dataset is planned at {reason}; if you mean it, set 'allow_large_dataset: true' "
+            "(on the command line: --config allow_large_dataset=true; `traj2events check-config` prints the plan)")
 
 
 def load_config(*paths: str | Path) -> dict:

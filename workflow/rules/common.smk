@@ -11,7 +11,7 @@ from pathlib import Path
 
 from snakemake.settings.types import DeploymentMethod
 
-from traj2events.config import ConfigError, resolve_config
+from traj2events.config import ConfigError, resolve_config, too_large_reason
 from traj2events.fingerprint import code_fingerprint
 from traj2events.formats.tile_cache import unusable as tile_cache_unusable
 from traj2events.plan import dataset_plan, disk_shortfall, job_resources
@@ -26,14 +26,18 @@ from traj2events.settings.poses import scenario_manoeuvre
 from traj2events.settings.render import render_settings as render_settings_of
 from traj2events.settings.solve import solve_settings
 
+# A dry run (snakemake -n) of a dataset too large to build prints its plan and a warning;
+# the real run refuses it.
 try:
-    _resolved = resolve_config(config)
+    _resolved = resolve_config(config, refuse_large=not workflow.dryrun)
 except ConfigError as error:
     raise WorkflowError(f"invalid configuration: {error}")
 config.clear()
 config.update(_resolved)
 _plan = dataset_plan(config)
 print(f"traj2events: {_plan.summary()}", file=sys.stderr)
+if workflow.dryrun and (_too_large := too_large_reason(config)):
+    print(f"traj2events: warning: a real run would stop here: {_too_large}", file=sys.stderr)
 
 
 def results_bytes():
@@ -50,6 +54,9 @@ def check_working_directory():
         raise WorkflowError(f"invalid configuration: render.tile_cache: {unusable}")
     free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
     if not config["allow_large_dataset"] and (short := disk_shortfall(_plan, free, results_bytes())):
+        if workflow.dryrun:
+            print(f"traj2events: warning: a real run would stop here: the dataset does not fit: {short}", file=sys.stderr)
+            return
         raise WorkflowError(
             f"the dataset does not fit: {short}; free space, build fewer or smaller trajectories, or set "
             "'allow_large_dataset: true' if the space will be there (`traj2events check-config` prints the plan)"

@@ -55,6 +55,10 @@ SPACE_STREAM = 0x5A0E  # the draws' own stream of the seed
 NOTHING_DUE = {**{k: np.empty(0, EVENT_DTYPE[k]) for k in EVENT_DTYPE.names}, "label": np.empty(0, np.uint8)}
 
 
+# The space environment off, as events.h5 records it: no particles, no glitches.
+NO_SPACE = SpaceParams(enabled=False, particle_flux_cm2_s=0.0, row_column_hz=0.0)
+
+
 def burst_levels(charge_ratio: float, theta_on: float, theta_off: float) -> tuple[int, np.ndarray]:
     """A hit of Q = charge_ratio Q_ref on a pixel: (ON events at the hit, the log levels of
     its OFF events as it recovers, highest first)."""

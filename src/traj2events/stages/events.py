@@ -31,7 +31,7 @@ from ..sensor.emulator import EmulatorParams, EventEmulator
 from ..sensor.laws import display_dn_per_radiance
 from ..sensor.optics import psf_kernel, through_lens, vignetting
 from ..sensor.photocurrent import SensorParams, dn_per_radiance
-from ..sensor.radiation import SpaceEvents, SpaceParams
+from ..sensor.radiation import NO_SPACE, SpaceEvents, SpaceParams
 from ..sensor.readout import Readout, ReadoutParams
 from ..trajectory.state import BODY_RATES
 from ..video import iter_video, video_info
@@ -273,7 +273,7 @@ def emulate(
         "labels": labels,
         "emulator_device": device,
         **{f"readout_{k}": v for k, v in asdict(readout).items()},
-        **{f"space_{k}": v for k, v in asdict(space.params if space else SpaceParams()).items()},
+        **{f"space_{k}": v for k, v in asdict(space.params if space else NO_SPACE).items()},
         "traj2events_version": __version__,
         **source.scene,
     }
