@@ -422,8 +422,10 @@ def too_large_reason(config: dict) -> str | None:
     reason = too_large(dataset_plan(config))
     if not reason or config["allow_large_dataset"]:
         return None
-    return (f"config: the dataset is planned at {reason}; if you mean it, set 'allow_large_dataset: true' "
-            "(on the command line: --config allow_large_dataset=true; `traj2events check-config` prints the plan)")
+    return (
+        f"config: the dataset is planned at {reason}; if you mean it, set 'allow_large_dataset: true' "
+        "(on the command line: --config allow_large_dataset=true; `traj2events check-config` prints the plan)"
+    )
 
 
 def load_config(*paths: str | Path) -> dict:

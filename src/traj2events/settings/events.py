@@ -17,18 +17,19 @@ EXPORT_FORMATS = ("npz", "evt3", "aedat4")
 
 @section("events.pixel", "the pixel model (docs/events.md): the preset's values, the config's own keys on top")
 class EmulatorParams:
+    # In events.h5's attribute order (emulator_*): reordering changes the files' bytes.
     theta_on: float = setting(unit="ln", doc="ON contrast threshold", ge=0.01)
     theta_off: float = setting(unit="ln", doc="OFF contrast threshold", ge=0.01)
     sigma: float = setting(unit="ln", doc="per-pixel threshold mismatch (standard deviation)", ge=0)
     cutoff_hz: float = setting(unit="Hz", doc="photoreceptor bandwidth at full scale (255 DN); 0: no low-pass", ge=0)
+    refractory_s: float = setting(unit="s", doc="refractory period (0: none)", ge=0)
     leak_hz: float = setting(unit="Hz", doc="leak events' rate", ge=0)
     shot_noise_hz: float = setting(unit="Hz", doc="shot-noise events' rate at full scale", ge=0)
-    refractory_s: float = setting(unit="s", doc="refractory period (0: none)", ge=0)
-    refractory_mode: str = setting(doc="crossings within the period: dropped (drop, ESIM) or pending (defer, v2e)",
-                                   choices=REFRACTORY_MODES)  # fmt: skip
     hot_pixel_fraction: float = setting(doc="fraction of pixels that fire at hot_pixel_hz whatever the input", ge=0,
                                         le=1)  # fmt: skip
     hot_pixel_hz: float = setting(unit="Hz", doc="the hot pixels' rate", ge=0)
+    refractory_mode: str = setting(doc="crossings within the period: dropped (drop, ESIM) or pending (defer, v2e)",
+                                   choices=REFRACTORY_MODES)  # fmt: skip
 
 
 @section(
