@@ -55,7 +55,9 @@ def check_working_directory():
     free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
     if not config["allow_large_dataset"] and (short := disk_shortfall(_plan, free, results_bytes())):
         if workflow.dryrun:
-            print(f"traj2events: warning: a real run would stop here: the dataset does not fit: {short}", file=sys.stderr)
+            print(
+                f"traj2events: warning: a real run would stop here: the dataset does not fit: {short}", file=sys.stderr
+            )
             return
         raise WorkflowError(
             f"the dataset does not fit: {short}; free space, build fewer or smaller trajectories, or set "
