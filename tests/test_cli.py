@@ -78,8 +78,10 @@ def test_picture_needs_a_kind():
 # -- a corpus of bad inputs: each is refused with one line naming the file or option ------
 
 
-def trajectory_file(path, drop_attr=None, nan=False, columns=13):
+def trajectory_file(path, drop_attr=None, nan=False, columns=13, backwards=False):
     t = np.linspace(0.0, 1.0, 11)
+    if backwards:
+        t[6] = t[4]
     state = np.zeros((11, columns))
     state[:, 2] = -100.0 + 50 * t  # descending, 100 m up
     state[:, -1] = 9000.0
@@ -101,6 +103,7 @@ def bad_inputs(tmp_path):
         "no_fps": trajectory_file(tmp_path / "no_fps.h5", drop_attr="fps"),
         "nan_pose": trajectory_file(tmp_path / "nan_pose.h5", nan=True),
         "wrong_shape": trajectory_file(tmp_path / "wrong_shape.h5", columns=7),
+        "backwards": trajectory_file(tmp_path / "backwards.h5", backwards=True),
     }
     files["text"].write_text("not an HDF5 file\n")
     good = trajectory_file(tmp_path / "good.h5")
@@ -125,6 +128,7 @@ def motion_field_args(trajectory, out):
         ("no_fps", "missing attribute 'fps'"),
         ("nan_pose", "NaN or infinite"),
         ("wrong_shape", "expected (11, 13)"),
+        ("backwards", "t must increase, but t[6] = 0.4 s follows t[5] = 0.5 s"),
     ],
 )
 def test_bad_trajectory_files_are_refused_naming_the_file(bad_inputs, case, fragment, tmp_path, capsys):
@@ -170,6 +174,54 @@ def test_bad_settings_and_options_are_named(tmp_path, capsys):
         assert option.lstrip("-") in capsys.readouterr().err and not (tmp_path / "e.h5").exists()
     assert main(["picture", "events", str(good), "-o", str(tmp_path / "e.png"), "--window-ms", "0"]) == 2
     assert "--window-ms" in capsys.readouterr().err and not (tmp_path / "e.png").exists()
+
+
+def _stage_settings(kind: str, key: str, value) -> str:
+    """The JSON the workflow passes a stage (smoke config), with one value changed."""
+    import json
+
+    from conftest import ROOT
+    from traj2events.config import load_config
+    from traj2events.settings.render import render_settings
+    from traj2events.settings.solve import solve_settings
+
+    config = load_config(ROOT / "config" / "smoke.yaml")
+    settings = solve_settings(config, "descent") if kind == "solve" else render_settings(config, "descent")
+    *parents, leaf = key.split(".")
+    node = settings
+    for parent in parents:
+        node = node[parent]
+    node[leaf] = value
+    return json.dumps(settings)
+
+
+@pytest.mark.parametrize(
+    "kind, key, value, fragment",
+    [
+        ("solve", "ocp.n_nodes", float("nan"), "ocp.n_nodes: expected a finite number, got nan"),
+        ("solve", "vehicle.isp_s", -1.0, "vehicle.isp_s: expected a value > 0, got -1.0"),
+        ("render", "sun.elevation_deg", float("nan"), "'sun.elevation_deg': expected a finite number, got nan"),
+        ("render", "sun.elevation_deg", 95.0, "sun.elevation_deg: expected a value <= 90, got 95.0"),
+        ("render", "lod.texture_filter", "bilinear", "render.lod.texture_filter: expected one of"),
+    ],
+)
+def test_a_stages_settings_are_checked_against_the_declarations(kind, key, value, fragment, tmp_path, capsys):
+    settings = _stage_settings(kind, key, value)
+    if kind == "solve":
+        argv = ["base", "--settings", settings, "-o", str(tmp_path / "base.h5")]
+    else:
+        argv = ["render", str(trajectory_file(tmp_path / "t.h5")), "--settings", settings, "--frames",
+                str(tmp_path / "f.h5"), "--video", str(tmp_path / "v.mkv")]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --settings: ") and fragment in err and len(err.strip().splitlines()) == 1, err
+    assert not [p for p in tmp_path.iterdir() if p.name != "t.h5"]
+
+
+@pytest.mark.parametrize("argv", [["--fps", "nan"], ["--settings", '{"fps": NaN}']])
+def test_a_non_finite_option_is_named(argv, tmp_path, capsys):
+    assert main(["upsample", "--solutions", "s.h5", "--id", "0", "-o", str(tmp_path / "t.h5"), *argv]) == 2
+    assert capsys.readouterr().err.startswith(f"error: {argv[0]}: config key 'camera.fps': expected a finite number")
 
 
 def test_a_truncated_video_is_refused_not_cut_short(tmp_path, capsys):

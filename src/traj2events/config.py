@@ -18,6 +18,7 @@ import jsonschema
 import yaml
 
 from .defaults import merge_config, with_preset
+from .settings.declare import non_finite
 from .settings.tree import config_schema, default_config
 
 SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")  # generated: settings/generate.py
@@ -81,17 +82,6 @@ def describe(error: jsonschema.ValidationError, prefix: list[str] | tuple = ()) 
     if v == "pattern":
         return f"config key '{where}': expected a name matching {schema_value}, got {got!r}"
     return f"config key '{where}': {error.message}"
-
-
-def _non_finite(value: Any, path: tuple = ()) -> list[str]:
-    """Keys whose number is NaN or infinite (JSON Schema's bounds let NaN through)."""
-    if isinstance(value, dict):
-        return [e for k, v in value.items() for e in _non_finite(v, (*path, k))]
-    if isinstance(value, list):
-        return [e for i, v in enumerate(value) for e in _non_finite(v, (*path, i))]
-    if isinstance(value, float) and not math.isfinite(value):
-        return [f"config key '{_key(path)}': expected a finite number, got {value}"]
-    return []
 
 
 def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
@@ -195,7 +185,7 @@ def _elevation_grid_error(terrain: dict) -> list[str]:
 def _semantic_errors(config: dict) -> list[str]:
     """What a schema cannot say: finite numbers, ordered ranges and bounds, initial
     attitudes within the tilt limit, start times within the time bounds, a usable DEM."""
-    errors = _non_finite(config)
+    errors = non_finite(config)
     if errors:
         return errors
     vehicle, ocp, terrain = config["vehicle"], config["ocp"], config["terrain"]

@@ -18,6 +18,7 @@ import jsonschema
 from .config import ConfigError, describe
 from .defaults import preset_names, preset_sections, with_preset
 from .settings import config_value, pick
+from .settings.declare import non_finite
 from .settings.tree import config_schema, default_config
 
 _PREFIX = "setting:"  # argparse dest of an option that changes one setting
@@ -144,11 +145,16 @@ def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
         for parent in parents:
             target = target[parent]
         target[leaf] = list(value) if isinstance(value, list) else value
+    from_options = [_config_key(keys, setting) for setting in options]
+
+    def given_by(key: str) -> str:  # the option that gave the value, or --settings
+        return next((args.settings_flags[k] for k in from_options if f"{key}.".startswith(f"{k}.")), "--settings")
+
     for name, path in keys.items():
+        for problem in non_finite(settings[name], tuple(path.split("."))):  # bounds let NaN through
+            raise ConfigError(f"{given_by(problem.split(chr(39))[1])}: {problem}")
         error = next(iter(jsonschema.Draft202012Validator(_node(path)).iter_errors(settings[name])), None)
-        if error is not None:  # named by the option that gave the value, or --settings
+        if error is not None:
             key = ".".join([path, *map(str, error.absolute_path)])
-            from_options = [_config_key(keys, setting) for setting in options]
-            option = next((args.settings_flags[k] for k in from_options if f"{key}.".startswith(f"{k}.")), "--settings")
-            raise ConfigError(f"{option}: {describe(error, path.split('.'))}")
+            raise ConfigError(f"{given_by(key)}: {describe(error, path.split('.'))}")
     return settings

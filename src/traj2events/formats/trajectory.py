@@ -110,6 +110,10 @@ def read_trajectory(path: str | os.PathLike) -> Trajectory:
         # The mass may be NaN: not known (an external flight's).
         if not (np.isfinite(t).all() and np.isfinite(state[:, :MASS]).all()):
             raise FileFormatError(f"{path}: {group} holds NaN or infinite times or states")
+        if group == "poses" and len(t) > 1 and not (np.diff(t) > 0).all():  # nodes may repeat at a leg's end
+            first = int(np.argmin(np.diff(t) > 0))
+            raise FileFormatError(f"{path}: {group}/t must increase, but t[{first + 1}] = {t[first + 1]:g} s follows "
+                                  f"t[{first}] = {t[first]:g} s")  # fmt: skip
     return tr
 
 

@@ -201,6 +201,17 @@ def field_errors(obj) -> list[str]:
                                                                     f.metadata)]  # fmt: skip
 
 
+def non_finite(value: object, path: tuple = ()) -> list[str]:
+    """Keys whose number is NaN or infinite (JSON Schema's bounds let NaN through)."""
+    if isinstance(value, dict):
+        return [e for k, v in value.items() for e in non_finite(v, (*path, k))]
+    if isinstance(value, list):
+        return [e for i, v in enumerate(value) for e in non_finite(v, (*path, i))]
+    if isinstance(value, float) and not math.isfinite(value):
+        return [f"config key '{'.'.join(str(p) for p in path) or '<root>'}': expected a finite number, got {value}"]
+    return []
+
+
 def default(cls, name: str):
     """The declared default of field `name` of section `cls`."""
     return next(f for f in dataclasses.fields(cls) if f.name == name).metadata["default"]

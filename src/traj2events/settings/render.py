@@ -155,6 +155,31 @@ class FrameTiming:
             raise ValueError("render.timing: adaptive needs max_log_change or max_displacement_px (both are null)")
 
 
+@section(
+    "scenarios.<name>.sun",
+    "the Sun at the site: azimuth from +x (down-range, toward the site) toward +y, "
+    'clockwise from above; a [low, high] range draws one per trajectory (docs/rendering.md "Sun")',
+)
+class SunSection:
+    range_m: float = setting(unit="m", doc="Sun-Moon distance: the Earth's perihelion to aphelion +- the Moon's orbit "
+                             "(1.467e11 .. 1.525e11)", ge=1.46e11, le=1.53e11)  # fmt: skip
+    azimuth_deg: float | list[float] = setting(unit="deg", doc="azimuth, or [low, high]: drawn uniformly per "
+                                               "trajectory", ge=-360, le=360, length=2)  # fmt: skip
+    elevation_deg: float | list[float] = setting(unit="deg", doc="above the horizon at the site (at or below it the "
+                                                 "scene is black), or [low, high]: drawn per trajectory", gt=0, le=90,
+                                                 length=2)  # fmt: skip
+
+
+@section(
+    "scenarios.<name>.earth",
+    "the Earth in the site's sky (the Sun's convention), the source of earthshine "
+    '(docs/rendering.md "Light in shadows")',
+)
+class EarthSection:
+    azimuth_deg: float = setting(unit="deg", doc="azimuth from +x toward +y", ge=-360, le=360)
+    elevation_deg: float = setting(unit="deg", doc="above the horizon at the site", gt=0, le=90)
+
+
 @section("render", "the scene's rendering, its videos and where it runs")
 class RenderSection:
     reflectance: ReflectanceParams = setting(ReflectanceParams, "", "the reflectance law")

@@ -12,37 +12,12 @@ from .declare import defaults_of, schema_of, section, setting
 from .events import EventsSection
 from .imu import ImuSection
 from .poses import Upsampling
-from .render import RenderSection, TerrainParams
+from .render import EarthSection, RenderSection, SunSection, TerrainParams
 from .solve import OcpSettings
 from .vehicle import Vehicle
 
 RANGE = "[low, high], each trajectory's drawn uniformly within (the base solve takes the midpoint)"
 TABLE_1 = "the paper's Table 1"
-
-
-@section(
-    "scenarios.<name>.sun",
-    "the Sun at the site: azimuth from +x (down-range, toward the site) toward +y, "
-    'clockwise from above; a [low, high] range draws one per trajectory (docs/rendering.md "Sun")',
-)
-class SunSection:
-    range_m: float = setting(unit="m", doc="Sun-Moon distance: the Earth's perihelion to aphelion +- the Moon's orbit "
-                             "(1.467e11 .. 1.525e11)", ge=1.46e11, le=1.53e11)  # fmt: skip
-    azimuth_deg: float | list[float] = setting(unit="deg", doc="azimuth, or [low, high]: drawn uniformly per "
-                                               "trajectory", ge=-360, le=360, length=2)  # fmt: skip
-    elevation_deg: float | list[float] = setting(unit="deg", doc="above the horizon at the site (at or below it the "
-                                                 "scene is black), or [low, high]: drawn per trajectory", gt=0, le=90,
-                                                 length=2)  # fmt: skip
-
-
-@section(
-    "scenarios.<name>.earth",
-    "the Earth in the site's sky (the Sun's convention), the source of earthshine "
-    '(docs/rendering.md "Light in shadows")',
-)
-class EarthSection:
-    azimuth_deg: float = setting(unit="deg", doc="azimuth from +x toward +y", ge=-360, le=360)
-    elevation_deg: float = setting(unit="deg", doc="above the horizon at the site", gt=0, le=90)
 
 
 @section(

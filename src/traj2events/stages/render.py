@@ -32,7 +32,9 @@ from ..scene.terrain import ProceduralTerrain, TerrainParams, load_elevation_gri
 from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
 from ..settings import without_late_defaults
-from ..settings.render import render_settings
+from ..settings.camera import CameraSection
+from ..settings.declare import non_finite
+from ..settings.render import EarthSection, ScatteredLight, Stars, SunSection, render_settings
 from ..trajectory.external import ExternalFlight
 from ..trajectory.flight import SolvedFlight, flight_of
 from ..trajectory.state import POSE
@@ -65,6 +67,20 @@ class RenderSettings:
     compression: str = "blosc"  # frames.h5's images (formats.hdf5.COMPRESSIONS)
     distortion: dict | None = None  # camera.distortion (None: a pinhole)
     supersample: int = 1  # each pixel from S x S samples (render.supersample)
+
+    def __post_init__(self) -> None:
+        """Checked against the declarations (a job's --settings is JSON anyone can write):
+        finite numbers, each section's bounds, the camera's."""
+        problems = non_finite(self.__dict__)
+        if problems:
+            raise ValueError(problems[0])
+        sections = ((TerrainParams, self.terrain), (ReflectanceParams, self.reflectance), (LodSettings, self.lod),
+                    (FrameTiming, self.timing), (SunSection, self.sun), (EarthSection, self.earth),
+                    (Stars, self.stars), (ScatteredLight, self.scattered_light))  # fmt: skip
+        for section, values in sections:
+            if values is not None:
+                section(**values)
+        CameraSection(width=self.width, height=self.height, fov_deg=self.fov_deg, mount_height_m=self.mount_height_m)
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> "RenderSettings":
