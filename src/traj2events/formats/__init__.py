@@ -9,5 +9,8 @@ of the pipeline never loads the solver or the renderer.
     flow        motion_field.h5 and Middlebury .flo
     events      the event dtype and events.h5 (DSEC layout)
     exports     the ELOPE-style .npz, EVT 3.0 and AEDAT4
+    imu         imu.h5: one trajectory's inertial and altitude streams
+    poses       pose files (CSV, HDF5, trajectory.h5) read into the site frame
+    spice       camera poses from SPICE kernels (the `spice` extra)
     tile_cache  the render's cache of tile heights, shared between jobs
 """

@@ -2,6 +2,7 @@
 
 Read first (the model):
     camera         the pinhole camera, its mounting and poses, frame conventions
+    distortion     the lens's radial-tangential distortion (OpenCV's model) and its inverse
     motion_field   the motion field's equations in numpy: flow, exact displacement, status
 
 Machinery a reader may skip:

@@ -7,4 +7,10 @@ Read first:
 
 Machinery a reader may skip:
     context        the OpenGL backend (EGL or OSMesa) and a headless context of it
+    camera_matrices  the pinhole camera's OpenGL projection and view matrices
+    law_uniforms   the reflectance laws' parameters as the shaders take them
+    footprint      a pixel's footprint on the shading texture (its levels, the box filter)
+    shading_array  the texture array of shading textures, one tile per layer
+    lens           a distorting lens: a pinhole cover drawn, then resampled onto the sensor
+    supersample    S x S supersampling, the pixel footprint's reference
 """

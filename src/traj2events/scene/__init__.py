@@ -7,8 +7,13 @@ Read first (the model):
     illumination   horizon-march shadows under it
     reflectance    the Hapke law (the shaders evaluate the same law)
     stars          the star field seen in the sky
+    earthshine     sunlight the Earth reflects onto the Moon, an optional second light
+    scattering     sunlight scattered into shadows: one bounce off the sunlit terrain
 
 Machinery a reader may skip:
     terrain_kernels  the terrain's compiled hashing, feature lookup and value noise
     tiles          level of detail: a quadtree of terrain tiles chosen per frame, cached
+    populations    features drawn from cumulative power laws of size, octave by octave
+    sky_cells      the sky cut into cells of equal area, so a frame projects its own stars
+    view           the view frustum, how far terrain is seen, the depth range drawn
 """

@@ -75,7 +75,7 @@ class EventEmulator:
     ) -> None:
         """`labels`: also label each event with its cause (`process_with_labels`).
         `input_scale`: the frames times this are the model's DN (e.g. radiance times
-        `sensor.dn_per_radiance`), applied per pixel in float64, so float32 frames need
+        `sensor.photocurrent.dn_per_radiance`), applied per pixel in float64, so float32 frames need
         no float64 copy; 8-bit frames with a scale of 1 use tables. `threads`: the per-pixel
         pass split over up to this many threads (rows of at least PIXELS_PER_THREAD pixels
         each); the same events however many. `device`: "cpu", or "cuda" for the pixel model

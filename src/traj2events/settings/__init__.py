@@ -1,19 +1,27 @@
-"""What each stage's jobs depend on, built from the validated config: the one channel from
-the config to the stages (the workflow's `params`, the commands' `--settings`). Plain
-values only, importable without CasADi or numba, so that the workflow builds its DAG
-without loading the solver or the kernels. One module per stage, so that editing one
-stage's settings reruns only that stage (a module's fingerprint covers what it imports):
+"""The settings: each config key declared once, and what each stage's jobs depend on, built
+from the validated config: the one channel from the config to the stages (the workflow's
+`params`, the commands' `--settings`). Plain values only, importable without CasADi or
+numba, so that the workflow builds its DAG without loading the solver or the kernels.
 
-    solve     base and sample solves of a scenario: vehicle, ocp, ranges, seed
-    poses     the camera poses at the frame rate: fps, upsampling method
-    render    one scenario's frames: camera, terrain, Sun, reflectance, detail, timing
-    events    the emulation: preset, pixel model, labels, input, sensor; its picture's window
+The declarations (read first):
+    declare   how a key is declared: type, default, unit, bounds, meaning, source
+    tree      the whole tree: the scenarios' declarations and defaults, the root section
+    generate  the files made from the tree: defaults.yaml, config.schema.yaml, the key table
+
+One module per stage, each with its sections' declarations, so that editing one stage's
+settings reruns only that stage (a module's fingerprint covers what it imports):
+    vehicle   the lander (every stage that flies the dynamics imports it)
+    solve     base and sample solves of a scenario: the OCP, ranges, seed
+    poses     the camera poses at the frame rate: fps, upsampling; diverts, hovers, pose files
+    render    one scenario's frames: terrain, reflectance, detail, light, Sun, timing
+    events    the emulation: pixel model, sensor, readout, space; its picture's window
     camera    the camera and the Moon's sphere (motion field, its picture)
+    imu       the IMU's rate and errors
 
 The simple ones are a map from each setting to its config key (`pick`), which the commands
 also read to offer one option per key (traj2events.options). Each stage turns its settings
 into its model's objects (`trajectory.scenarios.ScenarioSettings`, `stages.render.RenderSettings`,
-`sensor.emulator.EmulatorParams`, `geometry.camera.Camera`).
+`settings.events.EmulatorParams`, `geometry.camera.Camera`).
 """
 
 from __future__ import annotations

@@ -4,6 +4,8 @@ The command line (cli.py), the tests and the benchmarks all call these functions
     base_solution         the scenario's base optimal-control solve          -> base.h5
     sample_trajectories   continuation sampling of the boundary conditions   -> solutions.h5, samples.csv
     camera_poses          poses at the frame rate from the re-integrated dynamics -> trajectory.h5
+    external_poses        an external scenario's poses from a pose file or SPICE -> trajectory.h5
+    imu                   the IMU and altitude streams at the IMU's rate     -> imu.h5
     render                linear radiance, depth and videos of every pose    -> frames.h5, video.mkv, preview.mp4
     motion_field          ground-truth motion field of every n-th frame      -> motion_field.h5, flow/*.flo
     events                event emulation and its exports                    -> events.h5, .npz, .raw, .aedat4
@@ -11,4 +13,5 @@ The command line (cli.py), the tests and the benchmarks all call these functions
     pictures              mosaics of frames, motion field and events; the dataset figure (PNG)
     index                 one row per trajectory of a scenario               -> index.csv
     summary               one row per scenario                               -> summary.csv
+    overview              the dataset in numbers and one figure              -> overview.html
 """

@@ -1,0 +1,106 @@
+"""The house's maps stay true: every module is in its folder's map, the modules without a
+test file only get fewer, and the code names that docs and docstrings give resolve."""
+
+import ast
+import importlib
+import re
+
+import pytest
+
+from conftest import ROOT
+
+PACKAGE = ROOT / "src" / "traj2events"
+TESTS = ROOT / "tests"
+
+# Modules with no test file of their own (tested through others, or not yet): this list
+# only shrinks. A module that gets a test file must leave it.
+WITHOUT_TEST_FILE = {
+    "defaults", "memory", "progress", "stages/base_solution", "stages/sample_trajectories",
+    "stages/camera_poses",
+    "stages/pictures", "stages/index", "stages/summary", "stages/render_events",
+    "formats/atomic", "formats/flow", "formats/exports", "formats/poses",
+    "formats/spice", "formats/rounding", "geometry/motion_pass", "renderer/draw", "renderer/context",
+    "renderer/camera_matrices", "renderer/law_uniforms", "renderer/lens", "renderer/shading_array",
+    "scene/sun", "scene/terrain_kernels", "scene/populations", "scene/view", "sensor/noise", "sensor/pixel",
+    "sensor/ordering", "sensor/parallel", "sensor/photocurrent", "settings/events",
+    "settings/generate", "settings/poses", "settings/solve", "settings/tree",
+    "settings/vehicle", "trajectory/state", "trajectory/legs", "trajectory/flight", "trajectory/external",
+}  # fmt: skip
+
+
+def modules() -> list[str]:
+    """Every module of the package, as folder/name (name alone at the top level)."""
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        relative = path.relative_to(PACKAGE).with_suffix("")
+        if relative.name not in ("__init__", "__main__"):
+            found.append(relative.as_posix())
+    return found
+
+
+def has_test_file(module: str) -> bool:
+    folder, _, name = module.rpartition("/")
+    candidates = [f"test_{name}.py", f"{folder}/test_{name}.py", f"test_{folder}_{name}.py"]
+    if folder == "stages":
+        candidates.append(f"test_stage_{name}.py")
+    return any((TESTS / c).exists() for c in candidates if c)
+
+
+@pytest.mark.parametrize("folder", sorted({m.rpartition("/")[0] for m in modules() if "/" in m}))
+def test_every_module_is_in_its_folders_map(folder):
+    doc = ast.get_docstring(ast.parse((PACKAGE / folder / "__init__.py").read_text())) or ""
+    missing = [m for m in modules() if m.rpartition("/")[0] == folder and not re.search(
+        rf"^\s+{re.escape(m.rpartition('/')[2])}\b", doc, re.M)]  # fmt: skip
+    assert not missing, f"{folder}/__init__.py's map lacks {missing}"
+
+
+def test_the_architecture_page_names_every_top_level_module_and_folder():
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    top = [m for m in modules() if "/" not in m] + sorted({m.split("/")[0] + "/" for m in modules() if "/" in m})
+    assert not [m for m in top if not re.search(rf"\b{re.escape(m.removesuffix('/'))}(\.py|/)", text)]
+
+
+def test_the_modules_without_a_test_file_only_get_fewer():
+    untested = {m for m in modules() if not has_test_file(m)}
+    assert untested <= WITHOUT_TEST_FILE, f"give these a test file: {sorted(untested - WITHOUT_TEST_FILE)}"
+    assert not WITHOUT_TEST_FILE - untested, f"these have one now: {sorted(WITHOUT_TEST_FILE - untested)}"
+
+
+# `a.b` or `a.b.c` whose first part is one of the package's modules or folders.
+TOP = sorted({m.split("/")[0] for m in modules()})
+REFERENCE = re.compile(rf"`((?:{'|'.join(TOP)})(?:\.[A-Za-z_][A-Za-z0-9_]*)+)(?:\(\))?`")
+FILE_SUFFIXES = ("h5", "py", "yaml", "md", "csv", "flo", "png", "mkv", "mp4", "npz", "raw", "aedat4", "tsv")
+
+
+def resolves(name: str) -> bool:
+    parts = name.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            target = importlib.import_module("traj2events." + ".".join(parts[:cut]))
+        except ImportError:
+            continue
+        for attribute in parts[cut:]:
+            if not hasattr(target, attribute):
+                return False
+            target = getattr(target, attribute)
+        return True
+    return False
+
+
+def references() -> list[tuple[str, str]]:
+    """(where, name) of each code name the docs and the package's docstrings give."""
+    texts = [(p.relative_to(ROOT).as_posix(), p.read_text()) for p in sorted((ROOT / "docs").rglob("*.md"))]
+    for path in sorted(PACKAGE.rglob("*.py")):
+        tree = ast.parse(path.read_text())
+        docs = [ast.get_docstring(n) for n in ast.walk(tree) if isinstance(n, (ast.Module, ast.ClassDef,
+                                                                                ast.FunctionDef))]  # fmt: skip
+        texts.append((path.relative_to(ROOT).as_posix(), "\n".join(d for d in docs if d)))
+    return [(where, m.group(1)) for where, text in texts for m in REFERENCE.finditer(text)
+            if m.group(1).rsplit(".", 1)[1] not in FILE_SUFFIXES]  # fmt: skip
+
+
+def test_every_code_name_in_the_docs_and_docstrings_resolves():
+    found = references()
+    assert len(found) > 50
+    broken = sorted({f"{where}: `{name}`" for where, name in found if not resolves(name)})
+    assert not broken, "\n".join(broken)
