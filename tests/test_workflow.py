@@ -421,7 +421,7 @@ def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
     assert edited_source("cli.py", 'help="frames read at a time', 'help="frames read together') == {}
     assert (
         edited_source(
-            "sensor/emulator.py", '"""The pixel model\'s parameters:', '"""The parameters of the pixel model;'
+            "sensor/emulator.py", '"""Event-camera emulator: frames', '"""The event-camera emulator: frames'
         )
         == {}
     )
@@ -629,7 +629,7 @@ def test_what_the_working_directory_cannot_give_stops_before_any_job(tmp_path, c
     dry = snakemake(tmp_path, "-n", check=False)  # a dry run prints the plan; only a size gets a warning
     refused = "does not fit" not in message
     assert (dry.returncode != 0) == refused and message in dry.stdout + dry.stderr, dry.stderr[-2000:]
-    assert refused or "warning: a real run would stop here" in dry.stderr
+    assert refused or "warning: a run (not a dry run) stops here" in dry.stderr
 
 
 def test_a_config_file_that_is_not_utf8_is_named(tmp_path):

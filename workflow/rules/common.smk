@@ -26,18 +26,16 @@ from traj2events.settings.poses import scenario_manoeuvre
 from traj2events.settings.render import render_settings as render_settings_of
 from traj2events.settings.solve import solve_settings
 
-# A dry run (snakemake -n) of a dataset too large to build prints its plan and a warning;
-# the real run refuses it.
+# A dataset too large to build is refused by the real run only (`refuse_too_large`, the
+# Snakefile's onstart, which a dry run skips): `snakemake -n` prints its plan and a warning.
 try:
-    _resolved = resolve_config(config, refuse_large=not workflow.dryrun)
+    _resolved = resolve_config(config, refuse_large=False)
 except ConfigError as error:
     raise WorkflowError(f"invalid configuration: {error}")
 config.clear()
 config.update(_resolved)
 _plan = dataset_plan(config)
 print(f"traj2events: {_plan.summary()}", file=sys.stderr)
-if workflow.dryrun and (_too_large := too_large_reason(config)):
-    print(f"traj2events: warning: a real run would stop here: {_too_large}", file=sys.stderr)
 
 
 def results_bytes():
@@ -47,28 +45,40 @@ def results_bytes():
     return sum(f.stat().st_size for f in files if f.is_file() and f.parts[1:2] != ("tile_cache",))
 
 
-def check_working_directory():
-    """What the working directory cannot give, known before any job: an unusable tile cache
-    folder (every render job would fail on it), outputs that cannot fit the free space."""
-    if config["render"]["tile_cache"] and (unusable := tile_cache_unusable(config["render"]["tile_cache"])):
-        raise WorkflowError(f"invalid configuration: render.tile_cache: {unusable}")
+def too_large():
+    """Why this dataset may not be built here (too large for the plan's limits, or for the
+    free space), or None."""
+    reason = too_large_reason(config)
     free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
-    if not config["allow_large_dataset"] and (short := disk_shortfall(_plan, free, results_bytes())):
-        if workflow.dryrun:
-            print(
-                f"traj2events: warning: a real run would stop here: the dataset does not fit: {short}", file=sys.stderr
-            )
-            return
-        raise WorkflowError(
+    if not reason and not config["allow_large_dataset"] and (short := disk_shortfall(_plan, free, results_bytes())):
+        reason = (
             f"the dataset does not fit: {short}; free space, build fewer or smaller trajectories, or set "
             "'allow_large_dataset: true' if the space will be there (`traj2events check-config` prints the plan)"
         )
+    return reason
+
+
+def refuse_too_large():
+    """The real run's refusal, before any job (the Snakefile's onstart)."""
+    if _too_large:
+        raise WorkflowError(_too_large)
+
+
+def check_working_directory():
+    """What the working directory cannot give, known before any job: an unusable tile cache
+    folder (every render job would fail on it)."""
+    if config["render"]["tile_cache"] and (unusable := tile_cache_unusable(config["render"]["tile_cache"])):
+        raise WorkflowError(f"invalid configuration: render.tile_cache: {unusable}")
 
 
 # By the controller only: a job that runs the workflow again (a group's, on SLURM) would walk
 # results/ in every submission, and could refuse itself as the disk fills as planned.
+_too_large = None
 if workflow.is_main_process:
     check_working_directory()
+    _too_large = too_large()
+    if _too_large:
+        print(f"traj2events: warning: a run (not a dry run) stops here: {_too_large}", file=sys.stderr)
 
 if DeploymentMethod.CONDA in workflow.deployment_settings.deployment_method:
     # --sdm conda: each rule's environment (envs/*.yaml) holds the dependencies and the
