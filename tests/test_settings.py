@@ -54,17 +54,15 @@ def test_each_command_reads_back_the_settings_the_workflow_passes(path):
         assert settings_from(args, keys) == settings
 
 
-def test_compression_reaches_the_three_writers_settings_only_where_it_is_not_the_default():
-    """Blosc (the default) is left out, so that datasets built before the key keep their
-    jobs' params; gzip reaches render, motion field and events, and RenderSettings reads it."""
+def test_compression_reaches_the_three_writers_settings():
+    """compression reaches render, motion field and events, and RenderSettings reads it."""
     from traj2events.settings.camera import motion_field_settings
     from traj2events.settings.events import events_settings
     from traj2events.stages.render import RenderSettings
 
     config = load_config(ROOT / "config/smoke.yaml")
     each = (events_settings, motion_field_settings, lambda c: render_settings(c, "descent"))
-    assert all("compression" not in settings(config) for settings in each)
-    assert RenderSettings.from_json(json.dumps(render_settings(config, "descent"))).compression == "blosc"
+    assert [settings(config)["compression"] for settings in each] == ["blosc"] * 3
     config["compression"] = "gzip"
     assert [settings(config)["compression"] for settings in each] == ["gzip"] * 3
     assert RenderSettings.from_json(json.dumps(render_settings(config, "descent"))).compression == "gzip"
@@ -93,7 +91,8 @@ import json, sys
 config = resolve_config({{}})
 dataset_plan(config)
 for name in config["scenarios"]:
-    json.dumps(solve_settings(config, name)), json.dumps(render_settings_of(config, name))
+    for job in ("solve", "poses", "imu", "render", "motion_field", "camera", "events", "events_picture"):
+        job_settings_json(config, job, name, "0000")
     job_resources(config, "render", name)
 for stage in ("base_solution", "render", "events", "pictures"):
     code_fingerprint(f"traj2events.stages.{{stage}}")

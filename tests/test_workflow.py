@@ -420,9 +420,7 @@ def edited_source(built, tmp_path):
 def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
     assert edited_source("cli.py", 'help="frames read at a time', 'help="frames read together') == {}
     assert (
-        edited_source(
-            "sensor/emulator.py", '"""Event-camera emulator: frames', '"""The event-camera emulator: frames'
-        )
+        edited_source("sensor/emulator.py", '"""Event-camera emulator: frames', '"""The event-camera emulator: frames')
         == {}
     )
     assert edited_source("renderer/context.py", "\nimport os\n", "\nimport os  # a comment\n") == {}

@@ -15,16 +15,8 @@ from traj2events.config import ConfigError, resolve_config, too_large_reason
 from traj2events.fingerprint import code_fingerprint
 from traj2events.formats.tile_cache import unusable as tile_cache_unusable
 from traj2events.plan import dataset_plan, disk_shortfall, job_resources
-from traj2events.settings.camera import camera_settings as camera_settings_of
-from traj2events.settings.camera import motion_field_settings as motion_field_settings_of
-from traj2events.settings.events import events_picture_settings as events_picture_settings_of
-from traj2events.settings.events import events_settings as events_settings_of
-from traj2events.settings.imu import imu_settings as imu_settings_of
-from traj2events.settings.poses import external_pose_settings, is_external, scenario_count, trajectory_source
-from traj2events.settings.poses import pose_settings as pose_settings_of
-from traj2events.settings.poses import scenario_manoeuvre
-from traj2events.settings.render import render_settings as render_settings_of
-from traj2events.settings.solve import solve_settings
+from traj2events.settings.jobs import job_settings_json
+from traj2events.settings.poses import is_external, scenario_count, trajectory_source
 
 # A dataset too large to build is refused by the real run only (`refuse_too_large`, the
 # Snakefile's onstart, which a dry run skips): `snakemake -n` prints its plan and a warning.
@@ -113,25 +105,16 @@ def code(stage):
     return code_fingerprint(f"traj2events.stages.{stage}")
 
 
+def settings(job):
+    """A rule's settings (its params and its command's --settings): what one job of `job`
+    depends on, as JSON (traj2events.settings.jobs.job_settings)."""
+    return lambda wildcards: job_settings_json(config, job, wildcards.get("scenario"), wildcards.get("id"))
+
+
 def resources_of(stage, key):
     """A cluster resource of one job of `stage` (mem_mb, runtime in minutes), estimated from
     the config and the cost table (traj2events.plan.job_resources, src/traj2events/costs.yaml)."""
     return lambda wildcards, threads: job_resources(config, stage, wildcards.get("scenario"), threads)[key]
-
-
-def scenario_settings(wildcards):
-    """Everything the solves of one scenario depend on, as JSON (vehicle, ocp, ranges, seed)."""
-    return json.dumps(solve_settings(config, wildcards.scenario), sort_keys=True)
-
-
-def render_settings(wildcards):
-    """Everything one trajectory's frames depend on, as JSON (camera, terrain, its Sun, reflectance, LOD)."""
-    return json.dumps(render_settings_of(config, wildcards.scenario, wildcards.id), sort_keys=True)
-
-
-def trajectory_manoeuvre(wildcards):
-    """The trajectory's divert or hover, as JSON (null: none; drawn from the config, as its Sun)."""
-    return json.dumps(scenario_manoeuvre(config, wildcards.scenario, wildcards.id), sort_keys=True)
 
 
 def elevation_grid(wildcards):
@@ -173,7 +156,7 @@ def events_in_render(wildcards, output):
     if not ONE_JOB:
         return ""
     exports = " ".join(config["events"]["exports"])
-    settings = shlex.quote(json.dumps(events_settings_of(config), sort_keys=True))
+    settings = shlex.quote(job_settings_json(config, "events"))
     return f"--events {output.events} --events-settings {settings} --seed {trajectory_seed(wildcards)}" + (
         f" --exports {exports}" if exports else ""
     )
@@ -184,11 +167,6 @@ def preview_option(wildcards, output):
     `output`: Snakemake does not record such a parameter, so turning the preview off in a
     built dataset reruns no render job (tests/test_workflow.py)."""
     return f"--preview {output.preview}" if config["render"]["preview"] else ""
-
-
-def as_json(settings_of):
-    """A rule's --settings: a settings function of the config (traj2events.settings), as JSON."""
-    return lambda wildcards: json.dumps(settings_of(config), sort_keys=True)
 
 
 EXPORT_FILES = {"npz": "events.npz", "evt3": "events.raw", "aedat4": "events.aedat4"}
@@ -220,11 +198,6 @@ def trajectory_ids(scenario):
 def pose_file(wildcards):
     """An external trajectory's pose file (so that editing it rebuilds the trajectory)."""
     return trajectory_source(config, wildcards.scenario, wildcards.id)
-
-
-def external_settings(wildcards):
-    """Everything an external trajectory's poses depend on, as JSON."""
-    return json.dumps(external_pose_settings(config, wildcards.scenario), sort_keys=True)
 
 
 def sample_table(wildcards):

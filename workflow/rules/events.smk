@@ -24,7 +24,7 @@ if not ONE_JOB:
             mem_mb=resources_of("events", "mem_mb"),
             runtime=resources_of("events", "runtime"),
         params:
-            settings=as_json(events_settings_of),
+            settings=settings("events"),
             seed=trajectory_seed,
             exports=export_flags,
             code=code("events"),

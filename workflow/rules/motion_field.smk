@@ -19,7 +19,7 @@ rule motion_field:
         mem_mb=resources_of("motion_field", "mem_mb"),
         runtime=resources_of("motion_field", "runtime"),
     params:
-        settings=as_json(motion_field_settings_of),
+        settings=settings("motion_field"),
         code=code("motion_field"),
     shell:
         "traj2events motion-field {input.trajectory} --frames {input.frames} --settings {params.settings:q} "

@@ -44,7 +44,7 @@ rule motion_field_picture:
     conda:
         ENV
     params:
-        settings=as_json(camera_settings_of),
+        settings=settings("camera"),
         code=code("pictures"),
     shell:
         "traj2events picture motion-field {input.trajectory} --settings {params.settings:q} --video {input.video} "
@@ -69,7 +69,7 @@ rule events_picture:
     conda:
         ENV
     params:
-        settings=as_json(events_picture_settings_of),
+        settings=settings("events_picture"),
         code=code("pictures"),
     shell:
         "traj2events picture events {input.events} --trajectory {input.trajectory} "

@@ -21,9 +21,9 @@ rule render:
         mem_mb=resources_of("render_events" if ONE_JOB else "render", "mem_mb"),
         runtime=resources_of("render_events" if ONE_JOB else "render", "runtime"),
     params:
-        settings=render_settings,
+        settings=settings("render"),
         code=code("render_events" if ONE_JOB else "render"),
-        events_settings=as_json(events_settings_of) if ONE_JOB else "",
+        events_settings=settings("events") if ONE_JOB else "",
         seed=trajectory_seed if ONE_JOB else "",
         events=events_in_render,
         backend=config["render"]["backend"],

@@ -14,7 +14,7 @@ rule base_solution:
     conda:
         ENV
     params:
-        settings=scenario_settings,
+        settings=settings("solve"),
         code=code("base_solution"),
     shell:
         "traj2events base --settings {params.settings:q} --record-failure --output {output} 2> {log}"
@@ -37,7 +37,7 @@ rule sample_trajectories:
         mem_mb=resources_of("sample_trajectories", "mem_mb"),
         runtime=resources_of("sample_trajectories", "runtime"),
     params:
-        settings=scenario_settings,
+        settings=settings("solve"),
         code=code("sample_trajectories"),
     shell:
         "traj2events sample --settings {params.settings:q} --base {input.base} "
@@ -58,8 +58,8 @@ rule camera_poses:
     conda:
         ENV
     params:
-        settings=as_json(pose_settings_of),
-        manoeuvre=trajectory_manoeuvre,
+        settings=settings("poses"),
+        manoeuvre=settings("manoeuvre"),
         code=code("camera_poses"),
     shell:
         "traj2events upsample --solutions {input} --id {wildcards.id} --settings {params.settings:q} "
@@ -80,7 +80,7 @@ rule external_poses:
     conda:
         ENV
     params:
-        settings=external_settings,
+        settings=settings("external_poses"),
         code=code("external_poses"),
     shell:
         "traj2events poses {input} --id {wildcards.id} --settings {params.settings:q} --output {output} 2> {log}"
@@ -98,7 +98,7 @@ rule imu:
     conda:
         ENV
     params:
-        settings=as_json(imu_settings_of),
+        settings=settings("imu"),
         seed=trajectory_seed,
         code=code("imu"),
     shell:

@@ -7,6 +7,7 @@ The declarations (read first):
     declare   how a key is declared: type, default, unit, bounds, meaning, source
     tree      the whole tree: the scenarios' declarations and defaults, the root section
     generate  the files made from the tree: defaults.yaml, config.schema.yaml, the key table
+    jobs      each rule's settings from the config: the one getter the workflow calls
 
 One module per stage, each with its sections' declarations, so that editing one stage's
 settings reruns only that stage (a module's fingerprint covers what it imports):
@@ -29,23 +30,6 @@ from __future__ import annotations
 import copy
 import hashlib
 import random
-
-
-def without_late_defaults(settings: dict) -> dict:
-    """`settings` without the keys that came after datasets were built where they hold
-    their default (`compression` Blosc, `distortion` none, `supersample` 1), so that those
-    datasets' jobs' settings (the rules' params) stay as they were."""
-    return {k: v for k, v in settings.items() if not _late_default(k, v)}
-
-
-def _late_default(key: str, value) -> bool:
-    if key == "compression":
-        return value == "blosc"
-    if key == "supersample":
-        return value == 1
-    if key == "distortion":
-        return value is None or not any((value or {}).values())
-    return False
 
 
 def config_value(config: dict, path: str):

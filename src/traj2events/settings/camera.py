@@ -3,7 +3,7 @@ of the motion field and its picture."""
 
 from __future__ import annotations
 
-from . import pick, without_late_defaults
+from . import pick
 from .declare import section, setting
 
 OPENCV = "OpenCV's radial-tangential model (k1, k2, p1, p2, k3) on normalised coordinates"
@@ -55,12 +55,12 @@ MOTION_FIELD = {**CAMERA, "every_n_frames": "motion_field.every_n_frames", "comp
 
 
 def camera_settings(config: dict) -> dict:
-    """The camera (image size, field of view, mounting, lens distortion where it has one) and
+    """The camera (image size, field of view, mounting, lens distortion) and
     the sphere through the site."""
-    return without_late_defaults(pick(config, CAMERA))
+    return pick(config, CAMERA)
 
 
 def motion_field_settings(config: dict) -> dict:
     """The camera and sphere, which frames' fields are written, and motion_field.h5's
-    compression where it is not the default."""
-    return without_late_defaults(pick(config, MOTION_FIELD))
+    compression."""
+    return pick(config, MOTION_FIELD)

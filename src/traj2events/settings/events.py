@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import asdict
 
-from . import pick, without_late_defaults
+from . import pick
 from .declare import section, setting
 
 IMX636 = "Sony IMX636 / Prophesee Gen4.1: photodiode area 4.86 x 4.86 um (Prophesee's QE note)"
@@ -178,8 +178,8 @@ def events_settings(config: dict) -> dict:
     """Everything the emulation depends on (the seed aside, per trajectory): the pixel
     model (and the preset it came from), labels, the input scale, the sensor and its readout,
     and the device it runs on (a GPU can round a crossing differently); events.h5's
-    compression where it is not the default."""
-    return without_late_defaults(pick(config, EVENTS))
+    compression."""
+    return pick(config, EVENTS)
 
 
 def events_picture_settings(config: dict) -> dict:

@@ -4,7 +4,7 @@ when to render (`render.timing`)."""
 from __future__ import annotations
 
 from ..geometry.camera import horizon_distance_m
-from . import trajectory_rng, without_late_defaults
+from . import trajectory_rng
 from .declare import section, setting
 from .poses import external_extents, is_external, scenario_divert
 
@@ -229,7 +229,7 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     config gives it as a range; scenario_sun): camera, sphere, terrain, Sun,
     reflectance, level of detail and its extent, display mapping, frame timing, stars,
     with adaptive timing the emulator's input (its scale sets the predicted log change), and
-    frames.h5's compression where it is not the default."""
+    frames.h5's compression."""
     sc = config["scenarios"][name]
     radius = float(config["motion_field"]["moon_radius_m"])
     # Out to the horizon of the scenario's highest camera (with a margin for climbs and
@@ -247,32 +247,30 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     divert = scenario_divert(config, name, trajectory_id)
     if divert:  # a landing pad at the new site as at the old (scene/terrain.py)
         terrain["divert_sites_m"] = [divert["site_m"]]
-    return without_late_defaults(
-        {
-            "scenario": name,
-            "width": int(camera["width"]),
-            "height": int(camera["height"]),
-            "fov_deg": float(camera["fov_deg"]),
-            "mount_height_m": float(camera["mount_height_m"]),
-            "distortion": dict(camera["distortion"]),
-            "moon_radius_m": radius,
-            "terrain": terrain,
-            "sun": scenario_sun(config, name, trajectory_id),
-            "earth": dict(sc["earth"]) if sc.get("earth") else None,
-            "reflectance": dict(r["reflectance"]),
-            "lod": dict(r["lod"]),
-            "supersample": int(r["supersample"]),
-            "scattered_light": dict(r["scattered_light"]),
-            "half_extent_m": float(reach + horizon),
-            "display_white_w_m2_sr": float(r["display_white_w_m2_sr"]),
-            "display_gamma": float(r["display_gamma"]),
-            "timing": dict(r["timing"]),
-            "stars": dict(r["stars"]),
-            # Only adaptive frames depend on the emulator's input (None: fixed renders do not
-            # rerun when the sensor settings change).
-            "emulator_input": {"input": config["events"]["input"], "sensor": dict(config["events"]["sensor"])}
-            if adaptive
-            else None,
-            "compression": config["compression"],  # frames.h5's
-        }
-    )
+    return {
+        "scenario": name,
+        "width": int(camera["width"]),
+        "height": int(camera["height"]),
+        "fov_deg": float(camera["fov_deg"]),
+        "mount_height_m": float(camera["mount_height_m"]),
+        "distortion": dict(camera["distortion"]),
+        "moon_radius_m": radius,
+        "terrain": terrain,
+        "sun": scenario_sun(config, name, trajectory_id),
+        "earth": dict(sc["earth"]) if sc.get("earth") else None,
+        "reflectance": dict(r["reflectance"]),
+        "lod": dict(r["lod"]),
+        "supersample": int(r["supersample"]),
+        "scattered_light": dict(r["scattered_light"]),
+        "half_extent_m": float(reach + horizon),
+        "display_white_w_m2_sr": float(r["display_white_w_m2_sr"]),
+        "display_gamma": float(r["display_gamma"]),
+        "timing": dict(r["timing"]),
+        "stars": dict(r["stars"]),
+        # Only adaptive frames depend on the emulator's input (None: fixed renders do not
+        # rerun when the sensor settings change).
+        "emulator_input": {"input": config["events"]["input"], "sensor": dict(config["events"]["sensor"])}
+        if adaptive
+        else None,
+        "compression": config["compression"],  # frames.h5's
+    }

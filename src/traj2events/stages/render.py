@@ -31,7 +31,6 @@ from ..scene.sun import Sun
 from ..scene.terrain import ProceduralTerrain, TerrainParams, load_elevation_grid
 from ..scene.tiles import LodSettings, TileSet
 from ..sensor.photocurrent import emulator_white_w_m2_sr
-from ..settings import without_late_defaults
 from ..settings.camera import CameraSection
 from ..settings.declare import non_finite
 from ..settings.render import EarthSection, ScatteredLight, Stars, SunSection, render_settings
@@ -95,7 +94,7 @@ class RenderSettings:
         return emulator_white_w_m2_sr(self.emulator_input, self.display_white_w_m2_sr)
 
     def to_json(self) -> str:
-        return json.dumps(without_late_defaults(self.__dict__), sort_keys=True)
+        return json.dumps(self.__dict__, sort_keys=True)
 
     @classmethod
     def from_json(cls, text: str) -> "RenderSettings":
