@@ -470,7 +470,7 @@ def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(bu
     lens = {"k1": -0.2, "k2": 0.03, "p1": 0.004, "p2": -0.002, "k3": 0.0}
     lens_config = resolve_config({**CONFIG_OVERLAY, "camera": {**CONFIG_OVERLAY["camera"], "distortion": lens}})
     settings = RenderSettings.from_config(lens_config, "descent")
-    assert "distortion" not in RenderSettings.from_config(config, "descent").to_json()  # a pinhole's jobs unchanged
+    assert not any(RenderSettings.from_config(config, "descent").distortion.values())  # the default: a pinhole
     render_trajectory(
         built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None, tile_cache=tile_cache
     )
@@ -510,8 +510,8 @@ def test_a_distorting_lens_reaches_the_frames_the_motion_field_and_the_events(bu
 @pytest.mark.slow  # a whole trajectory rendered again
 def test_supersampled_frames_say_so_and_keep_the_scenes_light(built, config, tmp_path, tile_cache):
     """render.supersample: frames.h5 holds the camera's pixels, each the mean of S x S
-    samples, and says how many; the default's jobs are as before (no new setting)."""
-    assert "supersample" not in RenderSettings.from_config(config, "descent").to_json()
+    samples, and says how many."""
+    assert RenderSettings.from_config(config, "descent").supersample == 1
     settings = RenderSettings.from_config(resolve_config({**CONFIG_OVERLAY, "render": {"supersample": 3}}), "descent")
     render_trajectory(
         built / "trajectory.h5", settings, tmp_path / "frames.h5", tmp_path / "video.mkv", None, tile_cache=tile_cache
