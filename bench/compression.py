@@ -18,19 +18,16 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import h5py
+import hdf5plugin  # noqa: F401
+import numpy as np
 
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-import numpy as np  # noqa: E402
-
-from traj2events.formats import hdf5  # noqa: E402
-from traj2events.formats.events import COLUMNS  # noqa: E402
+from traj2events.formats import hdf5
+from traj2events.formats.events import COLUMNS
 
 IMAGE_CODEC = ("lz4", 5, False)  # frames.h5's and motion_field.h5's Blosc codec (formats/frames.py, flow.py)
 EVENT_CHUNK = 1 << 18  # EventsWriter's

@@ -34,27 +34,26 @@ import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-SRC = Path(__file__).resolve().parents[1] / "src"
-sys.path.insert(0, str(SRC))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-import numpy as np  # noqa: E402
-from motion_field_command import short_trajectory  # noqa: E402
+import h5py
+import hdf5plugin  # noqa: F401
+import numpy as np
+from common import short_trajectory
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.camera import Camera  # noqa: E402
-from traj2events.geometry.motion_field import (  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.geometry.camera import Camera
+from traj2events.geometry.motion_field import (
     MOON_RADIUS_M,
     SKY,
     inverse_depth_sphere,
     local_vertical,
     sphere_motion,
 )
-from traj2events.settings.camera import motion_field_settings  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.settings.camera import motion_field_settings
+from traj2events.stages.render import RenderSettings
+
+SRC = Path(__file__).resolve().parents[1] / "src"
 
 LENSES = {
     "A pinhole": {"k1": 0.0, "k2": 0.0, "p1": 0.0, "p2": 0.0, "k3": 0.0},

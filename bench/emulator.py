@@ -30,28 +30,18 @@ import argparse
 import os
 import platform
 import resource
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
-from scipy.ndimage import gaussian_filter  # noqa: E402
+import numpy as np
+from common import moving_texture
 
-import traj2events.sensor.emulator as emulator  # noqa: E402
-from traj2events.formats.events import EVENT_LABELS, EventsWriter  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-
-
-def moving_texture(height: int, width: int, n_frames: int, seed: int = 0) -> np.ndarray:
-    """Smoothed noise sliding sideways by 2 px per frame, 10-240 DN."""
-    rng = np.random.default_rng(seed)
-    big = gaussian_filter(rng.uniform(0, 1, (height, width + 2 * n_frames + 2)), 3.0)
-    big = (big - big.min()) / (big.max() - big.min()) * 230 + 10
-    return np.stack([big[:, 2 * k : 2 * k + width] for k in range(n_frames)]).round().astype(np.uint8)
+import traj2events.sensor.emulator as emulator
+from traj2events.formats.events import EVENT_LABELS, EventsWriter
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.stages.events import preset_params
 
 
 def flickering(frames: np.ndarray, period_frames: int, dim: float) -> np.ndarray:

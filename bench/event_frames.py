@@ -20,27 +20,25 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
-from pixel_integration import render_window  # noqa: E402
-from scipy.ndimage import binary_dilation, convolve  # noqa: E402
+import numpy as np
+from common import render_window
+from scipy.ndimage import binary_dilation, convolve
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.figures import event_frame  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.pictures import PAPER_FRACTIONS, PAPER_LABELS, centred_window, save_png  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.figures import event_frame
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+from traj2events.stages.events import preset_params
+from traj2events.stages.pictures import PAPER_FRACTIONS, PAPER_LABELS, centred_window, save_png
+from traj2events.stages.render import RenderSettings
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.upsample import ReintegratedStates
 
 MIDDLE = slice(1, 4)  # events.png's middle panels: tf/4, tf/2, 3tf/4
 

@@ -41,16 +41,15 @@ import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-import numpy as np  # noqa: E402
-from workflow_cost import clip_trajectory  # noqa: E402  (bench/, beside this script)
+import h5py
+import hdf5plugin  # noqa: F401
+import numpy as np
+from common import clip_trajectory
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.stages.render import RenderSettings, render_trajectory  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.stages.render import RenderSettings, render_trajectory
 
 THREADS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "LP_NUM_THREADS")
 V2E = "C v2e, video.mkv"  # the command that is v2e's

@@ -20,25 +20,22 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import time
-from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
-from scipy.spatial.transform import Rotation  # noqa: E402
+import numpy as np
+from scipy.spatial.transform import Rotation
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.geometry.camera import camera_motion, camera_pose  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.external import ExternalFlight  # noqa: E402
-from traj2events.trajectory.flight import camera_samples  # noqa: E402
-from traj2events.trajectory.imu import specific_force, specific_force_body  # noqa: E402
-from traj2events.trajectory.ocp import LandingProblem  # noqa: E402
-from traj2events.trajectory.scenarios import ScenarioSettings, base_conditions  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls, upsample  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.geometry.camera import camera_motion, camera_pose
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.external import ExternalFlight
+from traj2events.trajectory.flight import camera_samples
+from traj2events.trajectory.imu import specific_force, specific_force_body
+from traj2events.trajectory.ocp import LandingProblem
+from traj2events.trajectory.scenarios import ScenarioSettings, base_conditions
+from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls, upsample
 
 MOUNT_M = 3.0
 

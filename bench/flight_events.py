@@ -25,20 +25,17 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+import h5py
+import numpy as np
+from common import ROOT, clip_trajectory, cpu_seconds, stage_commands
 
-import h5py  # noqa: E402
-import numpy as np  # noqa: E402
-from workflow_cost import ROOT, clip_trajectory, cpu_seconds, stage_commands  # noqa: E402  (sets up src/)
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.plan import trajectory_frames  # noqa: E402
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.plan import trajectory_frames
 
 
 def times_to_go(tf_s: float, step_s: float, last_s: float, clip_s: float) -> list[float]:

@@ -18,20 +18,18 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.motion_field import depth_flow  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.geometry.motion_field import depth_flow
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.stages.render import RenderSettings
 
 
 def main() -> None:

@@ -65,21 +65,20 @@ from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion  # noqa: E402
-from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
-from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.render import RenderSettings, render_between  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.geometry.frame_timing import FrameTiming, emulator_log, frame_motion
+from traj2events.renderer.footprint import TEXTURE_FILTERS
+from traj2events.renderer.supersample import sensor_renderer
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.sensor.laws import radiance_to_dn
+from traj2events.stages.events import preset_params
+from traj2events.stages.render import RenderSettings, render_between
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.upsample import ReintegratedStates
 
 FIXED_FPS = (50, 80, 100, 125, 200, 250, 400, 500, 1000)
 ADAPTIVE = {

@@ -23,28 +23,24 @@ import io
 import os
 import platform
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402
-import numpy as np  # noqa: E402
+import h5py
+import hdf5plugin
+import numpy as np
+from common import CASES, R_MOON, poses
 
-from traj2events.formats.frames import round_mantissa  # noqa: E402
-from traj2events.geometry.camera import Camera  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
-from traj2events.sensor.laws import log_intensity_8bit, radiance_to_dn  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from render import CASES, R_MOON, poses  # noqa: E402
+from traj2events.formats.frames import round_mantissa
+from traj2events.geometry.camera import Camera
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.reflectance import ReflectanceParams
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+from traj2events.scene.tiles import LodSettings, TileSet
+from traj2events.sensor.laws import log_intensity_8bit, radiance_to_dn
 
 PAPER_FRAMES = 3.1e6  # config/paper.yaml: 500 trajectories, ~6200 frames each at 100 fps
 ZSTD = hdf5plugin.Blosc(cname="zstd", clevel=5, shuffle=hdf5plugin.Blosc.BITSHUFFLE)

@@ -28,16 +28,13 @@ import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import ROOT, card_name, clip_trajectory, traj2events_cli
 
-import gpu_emulator  # noqa: E402
-from workflow_cost import ROOT, clip_trajectory, traj2events_cli  # noqa: E402
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.plan import dataset_plan  # noqa: E402
-from traj2events.settings.events import events_settings  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.plan import dataset_plan
+from traj2events.settings.events import events_settings
+from traj2events.stages.render import RenderSettings
 
 
 def one_job(config: dict, clip: Path, folder: Path) -> list[str]:
@@ -73,7 +70,7 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, nargs="+", default=[1, 4, 8, 16])
     parser.add_argument("--seconds", type=float, default=0.3)
     args = parser.parse_args()
-    card = gpu_emulator.card_name()
+    card = card_name()
     if card is None:
         return
     driver = subprocess.run(["nvidia-smi", "--query-gpu=driver_version", "--format=csv,noheader"],
@@ -82,8 +79,9 @@ def main() -> None:
           f"{datetime.date.today()}; {args.config}")  # fmt: skip
 
     print("\n## 1. The emulator at 1024^2")
-    sys.argv = ["gpu_emulator.py", "--frames", "200", "--size", "1024"]
-    gpu_emulator.main()
+    sys.stdout.flush()
+    subprocess.run([sys.executable, str(Path(__file__).with_name("gpu_emulator.py")), "--frames", "200", "--size",
+                    "1024"], check=True)  # fmt: skip
 
     config = load_config(args.config)
     fps = config["camera"]["fps"]

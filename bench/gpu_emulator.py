@@ -17,19 +17,14 @@ from __future__ import annotations
 import argparse
 import datetime
 import platform
-import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+import numpy as np
+from common import card_name, moving_texture
 
-import numpy as np  # noqa: E402
-from emulator import moving_texture  # noqa: E402
-
-import traj2events.sensor.emulator as emulator  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
+import traj2events.sensor.emulator as emulator
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.stages.events import preset_params
 
 
 def run(frames: np.ndarray, device: str, scale: float) -> tuple[np.ndarray, float]:
@@ -77,17 +72,6 @@ def split_times(frames: np.ndarray, scale: float) -> dict[str, float]:
     finally:
         cuda_kernels.CudaPixels.interval, emulator.assemble = interval, assemble
     return spent
-
-
-def card_name() -> str | None:
-    """The GPU's name, or None (said) where numba finds none."""
-    from numba import cuda
-
-    if not cuda.is_available():
-        print("no usable CUDA GPU here (a driver, and pip install '.[gpu]'): nothing to measure")
-        return None
-    card = getattr(cuda.get_current_device(), "name", "numba's CUDA simulator")
-    return card.decode() if isinstance(card, bytes) else card
 
 
 def main() -> None:

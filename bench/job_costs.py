@@ -19,12 +19,11 @@ import statistics
 import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.plan import COSTS, events_s_per_frame, job_resources, render_s_per_frame
 
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.plan import COSTS, events_s_per_frame, job_resources, render_s_per_frame  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 PER_FRAME_RULES = ("render", "events")
 

@@ -20,19 +20,15 @@ from __future__ import annotations
 
 import argparse
 import platform
-import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from traj2events import data  # noqa: E402
-from traj2events.data import EventWindows, open_dataset  # noqa: E402
-from traj2events.formats.events import read_events_window  # noqa: E402
-from traj2events.formats.flow import MotionFieldReader  # noqa: E402
-from traj2events.formats.frames import FramesFile  # noqa: E402
+from traj2events import data
+from traj2events.data import EventWindows, open_dataset
+from traj2events.formats.events import read_events_window
+from traj2events.formats.flow import MotionFieldReader
+from traj2events.formats.frames import FramesFile
 
 
 def window_per_call(windows: EventWindows, i: int) -> bytes:

@@ -22,26 +22,23 @@ import argparse
 import os
 import platform
 import statistics
-import sys
 import time
-from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.settings.poses import scenario_divert, scenario_hover  # noqa: E402
-from traj2events.trajectory.divert import Divert, divert_flight, horizontal_acceleration_m_s2, manoeuvre_m_s2  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.hover import Hover, hover_drift_m, hover_flight  # noqa: E402
-from traj2events.trajectory.imu import specific_force_body  # noqa: E402
-from traj2events.trajectory.ocp import LandingProblem  # noqa: E402
-from traj2events.trajectory.scenarios import ScenarioSettings, base_conditions  # noqa: E402
-from traj2events.trajectory.state import MASS  # noqa: E402
-from traj2events.trajectory.upsample import upsample  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.settings.poses import scenario_divert, scenario_hover
+from traj2events.trajectory.divert import Divert, divert_flight, horizontal_acceleration_m_s2, manoeuvre_m_s2
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.hover import Hover, hover_drift_m, hover_flight
+from traj2events.trajectory.imu import specific_force_body
+from traj2events.trajectory.ocp import LandingProblem
+from traj2events.trajectory.scenarios import ScenarioSettings, base_conditions
+from traj2events.trajectory.state import MASS
+from traj2events.trajectory.upsample import upsample
 
 
 def main() -> None:

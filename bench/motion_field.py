@@ -17,19 +17,16 @@ import io
 import os
 import platform
 import statistics
-import sys
 import time
-from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import h5py  # noqa: E402
-import numpy as np  # noqa: E402
+import h5py
+import numpy as np
 
-from traj2events.formats.hdf5 import blosc  # noqa: E402
-from traj2events.geometry.camera import Camera, camera_pose  # noqa: E402
-from traj2events.geometry.motion_field import (  # noqa: E402
+from traj2events.formats.hdf5 import blosc
+from traj2events.geometry.camera import Camera, camera_pose
+from traj2events.geometry.motion_field import (
     inverse_depth_sphere,
     inverse_depth_sphere_textbook,
     local_vertical,

@@ -26,26 +26,16 @@ import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+
+import h5py
+import hdf5plugin  # noqa: F401
+import numpy as np
+from common import short_trajectory
+
+from traj2events.config import resolve_config
+from traj2events.stages.render import RenderSettings, render_trajectory
+
 SRC = Path(__file__).resolve().parents[1] / "src"
-sys.path.insert(0, str(SRC))
-
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-import numpy as np  # noqa: E402
-
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.stages.render import RenderSettings, render_trajectory  # noqa: E402
-
-
-def short_trajectory(source: Path, output: Path, n_poses: int) -> None:
-    """`source` with only n_poses poses, starting mid-flight (nodes and attributes kept)."""
-    with h5py.File(source) as f, h5py.File(output, "w") as out:
-        start = max(0, len(f["poses/t"]) // 2 - n_poses // 2)
-        for name, value in f.attrs.items():
-            out.attrs[name] = value
-        f.copy("nodes", out)
-        for name in ("t", "state", "control"):
-            out[f"poses/{name}"] = f[f"poses/{name}"][start : start + n_poses]
 
 
 def run_command(src: Path, trajectory: Path, size: int, every: int, frames: Path | None, work: Path) -> float:

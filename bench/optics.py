@@ -18,72 +18,28 @@ and the kernel each lens gives (its side and centre weight).
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import platform
 import statistics
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
+import h5py
+import hdf5plugin  # noqa: F401
+from common import clip, clip_arguments, run
+
+from traj2events.config import default_config
+from traj2events.formats.events import read_events
+from traj2events.sensor.optics import psf_kernel
+
 SRC = Path(__file__).resolve().parents[1] / "src"
-sys.path.insert(0, str(SRC))
-
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-
-from traj2events.config import default_config  # noqa: E402
-from traj2events.formats.events import read_events  # noqa: E402
-from traj2events.sensor.optics import psf_kernel  # noqa: E402
 
 LENSES = {
     "A no lens": {},
     "B diffraction": {"psf_diffraction": True},
     "C diffraction, 3 um blur, vignetting": {"psf_diffraction": True, "lens_blur_um": 3.0, "vignetting": True},
 }
-
-
-def clip(source: Path, n: int, folder: Path) -> Path:
-    """The first `n` frames of `source` as a frames.h5 of their own, with its attributes."""
-    out = folder / "frames.h5"
-    with h5py.File(source) as f, h5py.File(out, "w") as g:
-        n = min(n, len(f["t"]))
-        g["t"] = f["t"][:n]
-        g.create_dataset("radiance", data=f["radiance"][:n], chunks=(1, *f["radiance"].shape[1:]))
-        for key, value in f.attrs.items():
-            g.attrs[key] = value
-    return out
-
-
-def clip_arguments(description: str, extra=None) -> argparse.Namespace:
-    """The benches' common arguments: a frames.h5, how many of its frames, how many rounds."""
-    parser = argparse.ArgumentParser(description=description, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("frames", type=Path)
-    parser.add_argument("--frames", dest="n_frames", type=int, default=1000)
-    parser.add_argument("--repeats", type=int, default=3)
-    if extra is not None:
-        extra(parser)
-    return parser.parse_args()
-
-
-def timed_events(frames: Path, output: Path, options: list[str], src: Path = SRC) -> float:
-    """Seconds of one whole `traj2events events` command on one CPU with these options, by
-    the code under `src`."""
-    command = [sys.executable, "-m", "traj2events", "events", str(frames), "--output", str(output),
-               "--threads", "1", *options]  # fmt: skip
-    env = dict(os.environ, PYTHONPATH=str(src), OMP_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
-    start = time.perf_counter()
-    subprocess.run(command, check=True, env=env, capture_output=True)
-    return time.perf_counter() - start
-
-
-def run(frames: Path, output: Path, settings: dict, src: Path) -> float:
-    """Seconds of one whole `traj2events events` command with these `--settings` (the paper
-    preset, no labels)."""
-    return timed_events(frames, output, ["--preset", "paper", "--no-labels", "--settings", json.dumps(settings)], src)
 
 
 def main() -> None:

@@ -33,26 +33,24 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
+import numpy as np
+from common import render_window, silhouettes
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.sensor.laws import log_intensity_8bit  # noqa: E402
-from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.sensor.laws import log_intensity_8bit
+from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+from traj2events.stages.events import preset_params
+from traj2events.stages.render import RenderSettings
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.upsample import ReintegratedStates
 
 # (name, texture filter, samples per pixel side)
 VARIANTS = [
@@ -66,41 +64,6 @@ VARIANTS = [
 ]
 
 WINDOWS = ("mid-flight", "last second")  # from t_f / 2, and from t_f - 1 s
-
-
-def render_window(
-    settings, camera, states, times, texture_filter: str, samples: int, point_sun: bool = False, lod_scale: int = 1
-):
-    """(frames (n, h, w) float32 radiance, seconds per frame, the first frame's depth) of one
-    variant; `point_sun`: shadows of a point Sun (no penumbrae); `lod_scale`: the tiles and
-    finer texels a camera with lod_scale x lod_scale times the pixels would draw (a finer scene)."""
-    _, tiles, sun, reflectance = settings.build()
-    if point_sun:
-        tiles.sun_radius_rad = 0.0  # before any tile is built
-    frames = []
-    lod = {} if lod_scale == 1 else {"lod_camera": camera.scaled(lod_scale).pinhole_cover()}
-    with sensor_renderer(
-        tiles, camera, sun, reflectance, texture_filter=texture_filter, supersample=samples, **lod
-    ) as renderer:
-        poses = [camera.pose(s) for s in states.states(times)]
-        depth_m = renderer.render(poses[0]).depth_m  # tiles built and uploaded before the clock starts
-        start = time.perf_counter()
-        for pose in poses:
-            frames.append(renderer.render(pose).radiance.copy())
-        seconds = (time.perf_counter() - start) / len(poses)
-    return np.stack(frames), seconds, depth_m
-
-
-def silhouettes(depth_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(sky and horizon, depth edges) pixel masks of a depth image (0: sky): a sky pixel in
-    the 3 x 3 neighbourhood; ground depths there more than 10 % apart. There the pixel
-    footprint's one sample per pixel fires events of its own (docs/rendering.md)."""
-    from scipy.ndimage import maximum_filter, minimum_filter
-
-    ground = depth_m > 0
-    sky = ~ground | (minimum_filter(depth_m, 3) == 0)
-    edge = (maximum_filter(depth_m, 3) > 1.1 * minimum_filter(np.where(ground, depth_m, np.inf), 3)) & ~sky
-    return sky, edge
 
 
 def regions(radiance_dn: np.ndarray, depth_m: np.ndarray) -> dict[str, np.ndarray]:

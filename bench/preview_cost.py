@@ -21,18 +21,15 @@ import hashlib
 import os
 import platform
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import ROOT, clip_trajectory, cpu_seconds, stage_commands
 
-from workflow_cost import ROOT, clip_trajectory, cpu_seconds, stage_commands  # noqa: E402  (bench/)
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.plan import dataset_plan  # noqa: E402
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.plan import dataset_plan
 
 
 def content_digest(folder: Path) -> str:

@@ -20,17 +20,14 @@ from __future__ import annotations
 import os
 import platform
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+import numpy as np
+from common import SRC, clip, clip_arguments, run
 
-import numpy as np  # noqa: E402
-from optics import SRC, clip, clip_arguments, run  # noqa: E402
-
-from traj2events.formats.events import read_events  # noqa: E402
+from traj2events.formats.events import read_events
 
 
 def delays_us(reference: np.ndarray, delayed: np.ndarray) -> np.ndarray:

@@ -19,84 +19,20 @@ and the paper config's cost (500 trajectories x ~7500 frames).
 from __future__ import annotations
 
 import argparse
-import contextlib
-import dataclasses
 import os
 import platform
 import statistics
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-
-import numpy as np  # noqa: E402
-
-from traj2events.formats.frames import FramesWriter  # noqa: E402
-from traj2events.geometry.camera import Camera, camera_pose  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.scene.sun import Sun  # noqa: E402
-from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
-from traj2events.video import VideoWriter, display_frame  # noqa: E402
-
-R_MOON = 1737400.0
-CASES = {
-    "braking, 2 km, pitch 55 deg": (
-        np.array([-4000, 30, -2000, 90, 1, 12, 0.02, np.radians(55), 0.03, 0, 0, 0, 9500.0]),
-        Sun(1.496e11, 105, 7),
-        180e3,
-    ),
-    "descent, 150 m, pitch 3 deg": (
-        np.array([-150, 2, -150, 8, 0.2, 3, 0.01, np.radians(3), 0.01, 0, 0, 0, 9600.0]),
-        Sun(1.496e11, 155, 2),
-        110e3,
-    ),
-}
 
 
-def poses(state: np.ndarray, n: int, fps: float = 100.0) -> list:
-    out = []
-    for k in range(n):
-        s = state.copy()
-        s[:3] = state[:3] + state[3:6] * k / fps
-        out.append(camera_pose(s))
-    return out
+from common import CASES, frame_errors, stretch_renderer
 
-
-@contextlib.contextmanager
-def stretch_renderer(
-    state, sun, extent, size, n_frames, budget, backend, terrain=None, shading_levels=0, texture_filter=None
-):
-    """A renderer over one case's stretch of `n_frames` poses (`size`^2, 45 deg field of
-    view, Hapke, `budget` px/cell, shaded per vertex unless `shading_levels`), every tile
-    the stretch needs built beforehand, as a trajectory's first frames would: yields
-    (renderer, poses, seconds the tiles took to build). `terrain`: one shared between calls (None: seed 1's);
-    `texture_filter`: render.lod.texture_filter (None: the default)."""
-    camera = Camera(size, size, 45.0)
-    terrain = ProceduralTerrain(TerrainParams(seed=1)) if terrain is None else terrain
-    lod = LodSettings(pixels_per_cell=budget, shading_levels=shading_levels)
-    lod = lod if texture_filter is None else dataclasses.replace(lod, texture_filter=texture_filter)
-    tiles = TileSet(terrain, sun.direction, R_MOON, extent, lod)
-    path = poses(state, n_frames)
-    with TerrainRenderer(tiles, camera, sun, ReflectanceParams(), max_cached_tiles=20000, backend=backend) as renderer:
-        start = time.perf_counter()
-        for pose in path:
-            tiles.select(pose, camera)
-        yield renderer, path, time.perf_counter() - start
-
-
-def frame_errors(frame, reference) -> tuple[float, float]:
-    """(RMS radiance difference / mean radiance over the reference's ground pixels, median
-    relative depth difference over the pixels both frames see ground in)."""
-    ground = reference.depth_m > 0
-    both = ground & (frame.depth_m > 0)
-    mean = max(float(reference.radiance[ground].mean()), 1e-9)
-    radiance = np.sqrt(np.mean((frame.radiance - reference.radiance)[ground] ** 2)) / mean
-    depth = np.median(np.abs(frame.depth_m[both] / reference.depth_m[both] - 1)) if both.any() else np.nan
-    return float(radiance), float(depth)
+from traj2events.formats.frames import FramesWriter
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+from traj2events.video import VideoWriter, display_frame
 
 
 def run_case(name, state, sun, extent, size, n_frames, budgets, reference, backend):

@@ -19,14 +19,11 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-import numpy as np  # noqa: E402
-from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
+import numpy as np
+from common import CASES, stretch_renderer
 
 FRAME = 10  # of the stretch: tiles and buffers are warm by then
 NAMES = ("braking", "descent")

@@ -20,22 +20,18 @@ import json
 import os
 import platform
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import h5py
 import hdf5plugin  # noqa: F401
+from common import ROOT, clip_trajectory, cpu_seconds, traj2events_cli
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-
-from workflow_cost import ROOT, clip_trajectory, cpu_seconds, traj2events_cli  # noqa: E402
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.settings.events import events_settings  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.settings.events import events_settings
+from traj2events.stages.render import RenderSettings
 
 
 def commands(config: dict, scenario: str, clip: Path, folder: Path) -> dict[str, list[list[str]]]:

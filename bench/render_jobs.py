@@ -31,18 +31,16 @@ import resource
 import shutil
 import statistics
 import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
+from common import ONE_CORE, clip_trajectory, stage_commands
+
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "bench"))
-
-from workflow_cost import ONE_CORE, clip_trajectory, stage_commands  # noqa: E402
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
 
 # The render command's last progress line: "N frames and M adaptive ones in S s (...)".
 LOOP_LOG = re.compile(r"frames and \d+ adaptive ones in ([\d.]+) s")

@@ -42,15 +42,12 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import CASES, stretch_renderer
 
-from render import CASES, stretch_renderer  # noqa: E402  (bench/render.py)
-
-from traj2events.renderer import draw as render_module  # noqa: E402
-from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
-from traj2events.scene.tiles import LodSettings  # noqa: E402
+from traj2events.renderer import draw as render_module
+from traj2events.renderer.footprint import TEXTURE_FILTERS
+from traj2events.scene.tiles import LodSettings
 
 
 def timed(log: list[float], function):

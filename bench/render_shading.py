@@ -41,27 +41,25 @@ import dataclasses
 import os
 import platform
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import numpy as np  # noqa: E402
-from render import CASES, R_MOON, frame_errors, poses  # noqa: E402  (bench/render.py)
+import numpy as np
+from common import CASES, R_MOON, frame_errors, poses
 
-import traj2events.renderer.draw as render_module  # noqa: E402
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.geometry.camera import Camera  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.scene.reflectance import ReflectanceParams  # noqa: E402
-from traj2events.scene.terrain import ProceduralTerrain, TerrainParams  # noqa: E402
-from traj2events.scene.tiles import LodSettings, TileSet  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+import traj2events.renderer.draw as render_module
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.geometry.camera import Camera
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.reflectance import ReflectanceParams
+from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
+from traj2events.scene.tiles import LodSettings, TileSet
+from traj2events.stages.render import RenderSettings
 
 
 @dataclasses.dataclass

@@ -29,7 +29,7 @@ def draw_stretch(backend: str, size: int, n_frames: int, barrier) -> list[float]
     """Seconds of each render call along the braking stretch, after all workers are ready."""
     os.environ.setdefault("LP_NUM_THREADS", "1")
     sys.path.insert(0, str(BENCH))
-    from render import CASES, stretch_renderer  # bench/render.py (it puts src on the path)
+    from common import CASES, stretch_renderer
 
     state, sun, extent = next(iter(CASES.values()))
     with stretch_renderer(state, sun, extent, size, n_frames, 2.0, backend) as (r, path, _):

@@ -23,28 +23,24 @@ import argparse
 import dataclasses
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from test_scattering import FLAT_MOON, spherical_bowl  # noqa: E402
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.scene.scattering import scattered_sunlight  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.scattering import FLAT_MOON, scattered_sunlight, spherical_bowl
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+from traj2events.stages.events import preset_params
+from traj2events.stages.render import RenderSettings
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.upsample import ReintegratedStates
 
 
 def bowl_errors(azimuths: int, step_fraction: float) -> tuple[float, float, float]:

@@ -21,23 +21,20 @@ import math
 import os
 import platform
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+import h5py
+import hdf5plugin  # noqa: F401
+import numpy as np
+from common import clip, clip_arguments, timed_events
 
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-import numpy as np  # noqa: E402
-from optics import clip, clip_arguments, timed_events  # noqa: E402
-
-from traj2events.defaults import preset  # noqa: E402
-from traj2events.formats.events import SIGNAL  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.settings.tree import default_config  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
+from traj2events.defaults import preset
+from traj2events.formats.events import SIGNAL
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.settings.tree import default_config
+from traj2events.stages.events import preset_params
 
 PRESETS = ("paper", "imx636", "davis346")
 # The published figures the presets come from (docs/events.md "Sensor presets"): ON contrast

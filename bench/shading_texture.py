@@ -26,12 +26,12 @@ from pathlib import Path
 if "PYTHONPATH" not in os.environ:  # another commit's src on PYTHONPATH: keep it first
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.scene.tiles import long_sweep_lit  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.scene.tiles import long_sweep_lit
+from traj2events.stages.render import RenderSettings
 
 
 def main() -> None:

@@ -1,4 +1,4 @@
-"""Benchmark: the smoke dataset through a single-node SLURM (tests/slurm_cluster.py) with
+"""Benchmark: the smoke dataset through a single-node SLURM (profiles/single_node_slurm.py) with
 profiles/slurm, each trajectory's jobs grouped (the profile) against ungrouped (every
 rule its own SLURM job), alternated A B A B; and the same dataset run locally.
 
@@ -22,10 +22,9 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+from common import single_node_slurm
 
-from slurm_cluster import SingleNodeSlurm  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 SNAKEMAKE = Path(sys.executable).parent / "snakemake"
 GROUPED_RULES = ("camera_poses", "render", "motion_field", "events", "frames_picture", "motion_field_picture",
@@ -60,7 +59,7 @@ def main() -> None:
         workdir = Path(tmp) / "wf"
         workdir.mkdir()
         shutil.copy(ROOT / "config" / "smoke.yaml", workdir / "config.yaml")
-        with SingleNodeSlurm(Path(tmp) / "slurm") as cluster:
+        with single_node_slurm()(Path(tmp) / "slurm") as cluster:
             for _ in range(args.repeats):
                 for name, extra in variants.items():
                     times[name].append(run(workdir, cluster.env, *extra))

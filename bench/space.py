@@ -19,19 +19,16 @@ import json
 import os
 import platform
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+import h5py
+import hdf5plugin  # noqa: F401
+import numpy as np
+from common import clip, clip_arguments, timed_events
 
-import h5py  # noqa: E402
-import hdf5plugin  # noqa: E402, F401
-import numpy as np  # noqa: E402
-from optics import clip, clip_arguments, timed_events  # noqa: E402
-
-from traj2events.formats.events import GLITCH, RADIATION  # noqa: E402
+from traj2events.formats.events import GLITCH, RADIATION
 
 VARIANTS = {
     "A off": None,

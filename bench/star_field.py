@@ -15,16 +15,12 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
 import time
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from traj2events.geometry.camera import Camera, CameraPose  # noqa: E402
-from traj2events.scene.stars import StarField, add_stars  # noqa: E402
+from traj2events.geometry.camera import Camera, CameraPose
+from traj2events.scene.stars import StarField, add_stars
 
 
 def horizon_poses(n: int) -> list[CameraPose]:

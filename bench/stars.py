@@ -15,24 +15,22 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.renderer.draw import TerrainRenderer  # noqa: E402
-from traj2events.scene.stars import star_radiance  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.sensor.photocurrent import SensorParams, sensor_dn  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.renderer.draw import TerrainRenderer
+from traj2events.scene.stars import star_radiance
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.sensor.photocurrent import SensorParams, sensor_dn
+from traj2events.stages.events import preset_params
+from traj2events.stages.render import RenderSettings
 
 
 def skiest_second(trajectory, settings: RenderSettings, fps: float) -> np.ndarray:

@@ -18,21 +18,9 @@ from pathlib import Path
 
 import h5py
 import hdf5plugin  # noqa: F401  (frames.h5 is Blosc-compressed)
-import numpy as np
+from common import textured_share
 
 MIN_TEXTURED_SHARE = 0.05
-GRADIENT_PER_PX = 0.02  # |grad ln L|
-FLOOR_W_M2_SR = 1e-6  # shadowed pixels' radiance floor before the log
-
-
-def textured_share(radiance: np.ndarray, depth_m: np.ndarray) -> tuple[float, float]:
-    """(share of ground pixels with |grad ln L| above the threshold, ground share)."""
-    ground = depth_m > 0
-    log_l = np.log(np.maximum(radiance.astype(np.float64), FLOOR_W_M2_SR))
-    gx, gy = np.diff(log_l, axis=1)[:-1, :], np.diff(log_l, axis=0)[:, :-1]
-    on_ground = ground[:-1, :-1] & ground[1:, :-1] & ground[:-1, 1:]
-    textured = (np.hypot(gx, gy) > GRADIENT_PER_PX) & on_ground
-    return float(textured.sum() / max(on_ground.sum(), 1)), float(ground.mean())
 
 
 def main() -> None:

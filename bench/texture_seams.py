@@ -23,29 +23,27 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import sys
 import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
 os.environ.setdefault("LP_NUM_THREADS", "1")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
 
-import numpy as np  # noqa: E402
-from pixel_integration import silhouettes  # noqa: E402  (bench/, beside this file)
+import numpy as np
+from common import silhouettes
 
-import traj2events.renderer.draw as draw  # noqa: E402
-from traj2events.config import resolve_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.renderer.footprint import TEXTURE_FILTERS  # noqa: E402
-from traj2events.renderer.supersample import sensor_renderer  # noqa: E402
-from traj2events.scene.tiles import LodSettings  # noqa: E402
-from traj2events.sensor.emulator import EventEmulator  # noqa: E402
-from traj2events.sensor.laws import radiance_to_dn  # noqa: E402
-from traj2events.stages.events import preset_params  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates  # noqa: E402
+import traj2events.renderer.draw as draw
+from traj2events.config import resolve_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.renderer.footprint import TEXTURE_FILTERS
+from traj2events.renderer.supersample import sensor_renderer
+from traj2events.scene.tiles import LodSettings
+from traj2events.sensor.emulator import EventEmulator
+from traj2events.sensor.laws import radiance_to_dn
+from traj2events.stages.events import preset_params
+from traj2events.stages.render import RenderSettings
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.upsample import ReintegratedStates
 
 # The footprint shader's output, replaced: distance (px) to the nearest tile edge, plus
 # 1000 x the distance to the nearest quarter seam (99 where the tile has no finer texture).

@@ -19,18 +19,15 @@ import argparse
 import hashlib
 import platform
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import numpy as np
 
-import numpy as np  # noqa: E402
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.stages.render import RenderSettings
 
 
 def fly(trajectory: Path, config: dict, every: int, cache: Path | None, textures_cached: bool = True):

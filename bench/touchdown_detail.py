@@ -43,7 +43,7 @@ def main() -> None:
     sys.path.insert(0, str(HERE))
 
     import numpy as np
-    from texture import textured_share
+    from common import textured_share
 
     from traj2events.config import resolve_config
     from traj2events.formats.trajectory import read_trajectory

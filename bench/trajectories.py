@@ -31,30 +31,29 @@ import json
 import os
 import platform
 import statistics
-import sys
 import time
 from dataclasses import replace
 from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from traj2events.config import load_config, load_yaml, merge_config, resolve_config  # noqa: E402
-from traj2events.stages.base_solution import solve_base  # noqa: E402
-from traj2events.trajectory.batch import solve_samples  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.motion_stats import motion_summary  # noqa: E402
-from traj2events.trajectory.ocp import LandingProblem  # noqa: E402
-from traj2events.trajectory.scenarios import (  # noqa: E402
-    ScenarioSettings,  # noqa: E402
+from traj2events.config import load_config, load_yaml, merge_config, resolve_config
+from traj2events.stages.base_solution import solve_base
+from traj2events.trajectory.batch import solve_samples
+from traj2events.trajectory.dynamics import Dynamics
+from traj2events.trajectory.motion_stats import motion_summary
+from traj2events.trajectory.ocp import LandingProblem
+from traj2events.trajectory.scenarios import (
+    ScenarioSettings,
     base_conditions,
     sample_conditions,
 )
-from traj2events.trajectory.state import MASS  # noqa: E402
-from traj2events.trajectory.upsample import ShootingCheck, final_state_error  # noqa: E402
+from traj2events.trajectory.state import MASS
+from traj2events.trajectory.upsample import ShootingCheck, final_state_error
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def machine() -> str:

@@ -16,14 +16,11 @@ from __future__ import annotations
 import argparse
 import hashlib
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
-
-from traj2events import video  # noqa: E402
+from traj2events import video
 
 
 def writes_ms(frames, fps: float, work_s: float, widen: bool, folder: Path) -> tuple[float, str]:

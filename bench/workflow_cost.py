@@ -26,78 +26,25 @@ EGL on a GPU the render's CPU seconds are its CPU side only, and its wall second
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
-import resource
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "osmesa")
+
+import numpy as np
+from common import clip_trajectory, cpu_seconds, stage_commands
+
+from traj2events.config import load_config
+from traj2events.formats.trajectory import read_trajectory
+from traj2events.plan import dataset_plan
+from traj2events.renderer.context import resolve_backend
+
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))
 
-import numpy as np  # noqa: E402
-
-from traj2events.config import load_config  # noqa: E402
-from traj2events.formats.trajectory import read_trajectory, write_trajectory  # noqa: E402
-from traj2events.plan import dataset_plan  # noqa: E402
-from traj2events.renderer.context import resolve_backend  # noqa: E402
-from traj2events.settings.camera import motion_field_settings  # noqa: E402
-from traj2events.settings.events import events_settings  # noqa: E402
-from traj2events.stages.render import RenderSettings  # noqa: E402
-from traj2events.trajectory.dynamics import Dynamics  # noqa: E402
-from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls  # noqa: E402
-
-ONE_CORE = {"OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1", "NUMBA_NUM_THREADS": "1", "LP_NUM_THREADS": "1"}
 STAGES = ("render", "motion field", "events")
-
-
-def clip_trajectory(trajectory: Path, t0_s: float, seconds: float, fps: float, output: Path) -> int:
-    """A trajectory.h5 of `seconds` from t0_s (poses from the re-integrated dynamics); its frames."""
-    tr = read_trajectory(trajectory)
-    t = t0_s + np.arange(int(round(seconds * fps)) + 1) / fps
-    states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes).states(t)
-    poses = (t, states, interpolate_controls(tr.t_nodes, tr.control_nodes, t))
-    write_trajectory(output, (tr.t_nodes, tr.state_nodes, tr.control_nodes), poses, {**tr.attrs, "fps": fps})
-    return len(t)
-
-
-def cpu_seconds(command: list[str]) -> tuple[float, float]:
-    """(CPU seconds (user + system) of a command and the children it waited for, wall seconds)."""
-    before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-    done = subprocess.run(command, env={**os.environ, **ONE_CORE}, capture_output=True, text=True)
-    if done.returncode:
-        raise RuntimeError(f"{' '.join(command)} failed:\n{done.stderr[-3000:]}")
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime), time.perf_counter() - start
-
-
-def traj2events_cli() -> list[str]:
-    """The installed `traj2events` script beside this Python, else `python -m traj2events`
-    (a checkout on PYTHONPATH, not installed)."""
-    script = Path(sys.executable).parent / "traj2events"
-    return [str(script)] if script.exists() else [sys.executable, "-m", "traj2events"]
-
-
-def stage_commands(config: dict, scenario: str, clip: Path, folder: Path, field_every: int) -> dict[str, list[str]]:
-    cli = traj2events_cli()
-    settings = RenderSettings.from_config(config, scenario).to_json()
-    motion_field = {**motion_field_settings(config), "every_n_frames": field_every}
-    frames = folder / "frames.h5"
-    return {
-        "render": [*cli, "render", str(clip), "--settings", settings, "--frames", str(frames),
-                   "--video", str(folder / "video.mkv"),
-                   *(["--preview", str(folder / "preview.mp4")] if config["render"]["preview"] else [])],
-        "motion field": [*cli, "motion-field", str(clip), "--settings", json.dumps(motion_field),
-                         "--frames", str(frames), "-o", str(folder / "motion_field.h5"),
-                         "--flo-dir", str(folder / "flow")],
-        "events": [*cli, "events", str(frames), "-o", str(folder / "events.h5"), "--seed", "1",
-                   "--settings", json.dumps(events_settings(config)), "--threads", "1"],  # as the workflow's rule
-    }  # fmt: skip
 
 
 def output_bytes(folder: Path) -> dict[str, int]:

@@ -104,3 +104,41 @@ def test_every_code_name_in_the_docs_and_docstrings_resolves():
     assert len(found) > 50
     broken = sorted({f"{where}: `{name}`" for where, name in found if not resolves(name)})
     assert not broken, "\n".join(broken)
+
+
+BENCH = ROOT / "bench"
+
+
+def bench_imports(path) -> set[str]:
+    """The top-level names a benchmark imports (at module level or inside functions)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names |= {alias.name.split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            names.add(node.module.split(".")[0])
+    return names
+
+
+def test_no_benchmark_imports_another_or_a_test():
+    benches = {p.stem for p in BENCH.glob("*.py")} - {"common"}
+    tests = {p.stem for p in TESTS.glob("*.py")}
+    crossing = {p.name: sorted(bench_imports(p) & (benches | tests)) for p in BENCH.glob("*.py")}
+    assert not {k: v for k, v in crossing.items() if v}
+    assert not any(
+        "tests" in line and "sys.path" in line for p in BENCH.glob("*.py") for line in p.read_text().split("\n")
+    )
+
+
+def test_the_bench_readme_lists_every_benchmark_and_the_quick_set_exists():
+    import sys
+
+    sys.path.insert(0, str(BENCH))
+    try:
+        from run import QUICK, benchmarks
+    finally:
+        sys.path.remove(str(BENCH))
+        sys.modules.pop("run", None)
+    text = (BENCH / "README.md").read_text()
+    assert all(f"| `{name}` |" in text for name in benchmarks())
+    assert set(QUICK) <= set(benchmarks()) and len(benchmarks()) > 40

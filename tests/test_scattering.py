@@ -6,30 +6,7 @@ what one fine grid gives."""
 import numpy as np
 import pytest
 
-from traj2events.scene.scattering import height_normals, scattered_sunlight
-
-FLAT_MOON = 1e12  # no curvature
-
-
-def spherical_bowl(a=50.0, depth=20.0, elevation_deg=20.0, n=401, half=100.0):
-    """Heights, unit normals (x, y, up) and lit mu0 of a spherical cap (rim radius a) in a
-    plane, the Sun along +x at `elevation_deg`; lit where the ray to the Sun leaves the
-    sphere above the rim plane."""
-    sphere = (a * a + depth * depth) / (2 * depth)
-    x = np.linspace(-half, half, n)
-    xx, yy = np.meshgrid(x, x, indexing="ij")
-    inside = xx**2 + yy**2 < a * a
-    h = np.where(inside, sphere - np.sqrt(np.maximum(sphere**2 - xx**2 - yy**2, 0.0)) - depth, 0.0)
-    points = np.stack([xx, yy, h], axis=-1)
-    centre = np.array([0.0, 0.0, sphere - depth])
-    normals = np.where(inside[..., None], (centre - points) / sphere, np.array([0.0, 0.0, 1.0]))
-    e = np.radians(elevation_deg)
-    sun = np.array([np.cos(e), 0.0, np.sin(e)])
-    d = points - centre
-    b = d @ sun
-    exit_t = -b + np.sqrt(np.maximum(b * b - (np.sum(d * d, axis=-1) - sphere**2), 0.0))
-    lit = np.where(inside, h + exit_t * sun[2] >= 0.0, 1.0)
-    return x, h, points, normals, lit * np.maximum(normals @ sun, 0.0), sphere
+from traj2events.scene.scattering import FLAT_MOON, height_normals, scattered_sunlight, spherical_bowl
 
 
 @pytest.mark.parametrize("elevation_deg", [10.0, 20.0, 40.0])

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 import yaml
+from single_node_slurm import SingleNodeSlurm, SlurmUnavailable
 
 from conftest import ROOT
-from slurm_cluster import SingleNodeSlurm, SlurmUnavailable
 from test_workflow import assert_same_dataset, snakemake
 
 pytestmark = pytest.mark.slow

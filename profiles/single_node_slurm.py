@@ -1,4 +1,5 @@
-"""A single-node SLURM for a test: installs Debian's packages if they are missing (root
+"""A single-node SLURM, to try the cluster profiles on one machine (the tests and
+bench/slurm.py do): installs Debian's packages if they are missing (root
 only), writes a minimal slurm.conf in a temporary folder, starts munged, slurmctld and
 slurmd, and stops them by their PIDs.
 
@@ -32,7 +33,7 @@ from pathlib import Path
 PACKAGES = ["slurm-wlm", "slurmctld", "slurmd", "slurm-client", "munge"]
 SYSTEM_CONF = Path("/etc/slurm/slurm.conf")
 GRES_CONF = SYSTEM_CONF.with_name("gres.conf")
-MARKER = "# written by traj2events' tests/slurm_cluster.py"
+MARKER = "# written by traj2events' profiles/single_node_slurm.py"
 DAEMONS = ["munged", "slurmctld", "slurmd", "sbatch", "squeue"]
 
 
