@@ -41,13 +41,13 @@ class Camera:
             raise ValueError(f"camera.mount_height_m: expected 0 <= h < 100 m, got {self.mount_height_m}")
 
     @classmethod
-    def from_settings(cls, settings: dict) -> "Camera":
+    def from_settings(cls, settings: dict) -> Camera:
         """From the camera settings (settings/camera.py: width, height, fov_deg, mount_height_m,
         distortion where not a pinhole)."""
         distortion = distortion_from(settings.get("distortion"))
         return cls(settings["width"], settings["height"], settings["fov_deg"], settings["mount_height_m"], distortion)
 
-    def pose(self, state: np.ndarray) -> "CameraPose":
+    def pose(self, state: np.ndarray) -> CameraPose:
         """This camera's pose for one 13-state (see camera_pose)."""
         return camera_pose(state, self.mount_height_m)
 
@@ -114,7 +114,7 @@ class Camera:
         pixel centres): a point beyond them is out of view whatever the polynomial says."""
         return _reach(self)
 
-    def pinhole_cover(self, margin_px: float = 1.0) -> "Camera":
+    def pinhole_cover(self, margin_px: float = 1.0) -> Camera:
         """The pinhole camera of the same focal length, centred, whose image holds every
         pixel's ray with `margin_px` to spare (what the renderer draws before the lens's
         distortion resamples it onto the sensor); this camera when it is a pinhole."""
@@ -132,7 +132,7 @@ class Camera:
         fov = float(np.degrees(2.0 * np.arctan(width / (2.0 * f))))
         return Camera(width, height, fov, self.mount_height_m)
 
-    def scaled(self, factor: int) -> "Camera":
+    def scaled(self, factor: int) -> Camera:
         """This camera with `factor` x `factor` pixels in each of its pixels: the same field
         of view and lens, `factor` times the focal length in pixels (a block of pixels' middle
         is the ray of the pixel it divides)."""

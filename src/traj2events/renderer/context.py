@@ -94,7 +94,7 @@ def _bind_platform(backend: str) -> None:
         )
 
 
-def gl_context(backend: str, width: int, height: int) -> "EGLContext | OSMesaContext":
+def gl_context(backend: str, width: int, height: int) -> EGLContext | OSMesaContext:
     """A current OpenGL context of `backend` (`egl` or `osmesa`: resolve_backend)."""
     _bind_platform(backend)
     return OSMesaContext(width, height) if backend == "osmesa" else EGLContext()

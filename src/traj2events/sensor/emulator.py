@@ -35,7 +35,7 @@ events) and `parallel` (the per-pixel pass split over threads).
 
 from __future__ import annotations
 
-from typing import Iterator
+from collections.abc import Iterator
 
 import numpy as np
 

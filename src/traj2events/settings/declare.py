@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import functools
 import math
+import operator
 import types
 import typing
 from dataclasses import MISSING
@@ -81,7 +83,7 @@ def _split_optional(tp) -> tuple[object, bool]:
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(tp) if a is not type(None)]
         nullable = len(args) < len(typing.get_args(tp))
-        return (args[0] if len(args) == 1 else typing.Union[tuple(args)]), nullable
+        return (args[0] if len(args) == 1 else functools.reduce(operator.or_, args)), nullable
     return tp, False
 
 

@@ -82,7 +82,7 @@ class RenderSettings:
         CameraSection(width=self.width, height=self.height, fov_deg=self.fov_deg, mount_height_m=self.mount_height_m)
 
     @classmethod
-    def from_config(cls, config: dict, name: str) -> "RenderSettings":
+    def from_config(cls, config: dict, name: str) -> RenderSettings:
         return cls(**render_settings(config, name))
 
     @property
@@ -97,7 +97,7 @@ class RenderSettings:
         return json.dumps(self.__dict__, sort_keys=True)
 
     @classmethod
-    def from_json(cls, text: str) -> "RenderSettings":
+    def from_json(cls, text: str) -> RenderSettings:
         return cls(**json.loads(text))
 
     def build(self, tile_cache: str | None = None):

@@ -15,8 +15,8 @@ import multiprocessing as mp
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import replace
-from typing import Callable
 
 from .dynamics import Dynamics, Vehicle
 from .ocp import BoundaryConditions, LandingProblem, OcpSettings, Solution

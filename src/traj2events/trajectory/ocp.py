@@ -52,7 +52,7 @@ class BoundaryConditions:
     final: np.ndarray
     tf_guess_s: float = 60.0
 
-    def interpolate(self, other: "BoundaryConditions", s: float) -> "BoundaryConditions":
+    def interpolate(self, other: BoundaryConditions, s: float) -> BoundaryConditions:
         """(1 - s) self + s other, for homotopy from self (s = 0) to other (s = 1)."""
         return BoundaryConditions(
             (1 - s) * self.initial + s * other.initial,

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import json
 import zlib
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
-from typing import Callable
 
 import numpy as np
 
@@ -196,7 +196,7 @@ def solve_by_continuation(
         log.append(problem.solve(bc))
         return log[-1]
 
-    for name, strategy in (("warm", warm), ("homotopy-%d" % homotopy_steps, homotopy), ("cold", cold)):
+    for name, strategy in (("warm", warm), (f"homotopy-{homotopy_steps}", homotopy), ("cold", cold)):
         if attempt(strategy):
             method = name + ("+refined" if len(log[-1].t) != problem.settings.n_nodes else "")
             return SampleResult(
@@ -232,7 +232,7 @@ class ScenarioSettings:
     seed: int
 
     @classmethod
-    def from_config(cls, config: dict, name: str) -> "ScenarioSettings":
+    def from_config(cls, config: dict, name: str) -> ScenarioSettings:
         return cls.from_json(json.dumps(solve_settings(config, name)))
 
     def to_json(self) -> str:
@@ -247,7 +247,7 @@ class ScenarioSettings:
         )
 
     @classmethod
-    def from_json(cls, text: str) -> "ScenarioSettings":
+    def from_json(cls, text: str) -> ScenarioSettings:
         d = json.loads(text)
         sc = d["scenario"]
         scenario = Scenario(
