@@ -165,3 +165,16 @@ def test_exports_read_back_with_their_own_readers(tmp_path):
         np.testing.assert_array_equal(back["y"], events["y"])
         np.testing.assert_array_equal(back["on"], events["p"] == 1)
     assert not list(tmp_path.glob(".*"))
+
+
+def test_merged_events_are_in_time_order_the_first_sets_first_among_equal_times():
+    from traj2events.formats.events import merge_events
+
+    events = {"x": np.array([1, 2]), "y": np.array([0, 0]), "t": np.array([10, 30]), "p": np.array([1, 0])}
+    due = {"x": np.array([7, 8]), "y": np.array([1, 1]), "t": np.array([10, 20]), "p": np.array([1, 1]),
+           "label": np.array([4, 4], np.uint8)}  # fmt: skip
+    out, labels = merge_events(events, np.array([0, 0], np.uint8), due)
+    assert out["t"].tolist() == [10, 10, 20, 30] and out["x"].tolist() == [1, 7, 8, 2]
+    assert labels.tolist() == [0, 4, 4, 0]
+    none_due = {k: v[:0] for k, v in due.items()}
+    assert merge_events(events, None, none_due)[0] is events

@@ -8,7 +8,8 @@ from PIL import Image
 from scipy.special import erf
 
 from traj2events.formats.events import EVENT_LABELS, read_events
-from traj2events.stages.events import emulate, frame_source, preset_params
+from traj2events.sensor.sources import frame_source
+from traj2events.stages.events import emulate, preset_params
 from traj2events.stages.pictures import events_picture
 from traj2events.video import VideoWriter
 
@@ -196,7 +197,7 @@ def test_a_video_s_decoder_takes_one_of_the_threads(tmp_path, monkeypatch):
 
 
 def test_an_error_from_a_plain_iterator_source_is_the_one_raised(tmp_path):
-    from traj2events.stages.events import FrameSource
+    from traj2events.sensor.sources import FrameSource
 
     frames = np.full((3, 12, 16), np.nan, np.float32)  # refused by the emulator
     source = FrameSource(16, 12, "test", iter([(frames, np.arange(3) / 50.0)]))  # no close(), unlike a generator

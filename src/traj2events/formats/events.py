@@ -251,3 +251,14 @@ class EventsReader(HeldFile):
         out["t"] += self.t_offset_us
         inside = (out["t"] >= t_start_us) & (out["t"] < t_end_us)
         return out[inside], (label[inside] if labels else None)
+
+
+def merge_events(events: dict, labels: np.ndarray | None, due: dict) -> tuple[dict, np.ndarray | None]:
+    """Two event sets in time order (`events`' first among equal times): an interval's
+    events and those of the space environment due by its end (`due`, with its labels)."""
+    if not len(due["t"]):
+        return events, labels
+    order = np.argsort(np.concatenate([events["t"], due["t"]]), kind="stable")
+    out = {k: np.concatenate([np.asarray(events[k]), due[k].astype(np.asarray(events[k]).dtype)])[order]
+           for k in ("x", "y", "t", "p")}  # fmt: skip
+    return out, (None if labels is None else np.concatenate([labels, due["label"]])[order])

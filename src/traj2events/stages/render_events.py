@@ -10,14 +10,8 @@ from __future__ import annotations
 import os
 
 from ..formats.trajectory import read_trajectory
-from .events import (
-    CHUNK_FRAMES,
-    check_recording_length,
-    emulate_with_settings,
-    export_events,
-    pixel_and_sensor,
-    rendered_source,
-)
+from ..sensor.sources import CHUNK_FRAMES, check_recording_length, rendered_source
+from .events import emulate_with_settings, export_events, pixel_and_sensor
 from .render import RenderSettings, TrajectoryRender
 
 
