@@ -123,7 +123,7 @@ PartitionName=gpu Nodes=ALL Default=NO MaxTime=INFINITE State=UP
 """
         )
 
-    def __enter__(self) -> "SingleNodeSlurm":
+    def __enter__(self) -> SingleNodeSlurm:
         install()
         self._write_conf()
         try:

@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 from traj2events.sensor.emulator import EventEmulator
-from traj2events.sensor.laws import log_intensity_8bit, lowpass_gain
+from traj2events.sensor.laws import log_intensity_8bit, lowpass_gain, shot_noise_rate_hz
 from traj2events.stages.events import preset_params
 
 CLEAN = preset_params("clean")
@@ -140,6 +140,8 @@ def test_shot_noise_per_pixel_scales_as_the_nominal_over_its_own_threshold():
     counts = np.bincount(ev["y"].astype(int) * w + ev["x"], minlength=h * w)
     weight = 0.25 / (0.5 * (emu.theta_on.astype(float) + emu.theta_off))
     expected = 50.0 * (1 - 0.75 * 20 / 275) * weight * (n_frames - 1) / FPS
+    rate = shot_noise_rate_hz(0.0, 50.0, emu.theta_on.astype(float), emu.theta_off.astype(float), 0.25)
+    assert np.allclose(rate * (n_frames - 1) / FPS, expected)  # the law, as written once
     assert counts.sum() == pytest.approx(expected.sum(), rel=4 / np.sqrt(expected.sum()))
     # the least and most sensitive thirds differ as their weights say (~1.4x at sigma = 0.08)
     order = np.argsort(weight)

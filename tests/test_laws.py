@@ -63,3 +63,14 @@ def test_the_kernel_computes_the_laws_array_forms_bit_for_bit(cutoff_hz):
     mean = 0.5 * (i0.astype(np.float64) * scale + x1)
     expected = f0 + lowpass_gain(mean, cutoff_hz, dt) * (log_intensity_8bit(x1) - f0)
     assert np.array_equal(filtered, expected)
+
+
+def test_the_shot_noise_rate_is_v2es_gain_times_the_nominal_over_the_pixels_threshold():
+    from traj2events.sensor.laws import shot_noise_rate_hz
+
+    # v2e's linear fall of the rate with the input: R (1 - 0.75 (I + 20) / 275), here at
+    # I = 0 and 255 DN, a pixel of nominal thresholds and one 20 % more sensitive.
+    rates = shot_noise_rate_hz(np.array([0.0, 255.0, 0.0]), 5.0, np.array([0.25, 0.25, 0.2]),
+                               np.array([0.25, 0.25, 0.2]), 0.25)  # fmt: skip
+    assert np.allclose(rates, [5.0 * (1 - 0.75 * 20 / 275), 5.0 * 0.25, 5.0 * (1 - 0.75 * 20 / 275) * 1.25])
+    assert shot_noise_rate_hz(400.0, 5.0, 0.25, 0.25, 0.25) == 0.0  # no noise above 346 DN

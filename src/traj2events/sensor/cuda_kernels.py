@@ -7,7 +7,8 @@ frame interval:
             its block that land on it and are kept, its hot-pixel events -> how many events
     scan    exclusive prefix sum of the counts, by groups of 32: each pixel's first slot
             (no atomics, so the order does not depend on scheduling)
-    fill    each pixel writes its events from its slot, as `pixel.emit` does
+    fill    each pixel writes its events from its slot: `pixel.emit_crossings` as on the CPU,
+            then its shot noise (`noise.next_kept_on_pixel`, the walk `count` made) and hot pixels
 
 The events come back to the host in pixel order and are ordered as on the CPU
 (`ordering.assemble`), so the same input and seed give the same events on both, except
@@ -21,13 +22,23 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import cuda
+from numba import config, cuda
 
-from ..formats.events import HOT_PIXEL, LEAK, SHOT_NOISE, SIGNAL
+from ..formats.events import HOT_PIXEL, SHOT_NOISE
 from .draws import unit_key
 from .laws import log_response_scalar, lowpass_gain_scalar, refractory_allows
-from .noise import NOISE_BLOCK, block_mean_gap_s, candidate, hot_pixel_count, hot_pixel_time, kept
-from .pixel import advance_pixel, crossing_time
+from .noise import NOISE_BLOCK, block_mean_gap_s, hot_pixel_count, hot_pixel_time, next_kept_on_pixel
+from .pixel import advance_pixel, emit_crossings
+
+
+def _on_device(function):
+    """A shared njit function as the kernels call it: compiled for the GPU with them, or
+    under numba's CUDA simulator (kernels run as Python on the simulator's arrays) its
+    Python, which those arrays can enter."""
+    return function.py_func if config.ENABLE_CUDASIM else function
+
+
+emit_pixel_crossings = _on_device(emit_crossings)
 
 # CUDA threads per block, for every kernel here (the scan's shared array too); the events
 # do not depend on it.
@@ -62,15 +73,13 @@ def count_kernel(
         block = i // NOISE_BLOCK
         mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
         key = np.uint64(unit_key(shot_key, block))  # (a uint64 already: the simulator needs the cast)
-        j = 0
-        s, offset, coin, on = candidate(key, j, 0.0, mean_gap_s)
+        majorant = majorants[block]
+        j, s, on = next_kept_on_pixel(key, 0, 0.0, mean_gap_s, i, block, majorant, i1, theta_on[i], theta_off[i],
+                                      theta_nominal, dt)  # fmt: skip
         while s < dt:
-            if block * NOISE_BLOCK + offset == i and kept(
-                coin, majorants[block], i1, theta_on[i], theta_off[i], theta_nominal
-            ):
-                n += 1
-            j += 1
-            s, offset, coin, on = candidate(key, j, s, mean_gap_s)
+            n += 1
+            j, s, on = next_kept_on_pixel(key, j + 1, s, mean_gap_s, i, block, majorant, i1, theta_on[i],
+                                          theta_off[i], theta_nominal, dt)  # fmt: skip
     if hot_hz > 0.0 and hot[i]:  # 8.
         n += hot_pixel_count(hot_key, i, hot_hz, dt)
     n_events[i] = n
@@ -91,42 +100,28 @@ def fill_kernel(
     k = first_slot[i]
     c = count[i]
     if c != 0:
-        on = c > 0
-        step = theta_on[i] if on else -theta_off[i]
-        n = abs(c)
-        emitted = 0
-        for j in range(1, n + 1):
-            t = crossing_time(j, step, x0[i], x1[i], t0, dt)
-            if refractory_s > 0.0:
-                if not refractory_allows(t, last_event[i], refractory_s):
-                    continue
-                last_event[i] = t
-            out_pix[k], out_t[k], out_p[k] = i, t, on
-            out_label[k] = LEAK if j > n - n_leak[i] else SIGNAL
-            k += 1
-            emitted += 1
-        base[i] += (emitted if defer else n) * step
+        k, move = emit_pixel_crossings(i, c, x0[i], x1[i], n_leak[i], theta_on[i], theta_off[i], t0, dt, refractory_s,
+                                       defer, last_event, out_pix, out_t, out_p, out_label, k)  # fmt: skip
+        base[i] += move
     if shot_noise_hz > 0.0:
         i1 = np.float64(intensity1[i]) * scale
         block = i // NOISE_BLOCK
         mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
         key = np.uint64(unit_key(shot_key, block))  # (a uint64 already: the simulator needs the cast)
-        j = 0
+        majorant = majorants[block]
         reset = False
-        s, offset, coin, on = candidate(key, j, 0.0, mean_gap_s)
+        j, s, on = next_kept_on_pixel(key, 0, 0.0, mean_gap_s, i, block, majorant, i1, theta_on[i], theta_off[i],
+                                      theta_nominal, dt)  # fmt: skip
         while s < dt:
-            if block * NOISE_BLOCK + offset == i and kept(
-                coin, majorants[block], i1, theta_on[i], theta_off[i], theta_nominal
-            ):
-                t = t0 + s
-                if refractory_s <= 0.0 or refractory_allows(t, last_event[i], refractory_s):
-                    if refractory_s > 0.0:
-                        last_event[i] = t
-                    out_pix[k], out_t[k], out_p[k], out_label[k] = i, t, on, SHOT_NOISE
-                    k += 1
-                    reset = True
-            j += 1
-            s, offset, coin, on = candidate(key, j, s, mean_gap_s)
+            t = t0 + s
+            if refractory_s <= 0.0 or refractory_allows(t, last_event[i], refractory_s):
+                if refractory_s > 0.0:
+                    last_event[i] = t
+                out_pix[k], out_t[k], out_p[k], out_label[k] = i, t, on, SHOT_NOISE
+                k += 1
+                reset = True
+            j, s, on = next_kept_on_pixel(key, j + 1, s, mean_gap_s, i, block, majorant, i1, theta_on[i],
+                                          theta_off[i], theta_nominal, dt)  # fmt: skip
         if reset:
             base[i] = filtered[i]
             if leak_drift.size > 0:

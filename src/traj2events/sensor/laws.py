@@ -52,6 +52,12 @@ def _shot_noise_gain(intensity_dn):
     return max(g, 0.0)  # linear input can pass 255 DN: no noise above 346 DN
 
 
+def _shot_noise_rate_hz(intensity_dn, shot_noise_hz, theta_on, theta_off, theta_nominal):
+    # 7. A pixel's shot-noise rate, R_shot g(I) theta_nom / theta(x) (theta(x) the mean of its
+    # two thresholds: a more sensitive pixel fires more noise); noise.kept draws it by thinning.
+    return shot_noise_hz * shot_noise_gain_scalar(intensity_dn) * theta_nominal / (0.5 * (theta_on + theta_off))
+
+
 def _refractory_allows(t_s, last_event_s, refractory_s):
     return t_s - last_event_s >= refractory_s
 
@@ -68,6 +74,8 @@ _log_response_ufunc = vectorize([float32(float32), float64(float64)], cache=True
 _lowpass_gain_ufunc = vectorize([float64(float64, float64, float64)], cache=True)(_lowpass_gain)
 shot_noise_gain = vectorize([float64(float64)], cache=True)(_shot_noise_gain)
 bandwidth_hz = vectorize([float64(float64, float64)], cache=True)(_bandwidth_hz)  # Hz at each intensity
+# Hz of shot noise per pixel: (intensity DN, R_shot, theta_on, theta_off, theta_nominal).
+shot_noise_rate_hz = vectorize([float64(float64, float64, float64, float64, float64)], cache=True)(_shot_noise_rate_hz)
 
 
 def log_intensity_8bit(frame_dn: np.ndarray, dtype=np.float64) -> np.ndarray:

@@ -42,7 +42,9 @@ def block_majorants(theta_on: np.ndarray, theta_off: np.ndarray, theta_nominal: 
 @njit(inline="always")
 def kept(coin, majorant, intensity_dn, theta_on, theta_off, theta_nominal):
     """Is a candidate kept on its pixel, with probability g(I) w / majorant, w = theta_nom /
-    theta(x) (theta(x) the mean of the pixel's two thresholds)? Written without divisions."""
+    theta(x) (theta(x) the mean of the pixel's two thresholds)? The block's candidates come
+    at R_shot majorant per pixel, so the kept ones at `laws.shot_noise_rate_hz`. Written
+    without divisions."""
     return coin * majorant * (0.5 * (theta_on + theta_off)) < shot_noise_gain_scalar(intensity_dn) * theta_nominal
 
 
@@ -63,6 +65,21 @@ def candidate(block_key, j, s, mean_gap_s):
     offset = np.int64((bits >> np.uint64(27)) & np.uint64(NOISE_BLOCK - 1))
     coin = np.float64((bits >> np.uint64(1)) & np.uint64(0x3FFFFFF)) * 1.4901161193847656e-08  # 2^-26
     return s - math.log(u) * mean_gap_s, offset, coin, (bits & np.uint64(1)) == np.uint64(1)
+
+
+@njit(inline="always")
+def next_kept_on_pixel(block_key, j, s, mean_gap_s, i, block, majorant, intensity_dn, theta_on, theta_off,
+                       theta_nominal, dt):  # fmt: skip
+    """From the block's j-th candidate (drawn after time s) on, the first that lands on pixel
+    i and is kept: (its index, its time since the interval's start, ON); a time >= dt: none
+    in the interval. One pixel's walk over its block's candidates (the GPU's threads)."""
+    t, offset, coin, on = candidate(block_key, j, s, mean_gap_s)
+    while t < dt and not (
+        block * NOISE_BLOCK + offset == i and kept(coin, majorant, intensity_dn, theta_on, theta_off, theta_nominal)
+    ):
+        j += 1
+        t, offset, coin, on = candidate(block_key, j, t, mean_gap_s)
+    return j, t, on
 
 
 @njit(cache=True, nogil=True)

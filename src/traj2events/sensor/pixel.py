@@ -15,6 +15,7 @@ order (5.), the reference moved by one threshold per crossing ("drop") or per em
 event ("defer"). Then the pixel's shot noise (7., a kept one resets the reference to the
 signal) and its hot-pixel events (8.), drawn in `noise`.
 
+`emit_crossings` writes one pixel's crossings as events; the CPU and the GPU call it alike.
 On the CPU, `advance` runs over every pixel and lists those that cross; `emit` writes
 their events, then the shot noise's (`noise.shot_noise_events`), then the hot pixels'.
 """
@@ -79,6 +80,30 @@ def crossing_time(j, step, x0, x1, t0, dt):
     slope = x1 - x0
     frac = (j * step - x0) / slope if slope != 0.0 else 0.0
     return t0 + dt * min(max(frac, 0.0), 1.0)
+
+
+@njit(inline="always")
+def emit_crossings(i, count, x0, x1, n_leak, theta_on, theta_off, t0, dt, refractory_s, defer, last_event, out_pix,
+                   out_t, out_p, out_label, k):  # fmt: skip
+    """4-5. Pixel i's `count` crossings as events from slot k on (its last n_leak labelled
+    leak), each at its `crossing_time` unless the refractory period holds it back: (the
+    next free slot, how far its reference moves: every crossing's threshold with drop, the
+    emitted ones' with defer)."""
+    on = count > 0
+    step = theta_on if on else -theta_off
+    n = abs(count)
+    emitted = 0
+    for j in range(1, n + 1):
+        t = crossing_time(j, step, x0, x1, t0, dt)
+        if refractory_s > 0.0:  # 5.
+            if not refractory_allows(t, last_event[i], refractory_s):
+                continue
+            last_event[i] = t
+        out_pix[k], out_t[k], out_p[k] = i, t, on
+        out_label[k] = LEAK if j > n - n_leak else SIGNAL
+        k += 1
+        emitted += 1
+    return k, (emitted if defer else n) * step
 
 
 @njit(cache=True, nogil=True)
@@ -156,22 +181,9 @@ def emit(
     k = 0
     for a in range(n_active):
         i = active[a]
-        on = count[a] > 0
-        step = theta_on[i] if on else -theta_off[i]
-        n = abs(count[a])
-        emitted = 0
-        for j in range(1, n + 1):
-            t = crossing_time(j, step, x0[a], x1[a], t0, dt)
-            if refractory_s > 0.0:  # 5.
-                if not refractory_allows(t, last_event[i], refractory_s):
-                    continue
-                last_event[i] = t
-            out_pix[k], out_t[k], out_p[k] = i, t, on
-            out_label[k] = LEAK if j > n - n_leak[a] else SIGNAL
-            k += 1
-            emitted += 1
-        # the reference moves by every crossing (drop) or by the emitted ones only (defer)
-        base[i] += (emitted if defer else n) * step
+        k, move = emit_crossings(i, count[a], x0[a], x1[a], n_leak[a], theta_on[i], theta_off[i], t0, dt, refractory_s,
+                                 defer, last_event, out_pix, out_t, out_p, out_label, k)  # fmt: skip
+        base[i] += move
     reset = -1  # the last pixel whose noise reset its reference
     for b in range(n_noise):  # 7.
         i = noise_pix[b]
