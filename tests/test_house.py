@@ -142,3 +142,21 @@ def test_the_bench_readme_lists_every_benchmark_and_the_quick_set_exists():
     text = (BENCH / "README.md").read_text()
     assert all(f"| `{name}` |" in text for name in benchmarks())
     assert set(QUICK) <= set(benchmarks()) and len(benchmarks()) > 40
+
+
+def test_no_docs_table_row_is_over_400_characters():
+    pages = [*sorted((ROOT / "docs").rglob("*.md")), ROOT / "README.md", ROOT / "bench" / "README.md"]
+    long = [f"{p.relative_to(ROOT)}:{n}" for p in pages for n, line in enumerate(p.read_text().split("\n"), 1)
+            if line.startswith("|") and len(line) > 400]  # fmt: skip
+    assert not long, long
+
+
+def test_every_decision_record_has_its_four_parts_and_is_linked_from_a_page():
+    records = sorted((ROOT / "docs" / "decisions").glob("[0-9][0-9][0-9][0-9]-*.md"))
+    pages = "".join(p.read_text() for p in (ROOT / "docs").glob("*.md"))
+    assert len(records) >= 6
+    for record in records:
+        text = record.read_text()
+        assert all(f"## {part}" in text for part in ("Context", "Decision", "Consequences")), record.name
+        assert "## Options" in text, record.name
+        assert f"decisions/{record.name}" in pages, f"no page links {record.name}"
