@@ -1,7 +1,8 @@
 """Reflectance laws of the lunar regolith, as radiance factor I/F.
 
 Both laws exist twice: here in numpy (the reference, tested) and in
-`shaders/terrain.frag` (what the renderer runs); tests render a flat plane and compare.
+`renderer/shaders/reflectance.glsl` (what the renderer runs: the terrain shaders include it); tests
+render a flat plane and compare.
 Angles: incidence i (Sun from the surface normal), emission e (camera from the normal),
 phase g (Sun to camera, seen from the surface); mu0 = cos i, mu = cos e.
 Radiance: L = (I/F) E_sun / pi  (W m^-2 sr^-1), with E_sun the Sun's irradiance.

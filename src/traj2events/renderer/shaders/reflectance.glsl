@@ -1,5 +1,5 @@
 // traj2events: the reflectance laws of reflectance.py (the numpy reference the tests
-// compare with), for the shader stages that evaluate them (render.expand_includes).
+// compare with), for the shader stages that evaluate them (renderer.draw.expand_includes).
 uniform vec3 sun_dir;        // unit, toward the Sun (world)
 uniform float irradiance;    // W/m^2 at the Moon
 uniform int model;           // 0 Hapke, 1 Lunar-Lambert
