@@ -75,7 +75,7 @@ def test_every_key_has_a_meaning_and_numbers_a_unit_or_say_they_have_none():
         (lambda: SensorParams(band_m=(7e-7, 4e-7)), "events.sensor.band_m: expected [low, high] with low < high"),
         (lambda: SensorParams(band_m=(1e-7, 4e-7)), "events.sensor.band_m: expected a value >= 2e-07, got 1e-07"),
         (lambda: Vehicle(dry_mass_kg=1e5), "vehicle.dry_mass_kg: expected less than vehicle.mass_kg"),
-        (lambda: OcpSettings(n_nodes=40, refine_n_nodes=30), "ocp.refine_n_nodes: expected 0 or more than n_nodes"),
+        (lambda: OcpSettings(n_nodes=40, refine_n_nodes=30), "ocp.refine_n_nodes: expected 0 or more than ocp.n_nodes"),
         (lambda: TerrainParams(rock_diameter_min_m=1.0), "terrain.rock_diameter_min_m: expected at most"),
         (lambda: FrameTiming(mode="adaptive", max_log_change=None), "render.timing: adaptive needs max_log_change"),
     ],

@@ -188,33 +188,7 @@ def _semantic_errors(config: dict) -> list[str]:
     errors = non_finite(config)
     if errors:
         return errors
-    vehicle, ocp, terrain = config["vehicle"], config["ocp"], config["terrain"]
-    if vehicle["dry_mass_kg"] >= vehicle["mass_kg"]:
-        errors.append("config key 'vehicle.dry_mass_kg': expected less than vehicle.mass_kg")
-    weight_n = vehicle["mass_kg"] * vehicle["g_m_s2"]
-    if vehicle["thrust_main_N"] <= weight_n:
-        errors.append(
-            f"config key 'vehicle.thrust_main_N': expected more than the lander's weight "
-            f"mass_kg * g_m_s2 = {weight_n:.0f} N (it could not stop), got {vehicle['thrust_main_N']}"
-        )
-    if ocp["tf_min_s"] >= ocp["tf_max_s"]:
-        errors.append(f"config key 'ocp.tf_min_s': expected less than ocp.tf_max_s = {ocp['tf_max_s']}, "
-                      f"got {ocp['tf_min_s']}")  # fmt: skip
-    if ocp["refine_n_nodes"] and ocp["refine_n_nodes"] <= ocp["n_nodes"]:
-        errors.append(f"config key 'ocp.refine_n_nodes': expected 0 or more than ocp.n_nodes = {ocp['n_nodes']}, "
-                      f"got {ocp['refine_n_nodes']}")  # fmt: skip
-    for kind in ("crater", "boulder"):
-        if terrain[f"{kind}_diameter_min_m"] > terrain[f"{kind}_diameter_max_m"]:
-            errors.append(f"config key 'terrain.{kind}_diameter_min_m': expected at most terrain.{kind}_diameter_max_m")
-    if terrain["rock_diameter_min_m"] > terrain["boulder_diameter_min_m"]:
-        errors.append(f"config key 'terrain.rock_diameter_min_m': expected at most terrain.boulder_diameter_min_m "
-                      f"= {terrain['boulder_diameter_min_m']} (rocks are the boulders' law below it), "
-                      f"got {terrain['rock_diameter_min_m']}")  # fmt: skip
-    covered = _boulder_cover(terrain)
-    if covered > 0.5:
-        errors.append(f"config key 'terrain.boulder_density_k': boulders and rocks would cover {covered:.0%} of "
-                      f"the ground (pi/4 of D^2 summed over N(>D) = K D^-slope from the smallest to the largest); "
-                      f"expected at most 50 %, got K = {terrain['boulder_density_k']}")  # fmt: skip
+    errors = _section_errors(config)
     for name, sc in config["scenarios"].items():
         errors += _scenario_errors(config, name, sc)
     if errors:
@@ -226,8 +200,6 @@ def _semantic_errors(config: dict) -> list[str]:
         errors.append(f"config key 'events.window_ms': expected at most the shortest flight, {flight_ms:g} ms "
                       f"(tf_guess_s, pose files' durations), got {config['events']['window_ms']}")  # fmt: skip
     pixel = config["events"]["pixel"]
-    if pixel["hot_pixel_fraction"] > 0 and not pixel["hot_pixel_hz"] > 0:
-        errors.append("config key 'events.pixel.hot_pixel_hz': expected > 0 when events.pixel.hot_pixel_fraction > 0")
     sensor = config["events"]["sensor"]
     optics = [k for k in ("psf_diffraction", "lens_blur_um", "vignetting") if sensor[k]]
     if optics and config["events"]["input"] != "sensor":
@@ -240,18 +212,34 @@ def _semantic_errors(config: dict) -> list[str]:
     if space["enabled"] and space["particle_flux_cm2_s"] > 0 and not pixel["cutoff_hz"] > 0:
         errors.append("config key 'events.space.particle_flux_cm2_s': particle hits need events.pixel.cutoff_hz > 0 "
                       "(the photoreceptor's bandwidth sets a pixel's answer to a hit)")  # fmt: skip
-    band = sensor["band_m"]
-    if not band[0] < band[1]:
-        errors.append(f"config key 'events.sensor.band_m': expected [low, high] with low < high, got {band}")
     timing = config["render"]["timing"]
-    errors += _timing_errors(timing)
     if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
     errors += _display_errors(config) + _lens_errors(config["camera"])
     if not errors:  # a lens refused above has no pinhole cover to measure
         errors += _supersample_errors(config["camera"], config["render"]["supersample"])
-    return errors or _elevation_grid_error(terrain)
+    return errors or _elevation_grid_error(config["terrain"])
+
+
+def _section_errors(config: dict) -> list[str]:
+    """Each section that is a class built from the config: its own checks, written once in
+    its declaration (bounds, and what one section's keys must satisfy together)."""
+    from .settings.events import EmulatorParams, SensorParams
+    from .settings.render import FrameTiming, TerrainParams
+    from .settings.solve import OcpSettings
+    from .settings.vehicle import Vehicle
+
+    events = config["events"]
+    for cls, values in ((Vehicle, config["vehicle"]), (OcpSettings, config["ocp"]), (TerrainParams, config["terrain"]),
+                        (EmulatorParams, events["pixel"]), (SensorParams, events["sensor"]),
+                        (FrameTiming, config["render"]["timing"])):  # fmt: skip
+        try:
+            cls(**values)
+        except ValueError as error:  # "section.key: problem"
+            key, _, problem = str(error).partition(": ")
+            return [f"config key '{key}': {problem}"]
+    return []
 
 
 def _lens_errors(camera: dict) -> list[str]:
@@ -285,18 +273,6 @@ def _supersample_errors(camera: dict, supersample: int) -> list[str]:
     ]
 
 
-def _timing_errors(timing: dict) -> list[str]:
-    """FrameTiming's own checks (the render job would fail on them), before any job starts."""
-    from .settings.render import FrameTiming
-
-    try:
-        FrameTiming(**timing)
-    except ValueError as error:
-        key, _, problem = str(error).partition(": ")  # "render.timing.x: expected ..."
-        return [f"config key '{key}': {problem}"]
-    return []
-
-
 def _display_errors(config: dict) -> list[str]:
     """A display white far above any radiance the scene can have gives black videos."""
     from .scene.reflectance import ReflectanceParams, max_radiance_factor
@@ -322,18 +298,6 @@ _Validator = jsonschema.validators.extend(
         "integer", lambda _, value: isinstance(value, int) and not isinstance(value, bool)
     ),
 )
-
-
-def _boulder_cover(terrain: dict) -> float:
-    """Share of the ground boulders and rocks cover: the integral of (pi/4) D^2 |dN/dD| from
-    the smallest rock to the largest boulder, N(>D) = K D^-s per m^2 (terrain.boulder_*)."""
-    k, s = terrain["boulder_density_k"], terrain["boulder_slope"]
-    lo = min(terrain["rock_diameter_min_m"], terrain["boulder_diameter_min_m"])
-    hi = terrain["boulder_diameter_max_m"]
-    if k == 0 or hi <= lo:
-        return 0.0
-    power = math.log(hi / lo) if s == 2 else (hi ** (2 - s) - lo ** (2 - s)) / (2 - s)
-    return math.pi / 4 * k * s * power
 
 
 def section(name: str) -> dict:

@@ -31,6 +31,10 @@ class EmulatorParams:
     refractory_mode: str = setting(doc="crossings within the period: dropped (drop, ESIM) or pending (defer, v2e)",
                                    choices=REFRACTORY_MODES)  # fmt: skip
 
+    def __post_init__(self) -> None:
+        if self.hot_pixel_fraction > 0 and not self.hot_pixel_hz > 0:
+            raise ValueError("events.pixel.hot_pixel_hz: expected > 0 when events.pixel.hot_pixel_fraction > 0")
+
 
 @section(
     "events.sensor",

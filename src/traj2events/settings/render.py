@@ -3,6 +3,8 @@ when to render (`render.timing`)."""
 
 from __future__ import annotations
 
+import math
+
 from ..geometry.camera import horizon_distance_m
 from . import trajectory_rng
 from .declare import section, setting
@@ -61,7 +63,25 @@ class TerrainParams:
             if getattr(self, f"{kind}_diameter_min_m") > getattr(self, f"{kind}_diameter_max_m"):
                 raise ValueError(f"terrain.{kind}_diameter_min_m: expected at most terrain.{kind}_diameter_max_m")
         if self.rock_diameter_min_m > self.boulder_diameter_min_m:
-            raise ValueError("terrain.rock_diameter_min_m: expected at most terrain.boulder_diameter_min_m")
+            raise ValueError(f"terrain.rock_diameter_min_m: expected at most terrain.boulder_diameter_min_m = "
+                             f"{self.boulder_diameter_min_m} (rocks are the boulders' law below it), got "
+                             f"{self.rock_diameter_min_m}")  # fmt: skip
+        covered = self.boulder_cover
+        if covered > 0.5:
+            raise ValueError(f"terrain.boulder_density_k: boulders and rocks would cover {covered:.0%} of the ground "
+                             "(pi/4 of D^2 summed over N(>D) = K D^-slope from the smallest to the largest); expected "
+                             f"at most 50 %, got K = {self.boulder_density_k}")  # fmt: skip
+
+    @property
+    def boulder_cover(self) -> float:
+        """Share of the ground boulders and rocks cover: the integral of (pi/4) D^2 |dN/dD|
+        from the smallest rock to the largest boulder, N(>D) = K D^-s per m^2."""
+        k, s = self.boulder_density_k, self.boulder_slope
+        lo, hi = min(self.rock_diameter_min_m, self.boulder_diameter_min_m), self.boulder_diameter_max_m
+        if k == 0 or hi <= lo:
+            return 0.0
+        power = math.log(hi / lo) if s == 2 else (hi ** (2 - s) - lo ** (2 - s)) / (2 - s)
+        return math.pi / 4 * k * s * power
 
 
 @section("render.reflectance", 'the regolith\'s reflectance law (docs/rendering.md "Reflectance")')

@@ -38,8 +38,11 @@ class OcpSettings:
     pitch_decreasing: bool = False
 
     def __post_init__(self) -> None:
+        if self.tf_min_s >= self.tf_max_s:
+            raise ValueError(f"ocp.tf_min_s: expected less than ocp.tf_max_s = {self.tf_max_s}, got {self.tf_min_s}")
         if self.refine_n_nodes and self.refine_n_nodes <= self.n_nodes:
-            raise ValueError(f"ocp.refine_n_nodes: expected 0 or more than n_nodes = {self.n_nodes}")
+            raise ValueError(f"ocp.refine_n_nodes: expected 0 or more than ocp.n_nodes = {self.n_nodes}, "
+                             f"got {self.refine_n_nodes}")  # fmt: skip
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -34,6 +34,10 @@ class Vehicle:
         object.__setattr__(self, "inertia_kgm2", tuple(float(v) for v in self.inertia_kgm2))
         if not self.dry_mass_kg < self.mass_kg:
             raise ValueError("vehicle.dry_mass_kg: expected less than vehicle.mass_kg")
+        weight_n = self.mass_kg * self.g_m_s2
+        if self.thrust_main_N <= weight_n:
+            raise ValueError(f"vehicle.thrust_main_N: expected more than the lander's weight mass_kg * g_m_s2 = "
+                             f"{weight_n:.0f} N (it could not stop), got {self.thrust_main_N}")  # fmt: skip
 
     def to_dict(self) -> dict:
         return {**asdict(self), "inertia_kgm2": list(self.inertia_kgm2)}
