@@ -14,11 +14,12 @@ import sys
 
 from . import __version__, missing_dependency
 from .memory import keep_freed_memory
-from .options import add_settings, inline_or_file, json_or_null, settings_from
+from .options import add_declared_option, add_settings, inline_or_file, json_or_null, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
 from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE, EXPORT_SUFFIX
 from .settings.imu import IMU
 from .settings.poses import POSES
+from .settings.render import RenderSection
 
 
 def _settings(kind, value: str):
@@ -186,9 +187,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
     p.add_argument("--preview", help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless "
                    "render.preview is false: its encoder takes CPU beside the render); default: none")  # fmt: skip
-    p.add_argument("--backend", default="auto", help="OpenGL backend: egl (a GPU, headless), "
-                   "osmesa (the CPU, Mesa llvmpipe) or auto (EGL when a GPU's EGL device exists, else OSMesa); "
-                   "default: %(default)s")  # fmt: skip
+    add_declared_option(p, "--backend", RenderSection, "backend")
     p.add_argument("--tile-cache", metavar="FOLDER", help="share built tiles' terrain heights with other render jobs "
                    "through this folder (the workflow passes render.tile_cache); default: no cache")  # fmt: skip
     p.add_argument("--events", help="events.h5: also emulate the events, from the frames in memory (frames.h5 then "

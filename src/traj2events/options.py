@@ -18,7 +18,7 @@ import jsonschema
 from .config import ConfigError, describe
 from .defaults import preset_names, preset_sections, with_preset
 from .settings import config_value, pick
-from .settings.declare import non_finite
+from .settings.declare import declared_fields, non_finite
 from .settings.tree import config_schema, default_config
 
 _PREFIX = "setting:"  # argparse dest of an option that changes one setting
@@ -158,3 +158,16 @@ def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
             key = ".".join([path, *map(str, error.absolute_path)])
             raise ConfigError(f"{given_by(key)}: {describe(error, path.split('.'))}")
     return settings
+
+
+def add_declared_option(parser: argparse.ArgumentParser, flag: str, cls, name: str, **options) -> None:
+    """An option whose default, choices and help are a declared field's (`cls.name`), for a
+    command's own flags that are config keys but no part of its --settings (they change how
+    a job runs, not what it writes: `render --backend`)."""
+    from .settings.declare import describe_field
+
+    field = next(f for f in declared_fields(cls) if f.name == name)
+    meta = field.metadata
+    key = f"{cls.__section__}.{name}"
+    parser.add_argument(flag, default=meta["default"], choices=meta["choices"],
+                        help=f"{describe_field(field)} [{key}, default %(default)s]", **options)  # fmt: skip
