@@ -311,3 +311,26 @@ def test_the_cli_stays_thin_and_no_module_grows_past_a_reading():
     sizes = {p.relative_to(package).as_posix(): len(p.read_text().splitlines()) for p in package.rglob("*.py")}
     assert sizes["cli.py"] <= 300
     assert max(sizes.values()) <= 520, max(sizes, key=sizes.get)
+
+
+@pytest.mark.parametrize(
+    "settings, fragment",
+    [
+        ('{"fps": 10}', "missing keys ['g_m_s2', 'moon_radius_m', 'mount_height_m', 'scenario', 'seed', 'spice']"),
+        (
+            '{"fps": NaN, "mount_height_m": 3, "moon_radius_m": 1737400, "g_m_s2": 1.62, "scenario": "d", "seed": 1, '
+            '"spice": null}',
+            "fps: camera.fps: expected a finite number, got nan",
+        ),
+        (
+            '{"fps": 10, "mount_height_m": 300, "moon_radius_m": 1737400, "g_m_s2": 1.62, "scenario": "d", "seed": 1, '
+            '"spice": null}',
+            "mount_height_m: camera.mount_height_m: expected a value < 100, got 300",
+        ),
+    ],
+)
+def test_poses_settings_are_checked_against_the_declarations(settings, fragment, tmp_path, capsys):
+    source = trajectory_file(tmp_path / "t.h5")
+    assert main(["poses", str(source), "--settings", settings, "-o", str(tmp_path / "out.h5")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --settings: ") and fragment in err and not (tmp_path / "out.h5").exists(), err

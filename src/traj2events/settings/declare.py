@@ -195,6 +195,12 @@ def _value_errors(key: str, value, meta: dict) -> list[str]:
     return []
 
 
+def value_errors(cls, name: str, value) -> list[str]:
+    """What `value` breaks of the declaration of field `name` of section `cls`."""
+    field = next(f for f in declared_fields(cls) if f.name == name)
+    return _value_errors(f"{cls.__section__}.{name}", value, field.metadata)
+
+
 def field_errors(obj) -> list[str]:
     """What a built section's values break of their declarations (bounds, choices,
     lengths, finite numbers), each naming the config key."""

@@ -106,6 +106,37 @@ def external_pose_settings(config: dict, name: str) -> dict:
     }
 
 
+# The numbers of external_pose_settings, each as its config key declares it.
+EXTERNAL_POSE_KEYS = {"fps": ("camera", "fps"), "mount_height_m": ("camera", "mount_height_m"),
+                      "moon_radius_m": ("motion_field", "moon_radius_m"), "g_m_s2": ("vehicle", "g_m_s2")}  # fmt: skip
+
+
+def check_external_pose_settings(settings: object) -> dict:
+    """`settings` (a `poses` command's --settings) with every key of external_pose_settings,
+    each number within its declaration; ValueError naming the key otherwise."""
+    from .camera import CameraSection, MotionFieldSection
+    from .declare import value_errors
+    from .vehicle import Vehicle
+
+    sections = {"camera": CameraSection, "motion_field": MotionFieldSection, "vehicle": Vehicle}
+    expected = sorted({*EXTERNAL_POSE_KEYS, "scenario", "seed", "spice"})
+    if not isinstance(settings, dict):
+        raise ValueError(f"--settings: expected a JSON object with keys {expected}, got {settings!r}")
+    missing, unknown = sorted(set(expected) - set(settings)), sorted(set(settings) - set(expected))
+    if missing or unknown:
+        raise ValueError(f"--settings: {'missing' if missing else 'unknown'} keys {missing or unknown}; expected "
+                         f"{expected} (settings.poses.external_pose_settings)")  # fmt: skip
+    for key, (section_name, name) in EXTERNAL_POSE_KEYS.items():
+        value = settings[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ValueError(f"--settings: {key}: expected a number, got {value!r}")
+        for problem in value_errors(sections[section_name], name, value):
+            raise ValueError(f"--settings: {key}: {problem}")
+    if isinstance(settings["seed"], bool) or not isinstance(settings["seed"], int) or settings["seed"] < 0:
+        raise ValueError(f"--settings: seed: expected an integer >= 0, got {settings['seed']!r}")
+    return settings
+
+
 def external_extents(config: dict, name: str) -> list[dict]:
     """Per file of an external scenario: its duration `tf_s`, how far it goes from the site
     horizontally `reach_m` and how high `top_m` (read once per file and settings); a file

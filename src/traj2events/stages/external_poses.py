@@ -14,6 +14,7 @@ from ..formats.hdf5 import FileFormatError
 from ..formats.poses import pose_format, read_pose_samples
 from ..formats.trajectory import write_trajectory
 from ..progress import log
+from ..settings.poses import check_external_pose_settings
 from ..trajectory.external import ExternalFlight, PoseSamples, interpolation_record, sample_problems
 
 
@@ -30,6 +31,7 @@ def external_samples(source: str | os.PathLike, settings: dict) -> tuple[PoseSam
 def external_poses(source: str | os.PathLike, trajectory_id: int, settings: dict, output: str | os.PathLike) -> None:
     """Write trajectory.h5 of `source` at settings' fps: settings = settings.poses.external_pose_settings's
     (fps, mount_height_m, moon_radius_m, g_m_s2, scenario, seed, spice)."""
+    settings = check_external_pose_settings(settings)
     samples, record = external_samples(source, settings)
     flight = ExternalFlight(samples, settings["mount_height_m"])
     tf = float(samples.t_s[-1])
