@@ -29,7 +29,7 @@ from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
 from traj2events.scene.tiles import LodSettings, TileSet
 from traj2events.settings.camera import motion_field_settings
 from traj2events.settings.events import events_settings
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls
 

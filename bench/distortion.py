@@ -51,7 +51,7 @@ from traj2events.geometry.motion_field import (
     sphere_motion,
 )
 from traj2events.settings.camera import motion_field_settings
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 

@@ -34,9 +34,9 @@ from traj2events.figures import event_frame
 from traj2events.formats.trajectory import read_trajectory
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+from traj2events.settings.render import RenderSettings
 from traj2events.stages.events import preset_params
 from traj2events.stages.pictures import PAPER_FRACTIONS, PAPER_LABELS, centred_window, save_png
-from traj2events.stages.render import RenderSettings
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates
 

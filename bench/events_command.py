@@ -49,7 +49,8 @@ from common import clip_trajectory
 
 from traj2events.config import resolve_config
 from traj2events.formats.trajectory import read_trajectory
-from traj2events.stages.render import RenderSettings, render_trajectory
+from traj2events.settings.render import RenderSettings
+from traj2events.stages.render import render_trajectory
 
 THREADS = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS", "LP_NUM_THREADS")
 V2E = "C v2e, video.mkv"  # the command that is v2e's

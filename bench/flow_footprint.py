@@ -29,7 +29,7 @@ from traj2events.config import resolve_config
 from traj2events.formats.trajectory import read_trajectory
 from traj2events.geometry.motion_field import depth_flow
 from traj2events.renderer.draw import TerrainRenderer
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 
 def main() -> None:

@@ -75,8 +75,9 @@ from traj2events.renderer.footprint import TEXTURE_FILTERS
 from traj2events.renderer.supersample import sensor_renderer
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.laws import radiance_to_dn
+from traj2events.settings.render import RenderSettings
 from traj2events.stages.events import preset_params
-from traj2events.stages.render import RenderSettings, render_between
+from traj2events.stages.render import render_between
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates
 

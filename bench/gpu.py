@@ -34,7 +34,7 @@ from traj2events.config import load_config
 from traj2events.formats.trajectory import read_trajectory
 from traj2events.plan import dataset_plan
 from traj2events.settings.events import events_settings
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 
 def one_job(config: dict, clip: Path, folder: Path) -> list[str]:

@@ -33,7 +33,8 @@ import numpy as np
 from common import short_trajectory
 
 from traj2events.config import resolve_config
-from traj2events.stages.render import RenderSettings, render_trajectory
+from traj2events.settings.render import RenderSettings
+from traj2events.stages.render import render_trajectory
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 

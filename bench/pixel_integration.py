@@ -47,8 +47,8 @@ from traj2events.formats.trajectory import read_trajectory
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.laws import log_intensity_8bit
 from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+from traj2events.settings.render import RenderSettings
 from traj2events.stages.events import preset_params
-from traj2events.stages.render import RenderSettings
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates
 

@@ -31,7 +31,7 @@ from common import ROOT, clip_trajectory, cpu_seconds, traj2events_cli
 from traj2events.config import load_config
 from traj2events.formats.trajectory import read_trajectory
 from traj2events.settings.events import events_settings
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 
 def commands(config: dict, scenario: str, clip: Path, folder: Path) -> dict[str, list[list[str]]]:

@@ -59,7 +59,7 @@ from traj2events.renderer.draw import TerrainRenderer
 from traj2events.scene.reflectance import ReflectanceParams
 from traj2events.scene.terrain import ProceduralTerrain, TerrainParams
 from traj2events.scene.tiles import LodSettings, TileSet
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 
 @dataclasses.dataclass

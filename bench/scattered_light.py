@@ -37,8 +37,8 @@ from traj2events.renderer.draw import TerrainRenderer
 from traj2events.scene.scattering import FLAT_MOON, scattered_sunlight, spherical_bowl
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+from traj2events.settings.render import RenderSettings
 from traj2events.stages.events import preset_params
-from traj2events.stages.render import RenderSettings
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates
 

@@ -31,7 +31,7 @@ import numpy as np
 from traj2events.config import load_config
 from traj2events.formats.trajectory import read_trajectory
 from traj2events.scene.tiles import long_sweep_lit
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 
 def main() -> None:

@@ -29,8 +29,8 @@ from traj2events.renderer.draw import TerrainRenderer
 from traj2events.scene.stars import star_radiance
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.photocurrent import SensorParams, sensor_dn
+from traj2events.settings.render import RenderSettings
 from traj2events.stages.events import preset_params
-from traj2events.stages.render import RenderSettings
 
 
 def skiest_second(trajectory, settings: RenderSettings, fps: float) -> np.ndarray:

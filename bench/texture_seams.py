@@ -40,8 +40,8 @@ from traj2events.renderer.supersample import sensor_renderer
 from traj2events.scene.tiles import LodSettings
 from traj2events.sensor.emulator import EventEmulator
 from traj2events.sensor.laws import radiance_to_dn
+from traj2events.settings.render import RenderSettings
 from traj2events.stages.events import preset_params
-from traj2events.stages.render import RenderSettings
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from traj2events.config import load_config
 from traj2events.formats.trajectory import read_trajectory
-from traj2events.stages.render import RenderSettings
+from traj2events.settings.render import RenderSettings
 
 
 def fly(trajectory: Path, config: dict, every: int, cache: Path | None, textures_cached: bool = True):

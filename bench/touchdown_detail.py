@@ -50,8 +50,8 @@ def main() -> None:
     from traj2events.renderer.supersample import sensor_renderer
     from traj2events.sensor.emulator import EventEmulator
     from traj2events.sensor.photocurrent import SensorParams, dn_per_radiance
+    from traj2events.settings.render import RenderSettings
     from traj2events.stages.events import preset_params
-    from traj2events.stages.render import RenderSettings
     from traj2events.trajectory.dynamics import Dynamics
     from traj2events.trajectory.upsample import ReintegratedStates
 

@@ -290,7 +290,7 @@ def test_a_full_disk_is_a_write_error_not_a_crash(small_disk, tmp_path):
     import sys
 
     from traj2events.config import resolve_config
-    from traj2events.stages.render import RenderSettings
+    from traj2events.settings.render import RenderSettings
 
     trajectory = trajectory_file(tmp_path / "good.h5")
     config = resolve_config({"camera": {"width": 64, "height": 64}, "scenarios": {"descent": {}}})

@@ -86,8 +86,8 @@ def clip_32(tmp_path):
     """A 32 x 32 render's inputs: 11 poses descending from 100 m, and the render settings."""
     from traj2events.config import resolve_config
     from traj2events.formats.trajectory import vehicle_attrs, write_trajectory
+    from traj2events.settings.render import RenderSettings
     from traj2events.settings.vehicle import Vehicle
-    from traj2events.stages.render import RenderSettings
 
     t = np.linspace(0.0, 1.0, 11)
     state = np.zeros((11, 13))

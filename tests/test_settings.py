@@ -21,7 +21,7 @@ CONFIGS = ["config/config.yaml", "config/smoke.yaml", "config/paper.yaml"]
 
 @pytest.mark.parametrize("path", CONFIGS)
 def test_the_stages_read_back_what_the_workflow_passes(path):
-    from traj2events.stages.render import RenderSettings
+    from traj2events.settings.render import RenderSettings
     from traj2events.trajectory.scenarios import ScenarioSettings
 
     config = load_config(ROOT / path)
@@ -58,7 +58,7 @@ def test_compression_reaches_the_three_writers_settings():
     """compression reaches render, motion field and events, and RenderSettings reads it."""
     from traj2events.settings.camera import motion_field_settings
     from traj2events.settings.events import events_settings
-    from traj2events.stages.render import RenderSettings
+    from traj2events.settings.render import RenderSettings
 
     config = load_config(ROOT / "config/smoke.yaml")
     each = (events_settings, motion_field_settings, lambda c: render_settings(c, "descent"))

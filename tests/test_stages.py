@@ -12,13 +12,14 @@ from traj2events.formats.events import read_events
 from traj2events.formats.trajectory import read_solution_set, read_trajectory
 from traj2events.geometry.camera import Camera
 from traj2events.sensor.sources import frame_source
+from traj2events.settings.render import RenderSettings
 from traj2events.stages import pictures
 from traj2events.stages.base_solution import BaseSolveError, base_solution
 from traj2events.stages.camera_poses import camera_poses
 from traj2events.stages.events import emulate, export_events, preset_params
 from traj2events.stages.index import dataset_index
 from traj2events.stages.motion_field import motion_field
-from traj2events.stages.render import RenderSettings, render_trajectory
+from traj2events.stages.render import render_trajectory
 from traj2events.stages.sample_trajectories import SAMPLE_TABLE_COLUMNS, initial_values, sample_trajectories
 from traj2events.stages.summary import dataset_summary
 from traj2events.trajectory.scenarios import ScenarioSettings

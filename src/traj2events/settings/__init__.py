@@ -21,7 +21,7 @@ settings reruns only that stage (a module's fingerprint covers what it imports):
 
 The simple ones are a map from each setting to its config key (`pick`), which the commands
 also read to offer one option per key (traj2events.options). Each stage turns its settings
-into its model's objects (`trajectory.scenarios.ScenarioSettings`, `stages.render.RenderSettings`,
+into its model's objects (`trajectory.scenarios.ScenarioSettings`, `settings.render.RenderSettings`,
 `settings.events.EmulatorParams`, `geometry.camera.Camera`).
 """
 

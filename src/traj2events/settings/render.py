@@ -3,11 +3,14 @@ when to render (`render.timing`)."""
 
 from __future__ import annotations
 
+import json
 import math
+from dataclasses import dataclass
 
-from ..geometry.camera import horizon_distance_m
+from ..geometry.camera import Camera, horizon_distance_m
 from . import trajectory_rng
-from .declare import section, setting
+from .camera import CameraSection
+from .declare import non_finite, section, setting
 from .poses import external_extents, is_external, scenario_divert
 
 HAPKE = "representative lunar values after Helfenstein & Veverka (1987) and Sato et al. (2014), LROC WAC"
@@ -294,3 +297,132 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
         else None,
         "compression": config["compression"],  # frames.h5's
     }
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """One render job's settings, typed: what `render_settings` gives (the render rule's
+    `params`: camera, terrain, Sun, reflectance, level of detail, display mapping, frame
+    timing), checked against the declarations, and the scene they build."""
+
+    scenario: str
+    width: int
+    height: int
+    fov_deg: float
+    mount_height_m: float
+    moon_radius_m: float
+    terrain: dict
+    sun: dict
+    earth: dict | None  # earthshine's source (None: none)
+    reflectance: dict
+    lod: dict
+    scattered_light: dict
+    half_extent_m: float
+    display_white_w_m2_sr: float
+    display_gamma: float
+    timing: dict
+    stars: dict
+    emulator_input: dict | None  # adaptive timing: events.input and events.sensor (its log's scale)
+    compression: str = "blosc"  # frames.h5's images (formats.hdf5.COMPRESSIONS)
+    distortion: dict | None = None  # camera.distortion (None: a pinhole)
+    supersample: int = 1  # each pixel from S x S samples (render.supersample)
+
+    def __post_init__(self) -> None:
+        """Checked against the declarations (a job's --settings is JSON anyone can write):
+        finite numbers, each section's bounds, the camera's."""
+        problems = non_finite(self.__dict__)
+        if problems:
+            raise ValueError(problems[0])
+        sections = ((TerrainParams, self.terrain), (ReflectanceParams, self.reflectance), (LodSettings, self.lod),
+                    (FrameTiming, self.timing), (SunSection, self.sun), (EarthSection, self.earth),
+                    (Stars, self.stars), (ScatteredLight, self.scattered_light))  # fmt: skip
+        for declared, values in sections:
+            if values is not None:
+                declared(**values)
+        CameraSection(width=self.width, height=self.height, fov_deg=self.fov_deg, mount_height_m=self.mount_height_m)
+
+    @classmethod
+    def from_config(cls, config: dict, name: str) -> RenderSettings:
+        return cls(**render_settings(config, name))
+
+    @property
+    def emulator_white_w_m2_sr(self) -> float | None:
+        """The radiance the emulator's input puts at 255 DN (adaptive timing predicts its
+        log); None with fixed timing."""
+        from ..sensor.photocurrent import emulator_white_w_m2_sr
+
+        if self.emulator_input is None:
+            return None
+        return emulator_white_w_m2_sr(self.emulator_input, self.display_white_w_m2_sr)
+
+    def to_json(self) -> str:
+        return json.dumps(self.__dict__, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> RenderSettings:
+        return cls(**json.loads(text))
+
+    def build(self, tile_cache: str | None = None):
+        """(camera, tiles, sun, reflectance) ready for render.TerrainRenderer; `tile_cache`:
+        the folder of the tile cache shared between jobs (None: none). The scene's modules are
+        imported here, so that the settings import without them."""
+        from ..scene.sun import Sun
+        from ..scene.terrain import ProceduralTerrain, load_elevation_grid
+        from ..scene.tiles import TileSet
+
+        t = dict(self.terrain)
+        grid, spacing = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None)
+        terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
+        sun = Sun(**self.sun)
+        lod = LodSettings(**self.lod)
+        azimuths = int(self.scattered_light["azimuths"])
+        tiles = TileSet(
+            terrain, sun.direction, self.moon_radius_m, self.half_extent_m, lod, tile_cache, azimuths,
+            sun.angular_radius_rad,
+        )  # fmt: skip
+        return (
+            Camera.from_settings(vars(self)),
+            tiles,
+            sun,
+            ReflectanceParams(**self.reflectance),
+        )
+
+    def earth_light(self):
+        """Earthshine's source (scenarios.<name>.earth: scene.earthshine.Earth), or None."""
+        from ..scene.earthshine import Earth
+
+        return Earth(**self.earth) if self.earth else None
+
+    def star_field(self):
+        """The sky's stars (render.stars: scene.stars.StarField), or None where they are off."""
+        from ..scene.stars import StarField
+
+        if not self.stars["enabled"]:
+            return None
+        return StarField.draw(float(self.stars["magnitude_limit"]), int(self.stars["seed"]))
+
+    def frame_attrs(self, camera: Camera, sun) -> dict:
+        """The scene's description, stored with the frames."""
+        return {
+            "width": self.width,
+            "height": self.height,
+            "fov_deg": self.fov_deg,
+            "focal_px": camera.focal_px,
+            "moon_radius_m": self.moon_radius_m,
+            "sun_range_m": sun.range_m,
+            "sun_azimuth_deg": sun.azimuth_deg,
+            "sun_elevation_deg": sun.elevation_deg,
+            "sun_irradiance_w_m2": sun.irradiance_w_m2,
+            "earth": json.dumps(self.earth, sort_keys=True),  # "null": no earthshine
+            "reflectance": self.reflectance,
+            "terrain": self.terrain,
+            "lod": self.lod,
+            "samples_per_pixel": self.supersample,
+            "scattered_light": self.scattered_light,
+            "terrain_half_extent_m": self.half_extent_m,
+            "display_white_w_m2_sr": self.display_white_w_m2_sr,
+            "display_gamma": self.display_gamma,
+            "timing": self.timing,
+            "stars": self.stars,
+            **camera.intrinsics_attrs(),
+        }
