@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from traj2events.settings import generate
-from traj2events.settings.declare import BOUNDS, _is_section, _split_optional, declared_fields, default, schema_of
+from traj2events.settings.declare import BOUNDS, declared_fields, default, is_section, schema_of, without_none
 from traj2events.settings.events import EmulatorParams, ReadoutParams, SensorParams
 from traj2events.settings.render import FrameTiming, LodSettings, TerrainParams
 from traj2events.settings.solve import OcpSettings
@@ -22,10 +22,10 @@ def sections(cls=Config):
     """Every section class of the tree, once."""
     seen = [cls]
     for f in declared_fields(cls):
-        tp = _split_optional(typing.get_type_hints(cls)[f.name])[0]
+        tp = without_none(typing.get_type_hints(cls)[f.name])[0]
         if typing.get_origin(tp) is dict:
             tp = typing.get_args(tp)[1]
-        if _is_section(tp):
+        if is_section(tp):
             seen += [s for s in sections(tp) if s not in seen]
     return seen
 

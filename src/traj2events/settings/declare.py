@@ -78,7 +78,7 @@ def _hints(cls) -> dict:
     return typing.get_type_hints(cls)
 
 
-def _split_optional(tp) -> tuple[object, bool]:
+def without_none(tp) -> tuple[object, bool]:
     """(the type without None, whether None is allowed)."""
     if typing.get_origin(tp) in (typing.Union, types.UnionType):
         args = [a for a in typing.get_args(tp) if a is not type(None)]
@@ -87,7 +87,7 @@ def _split_optional(tp) -> tuple[object, bool]:
     return tp, False
 
 
-def _is_section(tp) -> bool:
+def is_section(tp) -> bool:
     return isinstance(tp, type) and hasattr(tp, "__section__")
 
 
@@ -97,11 +97,11 @@ def _bounded(schema: dict, meta: dict) -> dict:
 
 def _type_schema(tp, meta: dict) -> dict:
     """JSON Schema of a value of type `tp` (bounds and choices from `meta`)."""
-    tp, nullable = _split_optional(tp)
+    tp, nullable = without_none(tp)
     origin, args = typing.get_origin(tp), typing.get_args(tp)
     if origin in (typing.Union, types.UnionType):  # a number or [low, high]
         schema = {"oneOf": [_type_schema(a, meta) for a in args]}
-    elif _is_section(tp):
+    elif is_section(tp):
         schema = schema_of(tp)
     elif origin is dict:
         schema = {"type": "object", "additionalProperties": _type_schema(args[1], {**meta, "bounds": {}})}
@@ -162,7 +162,7 @@ def defaults_of(cls) -> dict:
         default = f.metadata["default"]
         if default is MISSING:
             continue
-        if isinstance(default, type) and _is_section(default):  # a subsection: its own defaults
+        if isinstance(default, type) and is_section(default):  # a subsection: its own defaults
             out[f.name] = defaults_of(default)
         else:
             out[f.name] = _plain(default)

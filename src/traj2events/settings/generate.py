@@ -18,7 +18,7 @@ from pathlib import Path
 
 import yaml
 
-from .declare import OPS, _is_section, _split_optional, declared_fields, describe_field
+from .declare import OPS, declared_fields, describe_field, is_section, without_none
 from .tree import SCENARIOS, Config, ScenarioSection, config_schema, default_config
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -55,14 +55,14 @@ def _yaml_section(cls, values: dict, indent: str = "") -> list[str]:
     for f in declared_fields(cls):
         if f.name not in values:
             continue
-        value, tp = values[f.name], _split_optional(hints[f.name])[0]
+        value, tp = values[f.name], without_none(hints[f.name])[0]
         if f.name == "scenarios":
             lines += ["", *_comment(describe_field(f), indent), f"{indent}scenarios:"]
             for i, (name, scenario) in enumerate(value.items()):
                 lines.append(f"{indent}  {name}:")
                 lines += _yaml_section(ScenarioSection, scenario, indent + "    ") if i == 0 else [
                     f"{indent}    {k}: {_scalar(v)}" for k, v in scenario.items()]  # fmt: skip
-        elif _is_section(tp) and isinstance(value, dict) and value:
+        elif is_section(tp) and isinstance(value, dict) and value:
             lines += [""] if not indent else []
             lines += [*_comment(tp.__section_doc__ or describe_field(f), indent), f"{indent}{f.name}:"]
             lines += _yaml_section(tp, value, indent + "  ")
@@ -94,10 +94,10 @@ def _bounds(f: dataclasses.Field) -> str:
 def _rows(cls, values: dict, prefix: str) -> list[str]:
     hints, rows = typing.get_type_hints(cls), []
     for f in declared_fields(cls):
-        tp, key = _split_optional(hints[f.name])[0], f"{prefix}{f.name}"
+        tp, key = without_none(hints[f.name])[0], f"{prefix}{f.name}"
         if f.name == "scenarios":
             continue
-        if _is_section(tp) and f.name != "pixel":
+        if is_section(tp) and f.name != "pixel":
             rows += _rows(tp, values.get(f.name) or {}, f"{key}.")
             continue
         meaning = f.metadata["doc"] + (f" (source: {f.metadata['source']})" if f.metadata["source"] else "")
