@@ -3,8 +3,9 @@ that name the key.
 
 A config file holds only what differs from defaults.yaml (`load_config`); the pixel
 model's values are those of the named preset under the config's events.pixel. The workflow
-validates the merged config against config.schema.yaml (beside this module) before any
-job runs; `validate_config` turns the first problem into one line such as
+validates the merged config against the declarations' schema (settings.tree.config_schema;
+config.schema.yaml beside this module is its generated copy) before any job runs;
+`validate_config` turns the first problem into one line such as
 ``config key 'ocp.n_nodes': expected integer, got str 'forty'``.
 """
 
@@ -139,7 +140,8 @@ def _external_errors(config: dict, name: str, sc: dict, sun: list) -> list[str]:
     cannot be used stops the run before any job), at least 2 frames per flight."""
     from .formats.hdf5 import FileFormatError
     from .formats.poses import pose_format
-    from .settings.poses import OCP_SCENARIO_KEYS, external_extents
+    from .settings.poses import external_extents
+    from .settings.tree import OCP_SCENARIO_KEYS
 
     errors = [f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}"
               for key, (lo, hi) in sun if lo > hi]  # fmt: skip

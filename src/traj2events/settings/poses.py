@@ -67,12 +67,6 @@ def scenario_manoeuvre(config: dict, name: str, trajectory_id: str | None) -> di
     return None
 
 
-# An external scenario (scenarios.<name>.poses) flies its files' poses: none of these.
-OCP_SCENARIO_KEYS = ("n_trajectories", "tf_guess_s", "downrange_m", "crossrange_m", "altitude_m", "speed_forward_m_s",
-                     "speed_cross_m_s", "speed_down_m_s", "roll_deg", "pitch_deg", "yaw_deg", "pitch_decreasing",
-                     "divert", "hover")  # fmt: skip
-
-
 def is_external(config: dict, name: str) -> bool:
     """Whether scenario `name` takes its poses from files (scenarios.<name>.poses)."""
     return bool(config["scenarios"][name].get("poses"))

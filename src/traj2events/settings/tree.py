@@ -8,7 +8,7 @@ from __future__ import annotations
 import functools
 
 from .camera import CameraSection, MotionFieldSection
-from .declare import defaults_of, schema_of, section, setting
+from .declare import declared_fields, defaults_of, schema_of, section, setting
 from .events import EventsSection
 from .imu import ImuSection
 from .poses import Upsampling
@@ -185,6 +185,10 @@ class Config:
 def config_schema() -> dict:
     """The config's JSON Schema, made from the declarations."""
     return {"$schema": "https://json-schema.org/draft/2020-12/schema", **schema_of(Config)}
+
+
+# What an external scenario (scenarios.<name>.poses) has none of: the OCP's keys.
+OCP_SCENARIO_KEYS = tuple(f.name for f in declared_fields(ScenarioSection) if f.name not in ("poses", "sun", "earth"))
 
 
 def default_config() -> dict:
