@@ -365,17 +365,18 @@ def resolve_config(overlay: Any, refuse_large: bool = True) -> dict:
         except ValueError as exc:  # an unknown preset
             raise ConfigError(str(exc)) from None
     validate_config(config)
-    reason = too_large_reason(config)
-    if reason and refuse_large:
+    reason = too_large_reason(config) if refuse_large else None
+    if reason:
         raise ConfigError(reason)
     return config
 
 
-def too_large_reason(config: dict) -> str | None:
-    """Why a dataset is refused as too large (None: it is not, or the config allows it)."""
+def too_large_reason(config: dict, plan=None) -> str | None:
+    """Why a dataset is refused as too large (None: it is not, or the config allows it);
+    `plan`: its plan.dataset_plan where the caller has it already."""
     from .plan import dataset_plan, too_large
 
-    reason = too_large(dataset_plan(config))
+    reason = too_large(plan if plan is not None else dataset_plan(config))
     if not reason or config["allow_large_dataset"]:
         return None
     return (

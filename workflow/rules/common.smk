@@ -40,7 +40,7 @@ def results_bytes():
 def too_large():
     """Why this dataset may not be built here (too large for the plan's limits, or for the
     free space), or None."""
-    reason = too_large_reason(config)
+    reason = too_large_reason(config, _plan)
     free = shutil.disk_usage("results" if Path("results").is_dir() else ".").free
     if not reason and not config["allow_large_dataset"] and (short := disk_shortfall(_plan, free, results_bytes())):
         reason = (
