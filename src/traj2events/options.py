@@ -18,7 +18,7 @@ import jsonschema
 from .config import ConfigError, describe
 from .defaults import preset_names, preset_sections, with_preset
 from .settings import config_value, pick
-from .settings.declare import declared_fields, non_finite
+from .settings.declare import declared_field, non_finite_problems
 from .settings.tree import config_schema, default_config
 
 _PREFIX = "setting:"  # argparse dest of an option that changes one setting
@@ -151,8 +151,8 @@ def settings_from(args: argparse.Namespace, keys: dict[str, str]) -> dict:
         return next((args.settings_flags[k] for k in from_options if f"{key}.".startswith(f"{k}.")), "--settings")
 
     for name, path in keys.items():
-        for problem in non_finite(settings[name], tuple(path.split("."))):  # bounds let NaN through
-            raise ConfigError(f"{given_by(problem.split(chr(39))[1])}: {problem}")
+        for key, problem in non_finite_problems(settings[name], tuple(path.split("."))):  # bounds let NaN through
+            raise ConfigError(f"{given_by(key)}: {problem}")
         error = next(iter(jsonschema.Draft202012Validator(_node(path)).iter_errors(settings[name])), None)
         if error is not None:
             key = ".".join([path, *map(str, error.absolute_path)])
@@ -166,7 +166,7 @@ def add_declared_option(parser: argparse.ArgumentParser, flag: str, cls, name: s
     a job runs, not what it writes: `render --backend`)."""
     from .settings.declare import describe_field
 
-    field = next(f for f in declared_fields(cls) if f.name == name)
+    field = declared_field(cls, name)
     meta = field.metadata
     key = f"{cls.__section__}.{name}"
     parser.add_argument(flag, default=meta["default"], choices=meta["choices"],

@@ -195,10 +195,14 @@ def _value_errors(key: str, value, meta: dict) -> list[str]:
     return []
 
 
+def declared_field(cls, name: str) -> dataclasses.Field:
+    """The declaration of field `name` of section `cls`."""
+    return next(f for f in declared_fields(cls) if f.name == name)
+
+
 def value_errors(cls, name: str, value) -> list[str]:
     """What `value` breaks of the declaration of field `name` of section `cls`."""
-    field = next(f for f in declared_fields(cls) if f.name == name)
-    return _value_errors(f"{cls.__section__}.{name}", value, field.metadata)
+    return _value_errors(f"{cls.__section__}.{name}", value, declared_field(cls, name).metadata)
 
 
 def field_errors(obj) -> list[str]:
@@ -209,17 +213,24 @@ def field_errors(obj) -> list[str]:
                                                                     f.metadata)]  # fmt: skip
 
 
-def non_finite(value: object, path: tuple = ()) -> list[str]:
-    """Keys whose number is NaN or infinite (JSON Schema's bounds let NaN through)."""
+def non_finite_problems(value: object, path: tuple = ()) -> list[tuple[str, str]]:
+    """(dotted key, message) of each number that is NaN or infinite (JSON Schema's bounds
+    let NaN through)."""
     if isinstance(value, dict):
-        return [e for k, v in value.items() for e in non_finite(v, (*path, k))]
+        return [e for k, v in value.items() for e in non_finite_problems(v, (*path, k))]
     if isinstance(value, list):
-        return [e for i, v in enumerate(value) for e in non_finite(v, (*path, i))]
+        return [e for i, v in enumerate(value) for e in non_finite_problems(v, (*path, i))]
     if isinstance(value, float) and not math.isfinite(value):
-        return [f"config key '{'.'.join(str(p) for p in path) or '<root>'}': expected a finite number, got {value}"]
+        key = ".".join(str(p) for p in path) or "<root>"
+        return [(key, f"config key '{key}': expected a finite number, got {value}")]
     return []
+
+
+def non_finite(value: object, path: tuple = ()) -> list[str]:
+    """A message naming the config key of each number that is NaN or infinite."""
+    return [message for _, message in non_finite_problems(value, path)]
 
 
 def default(cls, name: str):
     """The declared default of field `name` of section `cls`."""
-    return next(f for f in dataclasses.fields(cls) if f.name == name).metadata["default"]
+    return declared_field(cls, name).metadata["default"]
