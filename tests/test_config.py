@@ -9,15 +9,15 @@ import pytest
 import yaml
 
 from conftest import ROOT
-from traj2events.config import SCHEMA_PATH, ConfigError, load_config, load_yaml, resolve_config, validate_config
+from traj2events.config import ConfigError, load_config, load_yaml, resolve_config, validate_config
 from traj2events.defaults import merge_config, with_preset
-from traj2events.settings.tree import default_config
+from traj2events.settings.tree import config_schema, default_config
 from traj2events.trajectory.scenarios import ScenarioSettings
 
 
 @pytest.fixture(scope="module")
 def schema():
-    return load_yaml(SCHEMA_PATH)
+    return copy.deepcopy(config_schema())  # config.schema.yaml is its copy (tests/test_declare.py)
 
 
 @pytest.fixture()

@@ -22,7 +22,6 @@ from .defaults import merge_config, with_preset
 from .settings.declare import non_finite
 from .settings.tree import config_schema, default_config
 
-SCHEMA_PATH = Path(__file__).with_name("config.schema.yaml")  # generated: settings/generate.py
 # Folders of results/ that are not scenarios: a scenario of that name would mix its
 # outputs with them.
 RESERVED_SCENARIO_NAMES = ("logs", "figures")
