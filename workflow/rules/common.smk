@@ -15,6 +15,7 @@ from traj2events.config import ConfigError, resolve_config, too_large_reason
 from traj2events.fingerprint import code_fingerprint
 from traj2events.formats.tile_cache import unusable as tile_cache_unusable
 from traj2events.plan import dataset_plan, disk_shortfall, job_resources
+from traj2events.settings.events import EXPORT_SUFFIX
 from traj2events.settings.jobs import job_settings_json
 from traj2events.settings.poses import is_external, scenario_count, trajectory_source
 
@@ -169,7 +170,7 @@ def preview_option(wildcards, output):
     return f"--preview {output.preview}" if config["render"]["preview"] else ""
 
 
-EXPORT_FILES = {"npz": "events.npz", "evt3": "events.raw", "aedat4": "events.aedat4"}
+EXPORT_FILES = {name: f"events.{suffix}" for name, suffix in EXPORT_SUFFIX.items()}
 
 
 def export_outputs(folder):

@@ -12,7 +12,9 @@ from .declare import section, setting
 IMX636 = "Sony IMX636 / Prophesee Gen4.1: photodiode area 4.86 x 4.86 um (Prophesee's QE note)"
 REFRACTORY_MODES = ("drop", "defer")
 READOUT_MODES = ("delay", "drop")
-EXPORT_FORMATS = ("npz", "evt3", "aedat4")
+# events.exports: each format's file suffix beside events.h5 (events.npz, events.raw, events.aedat4).
+EXPORT_SUFFIX = {"npz": "npz", "evt3": "raw", "aedat4": "aedat4"}
+EXPORT_FORMATS = tuple(EXPORT_SUFFIX)
 
 
 @section("events.pixel", "the pixel model (docs/events.md): the preset's values, the config's own keys on top")
@@ -171,8 +173,6 @@ EVENTS = {
     "compression": "compression",  # events.h5's
 }
 EVENTS_PICTURE = {"window_ms": "events.window_ms"}
-# events.exports: each format's file suffix beside events.h5 (events.npz, events.raw, events.aedat4).
-EXPORT_SUFFIX = {"npz": "npz", "evt3": "raw", "aedat4": "aedat4"}
 # The events command's options where a key's own name would say too little.
 EVENTS_FLAGS = {"events.input": "--input-scale", "events.readout.mode": "--readout-mode",
                 "events.space.enabled": "--space"}  # fmt: skip
