@@ -122,10 +122,17 @@ def motion_field(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(u, v) in px/s; x_s a row (1, W), y_s a column (H, 1), h (H, W), in their dtype."""
     dtype = np.result_type(x_s, y_s, h).type
-    f = dtype(focal_px)
     vx, vy, vz = (dtype(c) for c in v_c)
     p, q, r = (dtype(c) for c in omega)
-    xy_over_f = x_s * (y_s / f)  # (H, W)
+    return flow_law(x_s, y_s, dtype(focal_px), h, vx, vy, vz, p, q, r)
+
+
+def flow_law(x_s, y_s, f, h, vx, vy, vz, p, q, r):
+    """The field (u, v) px/s of the formula above at centred pixel (x_s, y_s), inverse depth
+    h, camera velocity (vx, vy, vz) and body rates (p, q, r): numbers, or arrays that
+    broadcast. Written once: `motion_field` calls it on arrays, the compiled pass
+    (`motion_pass`) per pixel, the same operations in the same order."""
+    xy_over_f = x_s * (y_s / f)
     u = h * (x_s * vz - f * vx) + (p * xy_over_f + ((-(f + x_s * x_s / f) * q) + y_s * r))
     v = h * (y_s * vz - f * vy) + ((-q) * xy_over_f + (((f + y_s * y_s / f) * p) - x_s * r))
     return u, v

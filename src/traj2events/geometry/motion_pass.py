@@ -3,7 +3,7 @@
 
 Per row of rays: the inverse depth (the depth map's, or the sphere's near root), the
 point relative to camera k+1, its projection (the exact displacement), the instantaneous
-flow (`motion_field.motion_field`'s formula) and the pixel's status, in float64 and in the
+flow (`motion_field.flow_law`, compiled) and the pixel's status, in float64 and in the
 same operations and order as the numpy expressions of `motion_field` (bit for bit; tested).
 Written for speed: branch-free arithmetic loops over row buffers, which LLVM vectorises,
 and a branch-free occlusion pre-test.
@@ -15,7 +15,9 @@ import numpy as np
 from numba import njit
 
 from .camera import Camera
-from .motion_field import BEHIND_CAMERA, OCCLUDED, OUT_OF_VIEW, SKY, VISIBLE
+from .motion_field import BEHIND_CAMERA, OCCLUDED, OUT_OF_VIEW, SKY, VISIBLE, flow_law
+
+_flow_law = njit(cache=True, error_model="numpy")(flow_law)  # the law as motion_field writes it, compiled into the pass
 
 
 def fused_motion(camera: Camera, pose_k, pose_next, depth, sphere, q, depth_next, rel_tol: float, rates, dtype):
@@ -80,7 +82,7 @@ def _motion_pixels(
     """Row by row (ray (a, b, 1) per column and row): the inverse depth h (1 / depth where
     that is a positive finite number, else 0; or the sphere's near root, as
     `inverse_depth_sphere`), the point relative to camera k+1 (a direction where h = 0),
-    its projection, the instantaneous flow (`motion_field`'s formula, when flow is not
+    its projection, the instantaneous flow (`motion_field.flow_law`, when flow is not
     empty), and the status, the first that applies of SKY, BEHIND_CAMERA, OCCLUDED,
     OUT_OF_VIEW, VISIBLE. Float64 throughout, in the same operations and order as the
     numpy expressions. The arithmetic loops are branch-free and write row buffers so that
@@ -118,12 +120,7 @@ def _motion_pixels(
             displacement[i, 2 * j + 1] = v_row[j]
         if flow.size > 0:
             for j in range(width):
-                h, x_s = h_row[j], x_cols[j]
-                xy_over_f = x_s * (y_s / f)
-                flow_u_row[j] = h * (x_s * vz - f * vx) + (p * xy_over_f + ((-(f + x_s * x_s / f) * q_rate) + y_s * r))
-                flow_v_row[j] = h * (y_s * vz - f * vy) + (
-                    (-q_rate) * xy_over_f + (((f + y_s * y_s / f) * p) - x_s * r)
-                )
+                flow_u_row[j], flow_v_row[j] = _flow_law(x_cols[j], y_s, f, h_row[j], vx, vy, vz, p, q_rate, r)
             for j in range(width):
                 flow[i, 2 * j] = flow_u_row[j]
                 flow[i, 2 * j + 1] = flow_v_row[j]
