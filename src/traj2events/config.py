@@ -19,7 +19,9 @@ import jsonschema
 import yaml
 
 from .defaults import merge_config, with_preset
+from .settings.camera import lens_problems
 from .settings.declare import non_finite
+from .settings.render import display_problems
 from .settings.tree import config_schema, default_config
 
 # Folders of results/ that are not scenarios: a scenario of that name would mix its
@@ -217,9 +219,10 @@ def _semantic_errors(config: dict) -> list[str]:
     if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
-    errors += _display_errors(config) + _lens_errors(config["camera"])
-    if not errors:  # a lens refused above has no pinhole cover to measure
-        errors += _supersample_errors(config["camera"], config["render"]["supersample"])
+    sun_ranges_m = [sc["sun"]["range_m"] for sc in config["scenarios"].values()]
+    errors += display_problems(config["render"], sun_ranges_m) + lens_problems(
+        config["camera"], config["render"]["supersample"]
+    )
     return errors or _elevation_grid_error(config["terrain"])
 
 
@@ -240,54 +243,6 @@ def _section_errors(config: dict) -> list[str]:
         except ValueError as error:  # "section.key: problem"
             key, _, problem = str(error).partition(": ")
             return [f"config key '{key}': {problem}"]
-    return []
-
-
-def _lens_errors(camera: dict) -> list[str]:
-    """A distortion whose model folds over inside the image, or needs a pinhole image more
-    than 4x the sensor's to cover it (Camera.pinhole_cover), before any job starts."""
-    from .geometry.camera import Camera
-
-    try:
-        Camera.from_settings(camera).pinhole_cover()  # a pinhole: itself, nothing to check
-    except ValueError as exc:
-        return [f"config key '{exc}".replace(":", "':", 1)]
-    return []
-
-
-# The largest image drawn: OpenGL 4.1's least GL_MAX_RENDERBUFFER_SIZE (llvmpipe's own).
-MAX_DRAWN_PX = 16384
-
-
-def _supersample_errors(camera: dict, supersample: int) -> list[str]:
-    """An image to draw (the camera's, S times its size, its lens's pinhole cover) larger
-    than OpenGL's framebuffers hold, before any job starts."""
-    from .geometry.camera import Camera
-
-    drawn = Camera.from_settings(camera).scaled(supersample).pinhole_cover()
-    if max(drawn.width, drawn.height) <= MAX_DRAWN_PX:
-        return []
-    return [
-        f"config key 'render.supersample': {supersample} x {supersample} samples per pixel of the "
-        f"{camera['width']} x {camera['height']} camera draw {drawn.width} x {drawn.height} px (with the lens's "
-        f"margin); expected at most {MAX_DRAWN_PX} px a side, got {supersample}"
-    ]
-
-
-def _display_errors(config: dict) -> list[str]:
-    """A display white far above any radiance the scene can have gives black videos."""
-    from .scene.reflectance import ReflectanceParams, max_radiance_factor
-    from .scene.sun import Sun
-
-    factor = max_radiance_factor(ReflectanceParams(**config["render"]["reflectance"]), n=21)
-    irradiance = max(Sun(sc["sun"]["range_m"], 0.0, 90.0).irradiance_w_m2 for sc in config["scenarios"].values())
-    brightest = factor * irradiance / math.pi
-    white = config["render"]["display_white_w_m2_sr"]
-    if white > 10 * brightest:
-        return [
-            f"config key 'render.display_white_w_m2_sr': expected at most 10x the brightest radiance the scenes can "
-            f"have ({brightest:.3g} W m^-2 sr^-1), got {white} (the videos would be black)"
-        ]
     return []
 
 

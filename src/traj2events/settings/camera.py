@@ -43,6 +43,34 @@ class MotionFieldSection:
                                    "radius, +- its relief (-9 .. +11 km)", ge=1.70e6, le=1.76e6)  # fmt: skip
 
 
+# The largest image drawn: OpenGL 4.1's least GL_MAX_RENDERBUFFER_SIZE (llvmpipe's own).
+MAX_DRAWN_PX = 16384
+
+
+def lens_problems(camera: dict, supersample: int) -> list[str]:
+    """What the camera's keys must satisfy together, as config errors: a distortion whose
+    model folds over inside the image, or needs a pinhole image more than 4x the sensor's to
+    cover it (`geometry.camera.Camera.pinhole_cover`); else an image to draw (the camera's,
+    S = render.supersample times its size, with its lens's cover) larger than OpenGL's
+    framebuffers hold. The camera model is imported here, so that the settings import
+    without it."""
+    from ..geometry.camera import Camera
+
+    model = Camera.from_settings(camera)
+    try:
+        model.pinhole_cover()  # a pinhole: itself, nothing to check
+    except ValueError as exc:
+        return [f"config key '{exc}".replace(":", "':", 1)]
+    cover = model.scaled(supersample).pinhole_cover()
+    if max(cover.width, cover.height) <= MAX_DRAWN_PX:
+        return []
+    return [
+        f"config key 'render.supersample': {supersample} x {supersample} samples per pixel of the "
+        f"{camera['width']} x {camera['height']} camera draw {cover.width} x {cover.height} px (with the lens's "
+        f"margin); expected at most {MAX_DRAWN_PX} px a side, got {supersample}"
+    ]
+
+
 CAMERA = {
     "width": "camera.width",
     "height": "camera.height",

@@ -299,6 +299,25 @@ def render_settings(config: dict, name: str, trajectory_id: str | None = None) -
     }
 
 
+def display_problems(render: dict, sun_ranges_m: list[float]) -> list[str]:
+    """A display white (render.display_white_w_m2_sr) far above any radiance the scenes
+    can have, under the nearest of the scenarios' Suns (`sun_ranges_m`): the videos would be
+    black. The reflectance model is imported here, so that the settings import without it."""
+    from ..scene.reflectance import max_radiance_factor
+    from ..scene.sun import Sun
+
+    factor = max_radiance_factor(ReflectanceParams(**render["reflectance"]), n=21)
+    irradiance = max(Sun(range_m, 0.0, 90.0).irradiance_w_m2 for range_m in sun_ranges_m)
+    brightest = factor * irradiance / math.pi
+    white = render["display_white_w_m2_sr"]
+    if white > 10 * brightest:
+        return [
+            f"config key 'render.display_white_w_m2_sr': expected at most 10x the brightest radiance the scenes can "
+            f"have ({brightest:.3g} W m^-2 sr^-1), got {white} (the videos would be black)"
+        ]
+    return []
+
+
 @dataclass(frozen=True)
 class RenderSettings:
     """One render job's settings, typed: what `render_settings` gives (the render rule's
