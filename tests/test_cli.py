@@ -154,12 +154,27 @@ def test_bad_frames_file_for_the_motion_field_is_named(bad_inputs, tmp_path, cap
     assert str(bad_inputs["text"]) in capsys.readouterr().err
 
 
+def status(argv: list[str]) -> int:
+    """main's exit status, argparse's own refusals (SystemExit) included."""
+    try:
+        return main(argv)
+    except SystemExit as exit:
+        return exit.code
+
+
 def test_bad_settings_and_options_are_named(tmp_path, capsys):
     good = trajectory_file(tmp_path / "good.h5")
     out = [str(tmp_path / n) for n in ("f.h5", "v.mkv", "p.mp4")]
-    assert main(["render", str(good), "--settings", '{"width": 8}', "--frames", out[0], "--video", out[1],
-                 "--preview", out[2]]) == 2  # fmt: skip
-    assert "--settings" in capsys.readouterr().err and not list(tmp_path.glob("*.mkv"))
+    for option, value in (("--width", "0"), ("--sun-elevation-deg", "nan"), ("--texture-filter", "cubic"),
+                          ("--settings", '{"sun": {"elevation_deg": -5}}')):  # fmt: skip
+        assert status(["render", str(good), option, value, "--frames", out[0], "--video", out[1]]) == 2
+        err = capsys.readouterr().err
+        assert (option if option != "--settings" else "elevation_deg") in err and not list(tmp_path.glob("*.mkv"))
+    for argv, named in ((["base", "--n-nodes", "nan"], "--n-nodes"), (["base", "--scenario", "landing"], "--scenario"),
+                        (["sample", "--base", "b.h5", "--table", "s.csv", "--mass-kg", "-1"], "--mass-kg"),
+                        (["poses", str(good), "--fps", "0"], "--fps")):  # fmt: skip
+        assert status([*argv, "-o", str(tmp_path / "x.h5")]) == 2
+        assert named in capsys.readouterr().err and not (tmp_path / "x.h5").exists()
     assert main(["motion-field", str(good), "-o", str(tmp_path / "m.h5"), "--flo-dir", str(tmp_path / "f"),
                  "--moon-radius-m", "-1"]) == 2  # fmt: skip
     assert "moon_radius_m" in capsys.readouterr().err
@@ -316,7 +331,7 @@ def test_the_cli_stays_thin_and_no_module_grows_past_a_reading():
 @pytest.mark.parametrize(
     "settings, fragment",
     [
-        ('{"fps": 10}', "missing keys ['g_m_s2', 'moon_radius_m', 'mount_height_m', 'scenario', 'seed', 'spice']"),
+        ('{"fps": 10, "fsp": 3}', "unknown key 'fsp'"),
         (
             '{"fps": NaN, "mount_height_m": 3, "moon_radius_m": 1737400, "g_m_s2": 1.62, "scenario": "d", "seed": 1, '
             '"spice": null}',

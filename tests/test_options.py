@@ -96,3 +96,29 @@ def test_every_pixel_key_is_an_option_with_its_description_and_default(capsys):
     for key, value in preset("paper")["pixel"].items():
         assert f"--{key.replace('_', '-')}" in text and f"[events.pixel.{key}, default {value}]" in text
     assert "ON contrast threshold [ln]" in text and "--preset {clean,davis346,imx636,paper}" in text
+
+
+@pytest.mark.parametrize("command, scenario", [("base", None), ("sample", "braking"), ("render", "approach")])
+def test_a_jobs_command_starts_from_its_jobs_settings_and_an_option_changes_one_key(command, scenario):
+    """base, sample and render take the job's settings of a default scenario (the render:
+    its first trajectory's), as the workflow would pass them; an option changes one key."""
+    from traj2events.config import resolve_config
+    from traj2events.settings.render import RENDER, render_settings
+    from traj2events.settings.solve import SOLVE, solve_settings
+
+    keys, job = (RENDER, render_settings) if command == "render" else (SOLVE, solve_settings)
+    argv = {"base": ["base", "-o", "b.h5"], "sample": ["sample", "--base", "b.h5", "-o", "s.h5", "--table", "s.csv"],
+            "render": ["render", "t.h5", "--frames", "f.h5", "--video", "v.mkv"]}[command]  # fmt: skip
+    argv += ["--scenario", scenario] if scenario else []
+    expected = job(resolve_config({}), scenario or "descent", *(["0000"] if command == "render" else []))
+    assert settings_from(build_parser().parse_args(argv), keys) == expected
+    option, path, value = (("--sun-elevation-deg", ("sun", "elevation_deg"), 7.5) if command == "render" else
+                           ("--n-nodes", ("ocp", "n_nodes"), 31))  # fmt: skip
+    changed = settings_from(build_parser().parse_args([*argv, option, str(value)]), keys)
+    assert changed[path[0]] == {**expected[path[0]], path[1]: value}
+    assert {k: v for k, v in changed.items() if k != path[0]} == {k: v for k, v in expected.items() if k != path[0]}
+
+
+def test_a_render_option_shared_by_two_sections_is_named_by_its_section():
+    help_text = build_parser()._subparsers._group_actions[0].choices["render"].format_help()
+    assert "--terrain-seed" in help_text and "--stars-seed" in help_text and "--seed SEED" in help_text

@@ -10,22 +10,24 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")  # one process per core is faster 
 import argparse
 import gc
 import importlib
+import json
 import sys
 
 from . import __version__, missing_dependency
 from .memory import keep_freed_memory
-from .options import add_declared_option, add_settings, inline_or_file, json_or_null, settings_from
+from .options import add_declared_option, add_settings, json_or_null, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
 from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE, EXPORT_SUFFIX
 from .settings.imu import IMU
-from .settings.poses import POSES
-from .settings.render import RenderSection
+from .settings.poses import EXTERNAL_POSES, POSES, external_pose_defaults
+from .settings.render import RENDER, RENDER_FLAGS, RenderSection, render_job_settings
+from .settings.solve import SOLVE, solve_settings
 
 
-def _settings(kind, value: str):
-    """--settings (JSON inline, or @file) as a `kind` settings object."""
+def _job(kind, args, keys: dict[str, str]):
+    """--settings and the options (settings_from) as the job's `kind` object, which checks them."""
     try:
-        return kind.from_json(inline_or_file(value))
+        return kind.from_json(json.dumps(settings_from(args, keys)))
     except (ValueError, TypeError, KeyError, AttributeError) as exc:
         raise ValueError(f"--settings: expected the JSON of {kind.__name__} (the workflow writes it): {exc}") from None
 
@@ -49,7 +51,7 @@ def cmd_base(args) -> int:
     from .stages.base_solution import base_solution
     from .trajectory.scenarios import ScenarioSettings
 
-    base_solution(_settings(ScenarioSettings, args.settings), args.output, record_failure=args.record_failure)
+    base_solution(_job(ScenarioSettings, args, SOLVE), args.output, record_failure=args.record_failure)
     return 0
 
 
@@ -59,7 +61,7 @@ def cmd_sample(args) -> int:
 
     if args.jobs < 1:
         raise ValueError(f"sample: --jobs: expected >= 1, got {args.jobs}")
-    sample_trajectories(_settings(ScenarioSettings, args.settings), args.base, args.output, args.table, args.jobs)
+    sample_trajectories(_job(ScenarioSettings, args, SOLVE), args.base, args.output, args.table, args.jobs)
     return 0
 
 
@@ -67,9 +69,9 @@ def cmd_render(args) -> int:
     from .stages import render, render_events
 
     keep_freed_memory()
-    settings, files = _settings(render.RenderSettings, args.settings), (args.frames, args.video, args.preview)
+    settings, files = _job(render.RenderSettings, args, RENDER), (args.frames, args.video, args.preview)
     if args.events:  # the emulator takes the radiance in memory: frames.h5 keeps the depth only
-        events = settings_from(argparse.Namespace(settings=args.events_settings), EVENTS)
+        events = settings_from(argparse.Namespace(settings=args.events_settings, settings_defaults=None), EVENTS)
         beside = os.path.dirname(args.events)
         exports = {name: os.path.join(beside, f"events.{EXPORT_SUFFIX[name]}") for name in args.exports}
         render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events, exports,
@@ -137,16 +139,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("config", nargs="+", help="YAML overlays, merged in order on the defaults, e.g. config/smoke.yaml")
     p.set_defaults(func=cmd_check_config)
 
-    settings_help = "scenario settings as JSON (or @file): vehicle, ocp, scenario, seed"
     p = sub.add_parser("base", help="solve a scenario's base problem (every range at its midpoint)")
-    p.add_argument("--settings", required=True, help=settings_help)
+    add_settings(p, SOLVE, "the scenario's solve settings", defaults=solve_settings)
     p.add_argument("--output", "-o", required=True, help="base.h5 (nodes only)")
     p.add_argument("--record-failure", action="store_true", help="if the problem does not solve, write base.h5 "
                    "recording it, exit 0 (the workflow does: summary.csv says so); default: exit 1")  # fmt: skip
     p.set_defaults(func=cmd_base)
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
-    p.add_argument("--settings", required=True, help=settings_help)
+    add_settings(p, SOLVE, "the scenario's solve settings", defaults=solve_settings)
     p.add_argument("--base", required=True, help="base.h5 from `traj2events base` (one recording a failed solve "
                    "gives a solutions.h5 and samples.csv without samples, which say so)")  # fmt: skip
     p.add_argument("--output", "-o", required=True, help="solutions.h5: every sample's nodes and status")
@@ -167,10 +168,11 @@ def build_parser() -> argparse.ArgumentParser:
                        "`poses`, docs/trajectories.md \"External poses\")")  # fmt: skip
     p.add_argument("source", help="CSV or HDF5 of time, position, attitude; a trajectory.h5; a SPICE meta-kernel (.tm)")
     p.add_argument("--id", type=int, default=0, help="the trajectory's id (default 0)")
-    p.add_argument("--settings", type=json_or_null, required=True, help="JSON (or @file): fps, mount_height_m, "
-                   "moon_radius_m, g_m_s2, scenario, seed, spice (settings.poses.external_pose_settings)")  # fmt: skip
+    add_settings(p, EXTERNAL_POSES, "the poses' settings (settings.poses.external_pose_settings)",
+                 defaults=external_pose_defaults)  # fmt: skip
     p.add_argument("--output", "-o", required=True, help="trajectory.h5")
-    p.set_defaults(func=_calls("external_poses", "external_poses", "source", "id", "settings", "output"))
+    pose_settings = lambda a: settings_from(a, EXTERNAL_POSES)  # noqa: E731
+    p.set_defaults(func=_calls("external_poses", "external_poses", "source", "id", pose_settings, "output"))
 
     p = sub.add_parser("imu", help="imu.h5: the IMU's specific force and body rates, and the altitude, noise-free")
     p.add_argument("trajectory", help="trajectory.h5 (its flight is sampled at the IMU's rate)")
@@ -181,8 +183,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("render", help="render the surface from every pose of a trajectory (radiance, depth, videos)")
     p.add_argument("trajectory", help="trajectory.h5 (poses)")
-    p.add_argument("--settings", required=True, help="render settings as JSON (or @file): camera, terrain, sun, "
-                   "reflectance, lod, display (the workflow builds it from the config)")  # fmt: skip
+    add_settings(p, RENDER, "the render settings (settings.render.render_settings)", flags=RENDER_FLAGS,
+                 defaults=render_job_settings)  # fmt: skip
     p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
     p.add_argument("--preview", help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless "

@@ -100,6 +100,17 @@ def external_pose_settings(config: dict, name: str) -> dict:
     }
 
 
+# The `poses` command's options (the SPICE reading and the scenario's name: through --settings).
+EXTERNAL_POSES = {"fps": "camera.fps", "mount_height_m": "camera.mount_height_m",
+                  "moon_radius_m": "motion_field.moon_radius_m", "g_m_s2": "vehicle.g_m_s2",
+                  "seed": "seed"}  # fmt: skip
+
+
+def external_pose_defaults(config: dict, name: str) -> dict:
+    """external_pose_settings of a scenario `name` that reads no SPICE kernels."""
+    return external_pose_settings({**config, "scenarios": {name: {"poses": {"spice": None}}}}, name)
+
+
 # The numbers of external_pose_settings, each as its config key declares it.
 EXTERNAL_POSE_KEYS = {"fps": ("camera", "fps"), "mount_height_m": ("camera", "mount_height_m"),
                       "moon_radius_m": ("motion_field", "moon_radius_m"), "g_m_s2": ("vehicle", "g_m_s2")}  # fmt: skip

@@ -247,6 +247,27 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
     return sun
 
 
+# The render command's options: each key of render_settings that is a config key's (the
+# scenario, its Earth, the terrain's extent and the emulator's input: through --settings).
+RENDER = {"width": "camera.width", "height": "camera.height", "fov_deg": "camera.fov_deg",
+          "mount_height_m": "camera.mount_height_m", "distortion": "camera.distortion",
+          "moon_radius_m": "motion_field.moon_radius_m", "terrain": "terrain", "sun": "scenarios.*.sun",
+          "reflectance": "render.reflectance", "lod": "render.lod", "supersample": "render.supersample",
+          "scattered_light": "render.scattered_light", "display_white_w_m2_sr": "render.display_white_w_m2_sr",
+          "display_gamma": "render.display_gamma", "timing": "render.timing", "stars": "render.stars",
+          "compression": "compression"}  # fmt: skip
+# Its options where a key's own name would say too little.
+RENDER_FLAGS = {"render.timing.mode": "--timing", "render.reflectance.model": "--reflectance",
+                "render.stars.enabled": "--stars",
+                **{f"scenarios.*.sun.{k}": f"--sun-{k.replace('_', '-')}" for k in ("range_m", "azimuth_deg",
+                                                                                     "elevation_deg")}}  # fmt: skip
+
+
+def render_job_settings(config: dict, name: str) -> dict:
+    """render_settings of scenario `name`'s first trajectory (the render command's defaults)."""
+    return render_settings(config, name, "0000")
+
+
 def render_settings(config: dict, name: str, trajectory_id: str | None = None) -> dict:
     """Everything one scenario's frames depend on (the Sun: `trajectory_id`'s, where the
     config gives it as a range; scenario_sun): camera, sphere, terrain, Sun,

@@ -62,6 +62,11 @@ RANGE_KEYS = (
 )
 
 
+# The solve commands' options (`base`, `sample`): each vehicle and OCP key, the seed (a
+# scenario's ranges: through --settings).
+SOLVE = {"vehicle": "vehicle", "ocp": "ocp", "seed": "seed"}
+
+
 def solve_settings(config: dict, name: str) -> dict:
     """Everything the solves of scenario `name` depend on: the vehicle, the OCP (with the
     scenario's pitch_decreasing), the scenario's ranges and the dataset's seed."""
