@@ -9,7 +9,7 @@ GPU's time split into its kernels with their transfers and the host's ordering, 
 share of the CPU's events the GPU gives identically (same x, y, t, p: counted with
 multiplicity). Goal (issue 42): >= 2,000 frames/s at 1024 x 1024. Needs a GPU and
 `pip install ".[gpu]"`; without one it says so and stops (the kernels' correctness is
-tested without a GPU: tests/test_cuda_kernels.py).
+tested without a GPU: tests/sensor/test_cuda_kernels.py).
 """
 
 from __future__ import annotations

@@ -17,7 +17,7 @@ from traj2events.trajectory.scenarios import ScenarioSettings
 
 @pytest.fixture(scope="module")
 def schema():
-    return copy.deepcopy(config_schema())  # config.schema.yaml is its copy (tests/test_declare.py)
+    return copy.deepcopy(config_schema())  # config.schema.yaml is its copy (tests/settings/test_declare.py)
 
 
 @pytest.fixture()

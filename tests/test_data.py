@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from test_formats_events import random_events, write
+from formats.test_events import random_events, write
 from traj2events import data
 from traj2events.data import Landing
 

@@ -27,7 +27,7 @@ is at least half the step. Light reaching the terrain between two steps is misse
 below a rim, where a low Sun's lit crescent lies, this makes S ~5 % low (the bowl, 10 deg).
 Checked against the spherical bowl, whose every interior point receives the same
 E = A E_sun sin(e) a^2 / (4 R_s^2) from its lit part (rim radius a, sphere radius R_s,
-Sun elevation e; tests/test_scattering.py).
+Sun elevation e; tests/scene/test_scattering.py).
 """
 
 from __future__ import annotations

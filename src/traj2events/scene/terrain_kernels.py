@@ -1,7 +1,7 @@
 """The terrain's compiled machinery, which a reader may skip: counter-based hashing (any
 patch of terrain is evaluated on its own), the craters and boulders of a size octave found
 per lattice cell, value noise, and the grid points near a feature. Behind
-`terrain.ProceduralTerrain`; tests/test_terrain.py checks each against a numpy form.
+`terrain.ProceduralTerrain`; tests/scene/test_terrain.py checks each against a numpy form.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """The files made from the declarations (settings/tree.py), checked in so that users read
 them: defaults.yaml (every default, commented), config.schema.yaml (the JSON Schema, for
-editors) and the key table of config/README.md. tests/test_settings_generate.py fails when
+editors) and the key table of config/README.md. tests/settings/test_declare.py fails when
 one is not what the declarations make.
 
     python -m traj2events.settings.generate          # write them

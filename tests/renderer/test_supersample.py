@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from test_render import BACKEND, state
+from renderer.test_draw import BACKEND, state
 from traj2events.geometry.camera import Camera, camera_pose
 from traj2events.geometry.distortion import PINHOLE, Distortion
 from traj2events.renderer.supersample import block_depth, block_mean, sensor_renderer
