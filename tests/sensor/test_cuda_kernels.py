@@ -96,16 +96,19 @@ def test_the_kernels_compile_to_ptx_for_a_hopper_gpu(frame_dtype):
     from numba import cuda
 
     from traj2events.sensor import cuda_kernels as ck
+    from traj2events.sensor.pixel import Crossings, Events, PixelState, Thresholds
 
     n = 64
     frames = np.zeros(n, frame_dtype)
     f32, f64, i64, flags, labels = (np.zeros(n, d) for d in (np.float32, np.float64, np.int64, np.bool_, np.uint8))
     key = np.uint64(1)
+    state, thresholds = PixelState(f64, f64, f64, f64), Thresholds(f32, f32, f32)
+    crossing = Crossings(np.zeros(0, np.int64), i64, f64, f64, i64)
+    noise, hot = ck.ShotNoise(f64, 5.0, 0.25, key), ck.HotPixels(flags, 0.0, key)
     kernels = {
-        ck.count_kernel: (frames, frames, 1.0, 3.0, 0.01, f64, f64, f32, f32, f32, f64, flags, f64, 5.0, 0.25, key,
-                          0.0, key, i64, f64, f64, i64, i64),
-        ck.fill_kernel: (i64, f64, f64, i64, i64, i64, frames, 1.0, 0.01, 0.0, f32, f32, f64, f64, f64, f64, flags,
-                         f64, 5.0, 0.25, key, 0.0, key, 0.0, True, i64, f64, flags, labels),
+        ck.count_kernel: (frames, frames, 1.0, 3.0, 0.01, state, thresholds, noise, hot, crossing, i64),
+        ck.fill_kernel: (crossing, i64, i64, frames, 1.0, 0.01, 0.0, state, thresholds, noise, hot, 0.0, True,
+                         Events(i64, f64, flags, labels)),
         ck.group_sums: (i64, i64),
         ck.group_offsets: (i64, i64, i64),
     }  # fmt: skip

@@ -475,7 +475,7 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     """The kernel reuses the gain along a run of pixels with the same two inputs: every
     pixel still gets the first-order step of its own pair, as numpy computes it, where a
     run breaks in either frame alone, on -0.0 and with a scale."""
-    from traj2events.sensor.pixel import advance
+    from traj2events.sensor.pixel import Crossings, PixelState, Thresholds, advance
 
     _NO_TABLE = np.empty(0)
 
@@ -489,9 +489,10 @@ def test_the_low_pass_of_runs_of_equal_inputs_is_each_pixels_own():
     filtered, base = rng.uniform(0.0, 5.0, n), np.zeros(n)
     f0 = filtered.copy()
     theta = np.full(n, 100.0, np.float32)  # no crossings: only the low-pass is looked at
-    slots = [np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
-    advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), _NO_TABLE, cutoff_hz, dt, scale,
-            _NO_TABLE, _NO_TABLE, 0, *slots)  # fmt: skip
+    slots = Crossings(np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64))
+    state = PixelState(filtered, base, _NO_TABLE, np.full(n, -np.inf))
+    advance(i0, i1, state, Thresholds(theta, theta, np.zeros(n, np.float32)), cutoff_hz, dt, scale, _NO_TABLE,
+            _NO_TABLE, 0, slots)  # fmt: skip
     dn0, dn1 = i0.astype(np.float64) * scale, i1.astype(np.float64) * scale
     target = np.where(dn1 <= 20.0, dn1 * (np.log(20.0) / 20.0), np.log(np.maximum(dn1, 20.0)))
     gain = -np.expm1(-(2.0 * np.pi * dt) * (cutoff_hz * (0.5 * (dn0 + dn1) + 20.0) / 275.0))

@@ -12,7 +12,7 @@ from traj2events.sensor.laws import (
     refractory_allows,
     shot_noise_gain,
 )
-from traj2events.sensor.pixel import advance
+from traj2events.sensor.pixel import Crossings, PixelState, Thresholds, advance
 
 
 def test_log_response_is_linear_below_the_knee_and_continuous_at_it():
@@ -55,10 +55,11 @@ def test_the_kernel_computes_the_laws_array_forms_bit_for_bit(cutoff_hz):
     f0 = log_intensity_8bit(i0.astype(np.float64) * scale)
     filtered, base = f0.copy(), f0.copy()
     theta = np.full(n, 0.25, np.float32)
-    slots = [np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64)]
+    slots = Crossings(np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros(n), np.zeros(n), np.zeros(n, np.int64))
     none = np.empty(0)
-    advance(i0, i1, filtered, base, theta, theta, np.zeros(n, np.float32), none, cutoff_hz, dt, scale, none, none,
-            0, *slots)  # fmt: skip
+    state = PixelState(filtered, base, none, np.full(n, -np.inf))
+    advance(i0, i1, state, Thresholds(theta, theta, np.zeros(n, np.float32)), cutoff_hz, dt, scale, none, none, 0,
+            slots)  # fmt: skip
     x1 = i1.astype(np.float64) * scale
     mean = 0.5 * (i0.astype(np.float64) * scale + x1)
     expected = f0 + lowpass_gain(mean, cutoff_hz, dt) * (log_intensity_8bit(x1) - f0)

@@ -20,6 +20,7 @@ and by compiling the kernels to PTX.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import config, cuda
@@ -28,7 +29,7 @@ from ..formats.events import HOT_PIXEL, SHOT_NOISE
 from .draws import unit_key
 from .laws import log_response_scalar, lowpass_gain_scalar, refractory_allows
 from .noise import NOISE_BLOCK, block_mean_gap_s, hot_pixel_count, hot_pixel_time, next_kept_on_pixel
-from .pixel import advance_pixel, emit_crossings
+from .pixel import Crossings, Events, PixelState, Thresholds, advance_pixel, emit_crossings
 
 
 def _on_device(function):
@@ -45,93 +46,108 @@ emit_pixel_crossings = _on_device(emit_crossings)
 THREADS_PER_BLOCK = 256  # CUDA threads per block, for every kernel here (the events do not depend on it)
 
 
+class ShotNoise(NamedTuple):
+    """7. The shot noise's draw, as the kernels take it."""
+
+    majorants: object  # each block's thinning majorant (device array)
+    rate_hz: float  # events.pixel.shot_noise_hz
+    theta_nominal: float  # the preset's theta_on, the rate law's reference
+    key: np.uint64  # the interval's key of the stream
+
+
+class HotPixels(NamedTuple):
+    """8. The hot pixels' events, as the kernels take them."""
+
+    flags: object  # True at a hot pixel (device array)
+    rate_hz: float  # events.pixel.hot_pixel_hz
+    key: np.uint64  # the interval's key of the stream
+
+
 @cuda.jit
-def count_kernel(
-    intensity0, intensity1, scale, cutoff_hz, dt, filtered, base, theta_on, theta_off, leak_step, leak_drift, hot,
-    majorants, shot_noise_hz, theta_nominal, shot_key, hot_hz, hot_key, count, x0, x1, n_leak, n_events,
-):  # fmt: skip
-    """Steps 1-8 of each pixel's interval: its state advanced, its crossings (count, x0, x1,
-    n_leak) stored, and how many events it will write in n_events."""
+def count_kernel(intensity0, intensity1, scale, cutoff_hz, dt, state, thresholds, noise, hot, crossing, n_events):
+    """Steps 1-8 of each pixel's interval: its state (`pixel.PixelState`) advanced, its
+    crossings stored in its own slot of `crossing` (`pixel.Crossings`), and how many events
+    it will write in n_events."""
     i = cuda.grid(1)
     if i >= intensity1.size:
         return
     i1 = np.float64(intensity1[i]) * scale
     target = log_response_scalar(i1)
     gain = lowpass_gain_scalar(0.5 * (np.float64(intensity0[i]) * scale + i1), cutoff_hz, 2.0 * math.pi * dt)
-    labels = leak_drift.size > 0
+    labels = state.leak_drift.size > 0
+    theta_on, theta_off = thresholds.theta_on[i], thresholds.theta_off[i]
     f1, b, c, a, x, leak_only, d = advance_pixel(
-        target, gain, filtered[i], base[i], theta_on[i], theta_off[i], leak_step[i], leak_drift[i] if labels else 0.0,
-        labels, dt,
+        target, gain, state.filtered[i], state.base[i], theta_on, theta_off, thresholds.leak_step[i],
+        state.leak_drift[i] if labels else 0.0, labels, dt,
     )  # fmt: skip
-    filtered[i] = f1
-    base[i] = b
+    state.filtered[i] = f1
+    state.base[i] = b
     if labels:
-        leak_drift[i] = d
-    count[i], x0[i], x1[i], n_leak[i] = c, a, x, leak_only
+        state.leak_drift[i] = d
+    crossing.count[i], crossing.x0[i], crossing.x1[i], crossing.n_leak[i] = c, a, x, leak_only
     n = abs(c)
-    if shot_noise_hz > 0.0:  # 7. the block's candidates that land here and are kept
+    if noise.rate_hz > 0.0:  # 7. the block's candidates that land here and are kept
         block = i // NOISE_BLOCK
-        mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
-        key = np.uint64(unit_key(shot_key, block))  # (a uint64 already: the simulator needs the cast)
-        majorant = majorants[block]
-        j, s, on = next_kept_on_pixel(key, 0, 0.0, mean_gap_s, i, block, majorant, i1, theta_on[i], theta_off[i],
-                                      theta_nominal, dt)  # fmt: skip
+        majorant = noise.majorants[block]
+        mean_gap_s = block_mean_gap_s(noise.rate_hz, majorant)
+        key = np.uint64(unit_key(noise.key, block))  # (a uint64 already: the simulator needs the cast)
+        j, s, on = next_kept_on_pixel(key, 0, 0.0, mean_gap_s, i, block, majorant, i1, theta_on, theta_off,
+                                      noise.theta_nominal, dt)  # fmt: skip
         while s < dt:
             n += 1
-            j, s, on = next_kept_on_pixel(key, j + 1, s, mean_gap_s, i, block, majorant, i1, theta_on[i],
-                                          theta_off[i], theta_nominal, dt)  # fmt: skip
-    if hot_hz > 0.0 and hot[i]:  # 8.
-        n += hot_pixel_count(hot_key, i, hot_hz, dt)
+            j, s, on = next_kept_on_pixel(key, j + 1, s, mean_gap_s, i, block, majorant, i1, theta_on, theta_off,
+                                          noise.theta_nominal, dt)  # fmt: skip
+    if hot.rate_hz > 0.0 and hot.flags[i]:  # 8.
+        n += hot_pixel_count(hot.key, i, hot.rate_hz, dt)
     n_events[i] = n
 
 
 @cuda.jit
-def fill_kernel(
-    count, x0, x1, n_leak, n_events, first_slot, intensity1, scale, dt, t0, theta_on, theta_off, filtered, base,
-    leak_drift, last_event, hot, majorants, shot_noise_hz, theta_nominal, shot_key, hot_hz, hot_key, refractory_s,
-    defer, out_pix, out_t, out_p, out_label,
-):  # fmt: skip
-    """Each pixel's events from its first slot on, as `pixel.emit` writes them: signal,
-    shot noise (a kept one resets the reference), hot pixel. Slots the refractory period
-    leaves empty keep out_pix = -1."""
+def fill_kernel(crossing, n_events, first_slot, intensity1, scale, dt, t0, state, thresholds, noise, hot,
+                refractory_s, defer, out):  # fmt: skip
+    """Each pixel's events (`pixel.Events`) from its first slot on, as `pixel.emit` writes
+    them: signal, shot noise (a kept one resets the reference), hot pixel. Slots the
+    refractory period leaves empty keep out.pixel = -1."""
     i = cuda.grid(1)
-    if i >= count.size or n_events[i] == 0:
+    if i >= crossing.count.size or n_events[i] == 0:
         return
     k = first_slot[i]
-    c = count[i]
+    c = crossing.count[i]
+    last_event = state.last_event
+    theta_on, theta_off = thresholds.theta_on[i], thresholds.theta_off[i]
     if c != 0:
-        k, move = emit_pixel_crossings(i, c, x0[i], x1[i], n_leak[i], theta_on[i], theta_off[i], t0, dt, refractory_s,
-                                       defer, last_event, out_pix, out_t, out_p, out_label, k)  # fmt: skip
-        base[i] += move
-    if shot_noise_hz > 0.0:
+        k, move = emit_pixel_crossings(i, c, crossing.x0[i], crossing.x1[i], crossing.n_leak[i], theta_on, theta_off,
+                                       t0, dt, refractory_s, defer, last_event, out, k)  # fmt: skip
+        state.base[i] += move
+    if noise.rate_hz > 0.0:
         i1 = np.float64(intensity1[i]) * scale
         block = i // NOISE_BLOCK
-        mean_gap_s = block_mean_gap_s(shot_noise_hz, majorants[block])
-        key = np.uint64(unit_key(shot_key, block))  # (a uint64 already: the simulator needs the cast)
-        majorant = majorants[block]
+        majorant = noise.majorants[block]
+        mean_gap_s = block_mean_gap_s(noise.rate_hz, majorant)
+        key = np.uint64(unit_key(noise.key, block))  # (a uint64 already: the simulator needs the cast)
         reset = False
-        j, s, on = next_kept_on_pixel(key, 0, 0.0, mean_gap_s, i, block, majorant, i1, theta_on[i], theta_off[i],
-                                      theta_nominal, dt)  # fmt: skip
+        j, s, on = next_kept_on_pixel(key, 0, 0.0, mean_gap_s, i, block, majorant, i1, theta_on, theta_off,
+                                      noise.theta_nominal, dt)  # fmt: skip
         while s < dt:
             t = t0 + s
             if refractory_s <= 0.0 or refractory_allows(t, last_event[i], refractory_s):
                 if refractory_s > 0.0:
                     last_event[i] = t
-                out_pix[k], out_t[k], out_p[k], out_label[k] = i, t, on, SHOT_NOISE
+                out.pixel[k], out.t[k], out.on[k], out.label[k] = i, t, on, SHOT_NOISE
                 k += 1
                 reset = True
-            j, s, on = next_kept_on_pixel(key, j + 1, s, mean_gap_s, i, block, majorant, i1, theta_on[i],
-                                          theta_off[i], theta_nominal, dt)  # fmt: skip
+            j, s, on = next_kept_on_pixel(key, j + 1, s, mean_gap_s, i, block, majorant, i1, theta_on, theta_off,
+                                          noise.theta_nominal, dt)  # fmt: skip
         if reset:
-            base[i] = filtered[i]
-            if leak_drift.size > 0:
-                leak_drift[i] = 0.0
-    if hot_hz > 0.0 and hot[i]:
-        key = np.uint64(unit_key(hot_key, i))
+            state.base[i] = state.filtered[i]
+            if state.leak_drift.size > 0:
+                state.leak_drift[i] = 0.0
+    if hot.rate_hz > 0.0 and hot.flags[i]:
+        key = np.uint64(unit_key(hot.key, i))
         s = 0.0
-        for j in range(hot_pixel_count(hot_key, i, hot_hz, dt)):
-            s = hot_pixel_time(key, j, s, hot_hz)
-            out_pix[k], out_t[k], out_p[k], out_label[k] = i, t0 + s, True, HOT_PIXEL
+        for j in range(hot_pixel_count(hot.key, i, hot.rate_hz, dt)):
+            s = hot_pixel_time(key, j, s, hot.rate_hz)
+            out.pixel[k], out.t[k], out.on[k], out.label[k] = i, t0 + s, True, HOT_PIXEL
             k += 1
 
 
@@ -191,45 +207,41 @@ class CudaPixels:
             )
         n = theta_on.size
         self.n = n
-        self.theta_on, self.theta_off = cuda.to_device(theta_on), cuda.to_device(theta_off)
-        self.leak_step, self.majorants = cuda.to_device(leak_step), cuda.to_device(majorants)
+        self.thresholds = Thresholds(*(cuda.to_device(a) for a in (theta_on, theta_off, leak_step)))
+        self.majorants = cuda.to_device(majorants)
         hot = np.zeros(n, np.bool_)
         hot[hot_pixels] = True
         self.hot = cuda.to_device(hot)
-        self.last_event = cuda.to_device(np.full(n, -np.inf))
         self.labels = labels
-        self.slots = [cuda.device_array(n, dtype) for dtype in (np.int64, np.float64, np.float64, np.int64, np.int64)]
-        self.filtered = self.base = self.leak_drift = self.intensity = None
+        # A slot per pixel, its own: no pixel list (Crossings.pixel empty).
+        self.crossings = Crossings(*(cuda.device_array(size, d) for size, d in ((0, np.int64), (n, np.int64),
+                                     (n, np.float64), (n, np.float64), (n, np.int64))))  # fmt: skip
+        self.n_events = cuda.device_array(n, np.int64)
+        self.state = self.intensity = None
 
-    def start(self, intensity, filtered, base, leak_drift) -> None:
+    def start(self, intensity, state: PixelState) -> None:
         """The state at the first frame (computed on the host, as the CPU path does)."""
         self.intensity = cuda.to_device(intensity)
-        self.filtered, self.base = cuda.to_device(filtered), cuda.to_device(base)
-        self.leak_drift = cuda.to_device(leak_drift if self.labels else np.empty(0))
+        leak_drift = state.leak_drift if self.labels else np.empty(0)
+        self.state = PixelState(*(cuda.to_device(a) for a in (state.filtered, state.base, leak_drift,
+                                                               state.last_event)))  # fmt: skip
 
     def interval(self, intensity, scale, dt, t0, params, shot_key, hot_key):
         """One interval's events as host arrays (pixel, t s, ON, label), in pixel order."""
         intensity1 = cuda.to_device(np.ascontiguousarray(intensity))
-        count, x0, x1, n_leak, n_events = self.slots
-        noise = (self.majorants, float(params.shot_noise_hz), float(params.theta_on), shot_key)
-        hot = (float(params.hot_pixel_hz), hot_key)
+        noise = ShotNoise(self.majorants, float(params.shot_noise_hz), float(params.theta_on), shot_key)
+        hot = HotPixels(self.hot, float(params.hot_pixel_hz), hot_key)
         grid = (_blocks(self.n), THREADS_PER_BLOCK)
-        count_kernel[grid](
-            self.intensity, intensity1, scale, float(params.cutoff_hz), dt, self.filtered, self.base, self.theta_on,
-            self.theta_off, self.leak_step, self.leak_drift, self.hot, *noise, *hot, count, x0, x1, n_leak, n_events,
-        )  # fmt: skip
-        first_slot, total = exclusive_scan(n_events)
+        count_kernel[grid](self.intensity, intensity1, scale, float(params.cutoff_hz), dt, self.state,
+                           self.thresholds, noise, hot, self.crossings, self.n_events)  # fmt: skip
+        first_slot, total = exclusive_scan(self.n_events)
         gaps = params.refractory_s > 0  # only the refractory period leaves slots empty
         out_pix = cuda.to_device(np.full(total, -1, np.int64)) if gaps else cuda.device_array(total, np.int64)
-        out_t = cuda.device_array(total, np.float64)
-        out_p = cuda.device_array(total, np.bool_)
-        out_label = cuda.device_array(total, np.uint8)
+        out = Events(out_pix, *(cuda.device_array(total, d) for d in (np.float64, np.bool_, np.uint8)))
         if total:
-            fill_kernel[grid](
-                count, x0, x1, n_leak, n_events, first_slot, intensity1, scale, dt, t0, self.theta_on,
-                self.theta_off, self.filtered, self.base, self.leak_drift, self.last_event, self.hot, *noise, *hot,
-                float(params.refractory_s), params.refractory_mode == "defer", out_pix, out_t, out_p, out_label,
-            )  # fmt: skip
+            fill_kernel[grid](self.crossings, self.n_events, first_slot, intensity1, scale, dt, t0, self.state,
+                              self.thresholds, noise, hot, float(params.refractory_s),
+                              params.refractory_mode == "defer", out)  # fmt: skip
         self.intensity = intensity1
-        events = (out_pix.copy_to_host(), out_t.copy_to_host(), out_p.copy_to_host(), out_label.copy_to_host())
+        events = tuple(a.copy_to_host() for a in out)
         return tuple(a[events[0] >= 0] for a in events) if gaps else events

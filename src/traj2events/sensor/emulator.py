@@ -46,7 +46,7 @@ from .laws import log_intensity_8bit, lowpass_gain
 from .noise import block_majorants, shot_noise_events
 from .ordering import assemble
 from .parallel import RangedPass, pixel_ranges
-from .pixel import advance, emit, hot_pixel_counts
+from .pixel import Crossings, Events, PixelState, Thresholds, advance, emit, hot_pixel_counts
 
 
 def _rng(seed: int, *key: int) -> np.random.Generator:
@@ -105,23 +105,18 @@ class EventEmulator:
         self.leak_phase = rng.uniform(0.0, 1.0, n)
         hot = rng.uniform(size=n) < params.hot_pixel_fraction
         self.hot_pixels = np.flatnonzero(hot)
-        self._filtered: np.ndarray | None = None  # low-passed log intensity at the last frame
         self._intensity: np.ndarray | None = None  # input (DN) at the last frame
-        self._base: np.ndarray | None = None
+        self._state: PixelState | None = None  # set at the first frame
         self._last_event = np.full(n, -np.inf)  # s
         # Base's drift per second, and the thresholds, in float32: less for the per-frame
         # pass to read, and these are random draws whose last bits carry nothing.
         self._leak_step = (self.theta_on * self.leak_rate).astype(np.float32)
         self.theta_on, self.theta_off = self.theta_on.astype(np.float32), self.theta_off.astype(np.float32)
+        self._thresholds = Thresholds(self.theta_on, self.theta_off, self._leak_step)
         self._noise_majorants = block_majorants(self.theta_on, self.theta_off, params.theta_on)  # thinning (7.)
         # Work arrays of the compiled kernels, reused every frame.
-        self._count = np.zeros(n, np.int64)
-        self._x0 = np.zeros(n)
-        self._x1 = np.zeros(n)
-        self._active = np.zeros(n, np.int64)
-        self._n_leak = np.zeros(n, np.int64)
+        self._crossings = Crossings(*(np.zeros(n, d) for d in (np.int64, np.int64, np.float64, np.float64, np.int64)))
         self._noise = (np.zeros(0, np.int64), np.zeros(0), np.zeros(0, np.bool_))  # grown as needed
-        self._leak_drift = _NO_TABLE  # unspent leak drift per pixel (labels only)
         self._ranged_pass = RangedPass(pixel_ranges(n, threads))
         self._gpu = None
         if device == "cuda":
@@ -206,29 +201,26 @@ class EventEmulator:
 
     def _start(self, intensity: np.ndarray, t: float) -> None:
         log_i = log_intensity_8bit(np.asarray(intensity, dtype=np.float64) * self.input_scale)
-        self._filtered, self._intensity, self._t = log_i.copy(), intensity, t
+        self._intensity, self._t = intensity, t
         # Random leak phase: base starts a random fraction of theta_on below the signal.
         phase_drift = self.leak_phase * self.theta_on * (self.leak_rate > 0)
-        self._base = log_i - phase_drift
-        if self.labels:  # that offset is leak drift, pending from the start
-            self._leak_drift = phase_drift.astype(np.float64)
+        # With labels, that offset is leak drift, pending from the start.
+        leak_drift = phase_drift.astype(np.float64) if self.labels else _NO_TABLE
+        self._state = PixelState(log_i.copy(), log_i - phase_drift, leak_drift, self._last_event)
         if self._gpu is not None:
-            self._gpu.start(intensity, self._filtered, self._base, self._leak_drift)
+            self._gpu.start(intensity, self._state)
 
     def _advance_ranges(self, intensity0, intensity1, dt, log_lut, gain_lut) -> int:
         """`pixel.advance` over every pixel, a range of pixels per thread; returns how many
         pixels cross, listed in pixel order in the slots."""
-        per_pixel = (self._filtered, self._base, self.theta_on, self.theta_off, self._leak_step)
-        slots = (self._active, self._count, self._x0, self._x1, self._n_leak)
+        state, thresholds, slots = self._state, self._thresholds, self._crossings
         cutoff_hz = float(self.params.cutoff_hz)
 
         def advance_range(start: int, stop: int) -> int:
-            r = slice(start, stop)
-            return advance(
-                intensity0[r], intensity1[r], *(a[r] for a in per_pixel),
-                self._leak_drift[r] if self.labels else self._leak_drift, cutoff_hz, dt, self.input_scale,
-                log_lut, gain_lut, start, *(a[r] for a in slots),
-            )  # fmt: skip
+            r = slice(start, stop)  # (an empty leak_drift, no labels, stays empty)
+            return advance(intensity0[r], intensity1[r], PixelState(*(a[r] for a in state)),
+                           Thresholds(*(a[r] for a in thresholds)), cutoff_hz, dt, self.input_scale, log_lut,
+                           gain_lut, start, Crossings(*(a[r] for a in slots)))  # fmt: skip
 
         return self._ranged_pass(advance_range, slots)
 
@@ -259,17 +251,12 @@ class EventEmulator:
         hot_key = interval_key(self.seed, HOT_PIXEL_STREAM, self._interval)
         hot_pixels = self.hot_pixels if p.hot_pixel_hz > 0 else _NO_PIXELS
         hot_counts = hot_pixel_counts(hot_pixels, hot_key, float(p.hot_pixel_hz), dt)
-        n_room = int(np.abs(self._count[:n_active]).sum()) + n_noise + int(hot_counts.sum())
-        pix = np.empty(n_room, np.int64)
-        t = np.empty(n_room, np.float64)
-        on = np.empty(n_room, np.bool_)
-        label = np.empty(n_room, np.uint8)
-        k = emit(
-            self._active, n_active, self._count, self._x0, self._x1, self._n_leak, noise_pix, noise_s, noise_on,
-            n_noise, hot_pixels, hot_counts, hot_key, float(p.hot_pixel_hz), self.theta_on, self.theta_off,
-            self._filtered, self._base, self._leak_drift, self._last_event, t0, dt, float(p.refractory_s),
-            p.refractory_mode == "defer", pix, t, on, label,
-        )  # fmt: skip
+        n_room = int(np.abs(self._crossings.count[:n_active]).sum()) + n_noise + int(hot_counts.sum())
+        out = Events(*(np.empty(n_room, d) for d in (np.int64, np.float64, np.bool_, np.uint8)))
+        k = emit(self._crossings, n_active, (noise_pix, noise_s, noise_on), n_noise, hot_pixels, hot_counts, hot_key,
+                 float(p.hot_pixel_hz), self._thresholds, self._state, t0, dt, float(p.refractory_s),
+                 p.refractory_mode == "defer", out)  # fmt: skip
+        pix, t, on, label = out
         self._intensity, self._t = intensity, t1
         self._interval += 1
         n_pixels = self.width * self.height

@@ -18,11 +18,16 @@ signal) and its hot-pixel events (8.), drawn in `noise`.
 `emit_crossings` writes one pixel's crossings as events; the CPU and the GPU call it alike.
 On the CPU, `advance` runs over every pixel and lists those that cross; `emit` writes
 their events, then the shot noise's (`noise.shot_noise_events`), then the hot pixels'.
+
+The passes take their arrays in named structures (numba reads a named tuple's fields as
+fast as separate arguments): the pixels' `PixelState` and `Thresholds`, the `Crossings`
+of the pixels that cross, and the `Events` written.
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -31,6 +36,42 @@ from ..formats.events import HOT_PIXEL, LEAK, SHOT_NOISE, SIGNAL
 from .draws import unit_key
 from .laws import log_response_scalar, lowpass_gain_scalar, refractory_allows
 from .noise import hot_pixel_count, hot_pixel_time
+
+
+class PixelState(NamedTuple):
+    """Each pixel's state between frames (arrays over the pixels)."""
+
+    filtered: np.ndarray  # the low-passed log intensity f at the last frame
+    base: np.ndarray  # the reference level the signal is compared with
+    leak_drift: np.ndarray  # the leak's drift not yet spent on an event (labels only; else empty)
+    last_event: np.ndarray  # the time of the pixel's last event, s (-inf: none yet)
+
+
+class Thresholds(NamedTuple):
+    """Each pixel's contrast thresholds and leak (float32 arrays over the pixels)."""
+
+    theta_on: np.ndarray
+    theta_off: np.ndarray
+    leak_step: np.ndarray  # the reference's drift per second, theta_on x the leak rate
+
+
+class Crossings(NamedTuple):
+    """The crossings of one interval, a slot per crossing pixel (or per pixel, on the GPU)."""
+
+    pixel: np.ndarray  # int64: the pixel's index (the CPU's list)
+    count: np.ndarray  # int64: > 0 ON, < 0 OFF crossings
+    x0: np.ndarray  # the signal above the reference at t0
+    x1: np.ndarray  # ... and at t1
+    n_leak: np.ndarray  # int64: how many of the ON crossings are the leak's
+
+
+class Events(NamedTuple):
+    """Events written into slots (pixel index, time s, ON, label)."""
+
+    pixel: np.ndarray
+    t: np.ndarray
+    on: np.ndarray
+    label: np.ndarray
 
 
 @njit(inline="always")
@@ -83,12 +124,11 @@ def crossing_time(j, step, x0, x1, t0, dt):
 
 
 @njit(inline="always")
-def emit_crossings(i, count, x0, x1, n_leak, theta_on, theta_off, t0, dt, refractory_s, defer, last_event, out_pix,
-                   out_t, out_p, out_label, k):  # fmt: skip
-    """4-5. Pixel i's `count` crossings as events from slot k on (its last n_leak labelled
-    leak), each at its `crossing_time` unless the refractory period holds it back: (the
-    next free slot, how far its reference moves: every crossing's threshold with drop, the
-    emitted ones' with defer)."""
+def emit_crossings(i, count, x0, x1, n_leak, theta_on, theta_off, t0, dt, refractory_s, defer, last_event, out, k):
+    """4-5. Pixel i's `count` crossings as events into `out` (Events) from slot k on (its
+    last n_leak labelled leak), each at its `crossing_time` unless the refractory period
+    holds it back: (the next free slot, how far its reference moves: every crossing's
+    threshold with drop, the emitted ones' with defer)."""
     on = count > 0
     step = theta_on if on else -theta_off
     n = abs(count)
@@ -99,29 +139,27 @@ def emit_crossings(i, count, x0, x1, n_leak, theta_on, theta_off, t0, dt, refrac
             if not refractory_allows(t, last_event[i], refractory_s):
                 continue
             last_event[i] = t
-        out_pix[k], out_t[k], out_p[k] = i, t, on
-        out_label[k] = LEAK if j > n - n_leak else SIGNAL
+        out.pixel[k], out.t[k], out.on[k] = i, t, on
+        out.label[k] = LEAK if j > n - n_leak else SIGNAL
         k += 1
         emitted += 1
     return k, (emitted if defer else n) * step
 
 
 @njit(cache=True, nogil=True)
-def advance(
-    intensity0, intensity1, filtered, base, theta_on, theta_off, leak_step, leak_drift, cutoff_hz, dt, scale,
-    log_lut, gain_lut, first_pixel, active, count, x0, x1, n_leak,
-):  # fmt: skip
-    """`advance_pixel` over every pixel in the arrays (a range of a frame's pixels: threads
-    can run ranges side by side; `first_pixel` is the range's first index), with step 1
-    (target L(I1)) and the low-pass gain; lists the pixels that cross in `active` (as
-    first_pixel + i), their counts, x0, x1 and leak crossings in the same slots; returns
-    how many. Updates filtered, base (and leak_drift: labels, when not empty).
+def advance(intensity0, intensity1, state, thresholds, cutoff_hz, dt, scale, log_lut, gain_lut, first_pixel, out):
+    """`advance_pixel` over every pixel of `state` and `thresholds` (a range of a frame's
+    pixels: threads can run ranges side by side; `first_pixel` is the range's first index),
+    with step 1 (target L(I1)) and the low-pass gain; lists the pixels that cross in `out`
+    (Crossings, pixel = first_pixel + i) and returns how many. Updates the state's
+    filtered, base (and leak_drift: labels, when not empty).
 
     Speed: 8-bit input reads the law's values from tables (`log_lut[I]`, `gain_lut[I0 + I1]`:
     every value they can take); float input computes them, the gain reused while a run of
     pixels has the same two inputs (shadows and sky are runs of zeros)."""
     two_pi_dt = 2.0 * np.pi * dt
     tables = log_lut.size > 0
+    filtered, base, leak_drift = state.filtered, state.base, state.leak_drift
     labels = leak_drift.size > 0
     n_active = 0
     run0 = run1 = np.float64(np.nan)  # the inputs of the last gain computed (NaN: none yet)
@@ -140,8 +178,8 @@ def advance(
                 gain = lowpass_gain_scalar(0.5 * (np.float64(intensity0[i]) * scale + i1), cutoff_hz, two_pi_dt)
                 run0, run1, run_gain = intensity0[i], intensity1[i], gain
         f1, b, c, a, x, leak_only, d = advance_pixel(
-            target, gain, filtered[i], base[i], theta_on[i], theta_off[i], leak_step[i],
-            leak_drift[i] if labels else 0.0, labels, dt,
+            target, gain, filtered[i], base[i], thresholds.theta_on[i], thresholds.theta_off[i],
+            thresholds.leak_step[i], leak_drift[i] if labels else 0.0, labels, dt,
         )  # fmt: skip
         filtered[i] = f1
         base[i] = b
@@ -149,11 +187,11 @@ def advance(
             leak_drift[i] = d
         if c == 0:
             continue
-        active[n_active] = first_pixel + i
-        count[n_active] = c
-        x0[n_active] = a
-        x1[n_active] = x
-        n_leak[n_active] = leak_only
+        out.pixel[n_active] = first_pixel + i
+        out.count[n_active] = c
+        out.x0[n_active] = a
+        out.x1[n_active] = x
+        out.n_leak[n_active] = leak_only
         n_active += 1
     return n_active
 
@@ -168,22 +206,23 @@ def hot_pixel_counts(hot_pixels, hot_key, hot_hz, dt):
 
 
 @njit(cache=True, nogil=True)
-def emit(
-    active, n_active, count, x0, x1, n_leak, noise_pix, noise_s, noise_on, n_noise, hot_pixels, hot_counts, hot_key,
-    hot_hz, theta_on, theta_off, filtered, base, leak_drift, last_event, t0, dt, refractory_s, defer,
-    out_pix, out_t, out_p, out_label,
-):  # fmt: skip
-    """The interval's events into out_* (pixel index, t in s, ON, label): the crossing
-    pixels' signal (a pixel's last n_leak crossings labelled leak), then the shot noise's
-    events (`noise.shot_noise_events`, time since t0), then the hot pixels'. Each pixel
-    sees its own in that order (the order the events are written in does not matter: they
-    are sorted after). Returns how many."""
+def emit(crossing, n_active, noise, n_noise, hot_pixels, hot_counts, hot_key, hot_hz, thresholds, state, t0, dt,
+         refractory_s, defer, out):  # fmt: skip
+    """The interval's events into `out` (Events): the crossing pixels' signal (`crossing`,
+    the first n_active slots of Crossings; a pixel's last n_leak crossings labelled leak),
+    then the shot noise's events (`noise`: the first n_noise of (pixel, time since t0, ON),
+    `noise.shot_noise_events`), then the hot pixels'. Each pixel sees its own in that order
+    (the order the events are written in does not matter: they are sorted after). Returns
+    how many."""
+    base, last_event = state.base, state.last_event
     k = 0
     for a in range(n_active):
-        i = active[a]
-        k, move = emit_crossings(i, count[a], x0[a], x1[a], n_leak[a], theta_on[i], theta_off[i], t0, dt, refractory_s,
-                                 defer, last_event, out_pix, out_t, out_p, out_label, k)  # fmt: skip
+        i = crossing.pixel[a]
+        k, move = emit_crossings(i, crossing.count[a], crossing.x0[a], crossing.x1[a], crossing.n_leak[a],
+                                 thresholds.theta_on[i], thresholds.theta_off[i], t0, dt, refractory_s, defer,
+                                 last_event, out, k)  # fmt: skip
         base[i] += move
+    noise_pix, noise_s, noise_on = noise
     reset = -1  # the last pixel whose noise reset its reference
     for b in range(n_noise):  # 7.
         i = noise_pix[b]
@@ -192,12 +231,12 @@ def emit(
             if not refractory_allows(t, last_event[i], refractory_s):
                 continue
             last_event[i] = t
-        out_pix[k], out_t[k], out_p[k], out_label[k] = i, t, noise_on[b], SHOT_NOISE
+        out.pixel[k], out.t[k], out.on[k], out.label[k] = i, t, noise_on[b], SHOT_NOISE
         k += 1
         if i != reset:  # a noise event resets the pixel like a real one: the reference jumps to the signal
-            base[i] = filtered[i]
-            if leak_drift.size > 0:
-                leak_drift[i] = 0.0
+            base[i] = state.filtered[i]
+            if state.leak_drift.size > 0:
+                state.leak_drift[i] = 0.0
             reset = i
     for h in range(hot_pixels.size):  # 8. ON, past the refractory period and the reference
         i = hot_pixels[h]
@@ -205,6 +244,6 @@ def emit(
         s = 0.0
         for j in range(hot_counts[h]):
             s = hot_pixel_time(key, j, s, hot_hz)
-            out_pix[k], out_t[k], out_p[k], out_label[k] = i, t0 + s, True, HOT_PIXEL
+            out.pixel[k], out.t[k], out.on[k], out.label[k] = i, t0 + s, True, HOT_PIXEL
             k += 1
     return k
