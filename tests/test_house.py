@@ -32,7 +32,7 @@ def modules() -> list[str]:
     found = []
     for path in sorted(PACKAGE.rglob("*.py")):
         relative = path.relative_to(PACKAGE).with_suffix("")
-        if relative.name not in ("__init__", "__main__"):
+        if relative.name not in ("__init__", "__main__", "_version"):  # (_version: written at install)
             found.append(relative.as_posix())
     return found
 

@@ -397,6 +397,11 @@ def test_kept_files_describe_themselves(built, config):
     sun = config["scenarios"]["descent"]["sun"]
     assert attrs["sun_elevation_deg"] == sun["elevation_deg"] and attrs["scenario"] == "descent"
     assert '"seed": 1' in attrs["terrain"]  # the terrain's settings, as JSON
+    for name in ("trajectory.h5", "frames.h5", "events.h5", "imu.h5", "motion_field.h5"):  # which code made them
+        if (built / name).exists():
+            with h5py.File(built / name) as f:
+                assert {"traj2events_version", "traj2events_commit", "code_fingerprint"} <= set(f.attrs), name
+                assert len(f.attrs["code_fingerprint"]) == 16 and f.attrs["traj2events_commit"] != "unknown"
 
 
 def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path, tile_cache):

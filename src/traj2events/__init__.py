@@ -1,6 +1,9 @@
 """traj2events: synthetic event-camera datasets from mass-optimal lunar landings."""
 
-__version__ = "0.1.0"
+try:  # written by setuptools-scm at install time, from the git tags (traj2events.provenance)
+    from ._version import __version__
+except ImportError:  # a source tree never installed
+    __version__ = "0+unknown"
 
 
 def missing_dependency(exc: ModuleNotFoundError) -> str:

@@ -6,9 +6,9 @@ from __future__ import annotations
 import os
 from dataclasses import replace
 
-from .. import __version__
 from ..formats.trajectory import solution_attrs, vehicle_attrs, write_trajectory
 from ..progress import log
+from ..provenance import provenance
 from ..trajectory.ocp import LandingProblem, Solution, replace_tf_guess
 from ..trajectory.scenarios import ScenarioSettings, base_conditions
 
@@ -58,7 +58,7 @@ def base_solution(settings: ScenarioSettings, output: str | os.PathLike, record_
         "scenario": settings.scenario.name,
         "epsilon": settings.ocp.epsilon,
         "mesh_clustering": settings.ocp.mesh_clustering,
-        "traj2events_version": __version__,
+        **provenance(__name__),
     }
     write_trajectory(output, (sol.t, sol.state, sol.control), None, attrs)
     return sol

@@ -7,9 +7,9 @@ import os
 
 import numpy as np
 
-from .. import __version__
 from ..formats.trajectory import read_solution_set, vehicle_attrs, write_trajectory
 from ..progress import log
+from ..provenance import provenance
 from ..trajectory.divert import Divert, DivertedFlight, divert_flight, manoeuvre_m_s2
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.hover import Hover, HoverFlight, hover_drift_m, hover_flight
@@ -84,7 +84,7 @@ def camera_poses(
         "mesh_clustering": s.ocp.mesh_clustering,
         "continuation": sample["method"],
         "draw": sample["draw"],
-        "traj2events_version": __version__,
+        **provenance(__name__),
     }
     write_trajectory(output, (t, state, control), poses, attrs)
 

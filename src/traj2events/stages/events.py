@@ -12,7 +12,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
 from ..defaults import preset_pixel
 from ..formats.events import EVENT_DTYPE, EVENT_LABELS, EventsWriter, merge_events, read_events
 from ..formats.exports import write_elope_npz, write_faery
@@ -20,6 +19,7 @@ from ..formats.frames import FramesFile
 from ..formats.trajectory import read_trajectory
 from ..geometry.range_meter import range_readings
 from ..progress import log
+from ..provenance import provenance
 from ..sensor.emulator import EmulatorParams, EventEmulator
 from ..sensor.photocurrent import SensorParams
 from ..sensor.radiation import NO_SPACE, SpaceEvents, SpaceParams
@@ -74,7 +74,7 @@ def emulate(
         "emulator_device": device,
         **{f"readout_{k}": v for k, v in asdict(readout).items()},
         **{f"space_{k}": v for k, v in asdict(space.params if space else NO_SPACE).items()},
-        "traj2events_version": __version__,
+        **provenance(__name__),
         **source.scene,
     }
     start, n_frames, n_events, t_last = time.perf_counter(), 0, 0, 0.0

@@ -9,11 +9,11 @@ import os
 
 import numpy as np
 
-from .. import __version__
 from ..formats.hdf5 import FileFormatError
 from ..formats.poses import pose_format, read_pose_samples
 from ..formats.trajectory import write_trajectory
 from ..progress import log
+from ..provenance import provenance
 from ..settings.poses import check_external_pose_settings
 from ..trajectory.external import ExternalFlight, PoseSamples, interpolation_record, sample_problems
 
@@ -60,6 +60,6 @@ def external_poses(source: str | os.PathLike, trajectory_id: int, settings: dict
         "error_velocity_m_s": np.nan,
         "divert": "none",
         "hover": "none",
-        "traj2events_version": __version__,
+        **provenance(__name__),
     }
     write_trajectory(output, (samples.t_s, flight.states(samples.t_s), None), (t, poses, None), attrs)

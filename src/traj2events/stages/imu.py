@@ -8,10 +8,10 @@ import os
 
 import numpy as np
 
-from .. import __version__
 from ..formats.imu import write_imu
 from ..formats.trajectory import read_trajectory
 from ..progress import log
+from ..provenance import provenance
 from ..trajectory.flight import flight_of
 from ..trajectory.imu import ImuNoise, altitude_above_sphere, angular_rate_body, measured, specific_force
 
@@ -56,7 +56,7 @@ def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settin
         "inertial_frame": "the site frame, as the dynamics take it: the Moon's rotation is not in angular_rate_b",
         "scenario": tr.attrs.get("scenario", ""),
         "id": tr.attrs.get("id", -1),
-        "traj2events_version": __version__,
+        **provenance(__name__),
     }
     write_imu(output, streams, attrs)
     log(f"{trajectory}: {len(t)} IMU samples at {rate:g} Hz -> {output}")

@@ -10,7 +10,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
 from ..formats.atomic import atomic_directory
 from ..formats.flow import motion_field_file, write_flo
 from ..formats.frames import FramesFile
@@ -27,6 +26,7 @@ from ..geometry.motion_field import (
     sphere_motion,
 )
 from ..progress import log
+from ..provenance import provenance
 
 
 def field_layout(h: int, w: int, terrain: bool) -> dict[str, tuple[tuple, type]]:
@@ -88,7 +88,7 @@ def motion_field(
             "every_n_frames": every_n_frames,
             "scenario": tr.attrs["scenario"],
             "id": int(tr.attrs["id"]),
-            "traj2events_version": __version__,
+            **provenance(__name__),
             "status_codes": ", ".join(f"{code} {name}" for code, name in enumerate(STATUS_NAMES)),
             **camera.intrinsics_attrs(),
         }

@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import __version__
 from ..figures import event_rate_figure, png_bytes
 from ..formats.atomic import atomic_output
 from ..formats.hdf5 import open_file
+from ..provenance import provenance
 from .index import manoeuvre_stats
 
 RATE_BIN_MS = 10  # the event rate's bin: the paper's event-frame window
@@ -73,8 +73,9 @@ def overview_html(
     manoeuvres: pd.DataFrame | None = None,
 ) -> str:
     """The page: per-scenario and per-trajectory tables, the rate figure, the diverts and
-    hovers flown (where any was tried), bytes per kind of file, summary.csv, the version
-    and the config."""
+    hovers flown (where any was tried), bytes per kind of file, summary.csv, the version,
+    commit and the config."""
+    made = provenance(__name__)
     per_scenario = trajectories.groupby("scenario", sort=False).agg(
         trajectories=("id", "size"), frames=("frames", "sum"), flight_s=("t_f_s", "sum"), events=("events", "sum"),
         peak_events_per_s=("peak_events_per_s", "max"), MB=("MB", "sum"),
@@ -89,7 +90,10 @@ def overview_html(
     return "\n".join([
         "<!DOCTYPE html>", "<html><head><meta charset='utf-8'><title>traj2events dataset</title>",
         f"<style>{style}</style></head><body>",
-        f"<h1>Dataset overview</h1><p>traj2events {html.escape(__version__)}: {len(trajectories)} trajectories, "
+        f"<h1>Dataset overview</h1><p>traj2events {html.escape(made['traj2events_version'])} (commit "
+        f"<code>{html.escape(made['traj2events_commit'])}</code>; every file's root attributes name its version, "
+        "commit and its stage's code fingerprint, docs/dataset.md \"Provenance\"): "
+        f"{len(trajectories)} trajectories, "
         f"{int(trajectories['frames'].sum())} frames of {html.escape(str(config['camera']['width']))} x "
         f"{html.escape(str(config['camera']['height']))} px, {int(trajectories['events'].sum())} events, "
         f"{trajectories['MB'].sum():.1f} MB on disk (docs/dataset.md describes every file).</p>",

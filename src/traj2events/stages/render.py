@@ -13,12 +13,12 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from .. import __version__
 from ..formats.frames import FramesWriter
 from ..formats.trajectory import read_trajectory
 from ..geometry.camera import Camera
 from ..geometry.frame_timing import FrameTiming, frame_motion, next_interval_s, next_render_time
 from ..progress import log
+from ..provenance import provenance
 from ..renderer.draw import TerrainRenderer
 from ..renderer.lens import LensRenderer
 from ..renderer.supersample import Supersampled, sensor_renderer
@@ -69,7 +69,7 @@ class TrajectoryRender:
             "fps": float(tr.attrs["fps"]),
             "scenario": tr.attrs["scenario"],
             "id": int(tr.attrs["id"]),
-            "traj2events_version": __version__,
+            **provenance(__name__),
         }
         self.attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
 
@@ -192,6 +192,8 @@ FRAME_ATTR_ORDER = (
     "scenario",
     "id",
     "traj2events_version",
+    "traj2events_commit",
+    "code_fingerprint",
     "camera_matrix_px",
     "distortion",
     "distortion_coefficients",

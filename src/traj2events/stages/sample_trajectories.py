@@ -13,10 +13,10 @@ import time
 import numpy as np
 import pandas as pd
 
-from .. import __version__
 from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_trajectory, solution_attrs, write_solution_set
 from ..progress import log
+from ..provenance import provenance
 from ..settings.solve import RANGE_KEYS
 from ..trajectory.batch import print_progress, solve_samples
 from ..trajectory.ocp import Solution
@@ -150,7 +150,7 @@ def sample_trajectories(
         "n_trajectories": s.scenario.n_trajectories,
         "base_solver_status": base_solution.status,
         "base_solver_success": base_solution.success,
-        "traj2events_version": __version__,
+        **provenance(__name__),
     }
     samples = {
         r.index: ((r.solution.t, r.solution.state, r.solution.control), sample_attrs(r, i))
