@@ -397,11 +397,16 @@ def test_kept_files_describe_themselves(built, config):
     sun = config["scenarios"]["descent"]["sun"]
     assert attrs["sun_elevation_deg"] == sun["elevation_deg"] and attrs["scenario"] == "descent"
     assert '"seed": 1' in attrs["terrain"]  # the terrain's settings, as JSON
-    for name in ("trajectory.h5", "frames.h5", "events.h5", "imu.h5", "motion_field.h5"):  # which code made them
-        if (built / name).exists():
-            with h5py.File(built / name) as f:
-                assert {"traj2events_version", "traj2events_commit", "code_fingerprint"} <= set(f.attrs), name
-                assert len(f.attrs["code_fingerprint"]) == 16 and f.attrs["traj2events_commit"] != "unknown"
+    files = sorted(built.rglob("*.h5")) + sorted(built.parent.glob("*.h5"))  # the trajectory's, base.h5, solutions.h5
+    assert {"trajectory.h5", "frames.h5", "events.h5", "base.h5", "solutions.h5"} <= {p.name for p in files}
+    for path in files:
+        with h5py.File(path) as f:  # which code made them; every dataset's units or categories
+            assert {"traj2events_version", "traj2events_commit", "code_fingerprint"} <= set(f.attrs), path
+            assert len(f.attrs["code_fingerprint"]) == 16 and f.attrs["traj2events_commit"] != "unknown"
+            unlabelled = []
+            f.visititems(lambda name, obj: unlabelled.append(name) if isinstance(obj, h5py.Dataset) and not (
+                "units" in obj.attrs or "flag_values" in obj.attrs) else None)  # fmt: skip
+            assert not unlabelled, f"{path.name}: {unlabelled}"
 
 
 def test_adaptive_timing_adds_emulator_frames_between_the_poses(built, tmp_path, tile_cache):

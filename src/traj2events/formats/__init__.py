@@ -3,6 +3,7 @@ of the pipeline never loads the solver or the renderer.
 
     atomic      one helper for every write: a temporary name, renamed when complete
     hdf5        byte-reproducible HDF5 files, datasets and attributes
+    units       every dataset's units (CF / UDUNITS) and categories, one table per kind of file
     trajectory  base.h5, solutions.h5, trajectory.h5 (nodes, poses, vehicle constants)
     frames      frames.h5 (linear radiance and depth per frame)
     rounding    frames.h5's mantissa rounding, compiled (numba: for writing only)

@@ -162,6 +162,9 @@ class EventsWriter:
                 self._ms_to_idx.append(np.full(end_ms - self._next_ms + 1, self.n, dtype=np.int64))
             ms_to_idx = np.concatenate(self._ms_to_idx) if self._ms_to_idx else np.zeros(1, np.int64)
             self._file.create_dataset("ms_to_idx", data=ms_to_idx.astype(np.uint64), track_times=False)
+            from .units import UNITS, label_datasets  # (it names EVENT_LABELS: imported here, not at the top)
+
+            label_datasets(self._file, UNITS["events"])
         self._file.close()
         self._context.__exit__(*exc)
 

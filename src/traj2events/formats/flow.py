@@ -21,6 +21,7 @@ from .hdf5 import (
     read_errors_named,
     write_dataset,
 )
+from .units import UNITS, label_datasets
 
 FLO_MAGIC = 202021.25  # "PIEH" as a little-endian float32: Middlebury .flo (Baker et al. 2007)
 
@@ -84,6 +85,7 @@ def motion_field_file(
             )
             writers[name] = ChunkWriter(dataset) if n else None
         yield f, writers
+        label_datasets(f, UNITS["motion_field"])  # the caller's datasets too
 
 
 class MotionFieldReader(HeldFile):

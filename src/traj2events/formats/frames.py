@@ -35,6 +35,7 @@ from .hdf5 import (
     write_dataset,
     write_errors_named,
 )
+from .units import UNITS, label_datasets
 
 
 def central_ray(height: int, width: int, focal_px: float, attrs=None) -> tuple[int, int, float]:
@@ -138,6 +139,7 @@ class FramesWriter:
         if self._ray is not None:
             write_dataset(self._file, "slant_range_m", np.asarray(self._slant_range, float))
         set_attrs(self._file, self._attrs)
+        label_datasets(self._file, UNITS["frames"])
 
     def __enter__(self):
         return self

@@ -14,6 +14,7 @@ import numpy as np
 
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, set_attrs, write_dataset
+from .units import UNITS, label_datasets
 
 COLUMNS = {
     "t": 1,
@@ -32,6 +33,7 @@ def write_imu(path: str | os.PathLike, streams: dict[str, np.ndarray], attrs: di
         for name in COLUMNS:
             write_dataset(f, name, np.asarray(streams[name], np.float64))
         set_attrs(f, attrs)
+        label_datasets(f, UNITS["imu"])
 
 
 def read_imu(path: str | os.PathLike) -> tuple[dict[str, np.ndarray], dict]:

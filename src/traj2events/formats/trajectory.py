@@ -17,6 +17,7 @@ import numpy as np
 from ..trajectory.state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, MASS, STATE_NAMES, STATE_UNITS
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, plain, set_attrs, write_dataset
+from .units import UNITS, label_datasets
 
 VEHICLE_KEYS = ("mass_kg", "dry_mass_kg", "thrust_main_N", "thrust_rcs_N", "lever_arm_m", "inertia_kgm2", "isp_s",
                 "g_m_s2", "g0_m_s2", "tilt_max_deg")  # fmt: skip
@@ -69,6 +70,7 @@ def write_trajectory(
         if poses is not None:
             _write_nodes(f.create_group("poses"), *poses)
         set_attrs(f, {**attrs, **CONVENTIONS})
+        label_datasets(f, UNITS["trajectory"])
 
 
 @dataclass
@@ -128,6 +130,7 @@ def write_solution_set(path: str | os.PathLike, samples: dict[int, tuple[tuple, 
             _write_nodes(g, *nodes)
             set_attrs(g, sample_attrs)
         set_attrs(f, attrs)
+        label_datasets(f, UNITS["trajectory"])
 
 
 def read_solution_set(path: str | os.PathLike) -> dict:
