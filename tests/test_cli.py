@@ -349,3 +349,31 @@ def test_poses_settings_are_checked_against_the_declarations(settings, fragment,
     assert main(["poses", str(source), "--settings", settings, "-o", str(tmp_path / "out.h5")]) == 2
     err = capsys.readouterr().err
     assert err.startswith("error: --settings: ") and fragment in err and not (tmp_path / "out.h5").exists(), err
+
+
+def test_the_readme_and_the_readers_help_name_every_subcommand():
+    from traj2events.__main__ import COMMANDS
+
+    commands = build_parser()._subparsers._group_actions[0].choices
+    assert tuple(commands) == COMMANDS
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    assert all(f"`{name}`" in readme for name in commands), [n for n in commands if f"`{n}`" not in readme]
+
+
+@pytest.mark.parametrize("argv, status, says", [(["--version"], 0, "traj2events "), (["--help"], 0, "pip install"),
+                                                (["base"], None, None)])  # fmt: skip
+def test_the_reader_install_answers_version_and_help(argv, status, says, monkeypatch, capsys):
+    """Where the commands' imports are missing (the base install), --version and --help
+    still answer and exit 0; a command says what to install."""
+    import sys
+
+    from traj2events import __main__
+
+    monkeypatch.setitem(sys.modules, "traj2events.cli", None)  # its import fails as without the pipeline extra
+    monkeypatch.setattr(sys, "argv", ["traj2events", *argv])
+    with pytest.raises(SystemExit) as exit:
+        __main__.main()
+    if status is None:
+        assert "traj2events[pipeline]" in str(exit.value.code)
+    else:
+        assert exit.value.code == status and says in capsys.readouterr().out

@@ -343,6 +343,8 @@ def test_a_number_yaml_reads_as_text_gets_a_hint():
         resolve_config({"events": {"window_ms": "1.0e9"}})
     with pytest.raises(ConfigError, match=r"expected number, got str 'ten'$"):
         resolve_config({"events": {"window_ms": "ten"}})
+    with pytest.raises(ConfigError, match=r"got str '50' \(a number in quotes is text: write 50 without quotes\)"):
+        resolve_config({"events": {"window_ms": "50"}})
 
 
 @pytest.mark.parametrize(

@@ -90,3 +90,7 @@ def test_fields_and_frames_read_from_held_files_are_the_written_ones(tmp_path):
     for k in (4, 1, 3):
         frame, depth = landing.frame(k)
         assert np.allclose(frame, radiance[k], rtol=1e-3) and np.allclose(depth, radiance[k] + 1, rtol=1e-3)
+    with pytest.raises(IndexError, match=r"frames\.h5: pose 5: expected 0 <= k < 5"):
+        landing.frame(5)
+    with pytest.raises(ValueError, match=r"expected t_start_s <= t_end_s.*got 2.0, 1.0"):
+        landing.events(2.0, 1.0)

@@ -70,8 +70,10 @@ def describe(error: jsonschema.ValidationError, prefix: list[str] | tuple = ()) 
     if v == "type":
         hint = ""
         if isinstance(got, str) and schema_value in ("number", "integer") and _is_number(got):
-            # YAML 1.1 (PyYAML, Snakemake) reads 1.0e9 or 1e-3, without a dot and a sign, as text.
-            hint = f" (YAML reads {got} as text: write it with a dot and a signed exponent, e.g. 1.0e+9)"
+            if "e" in got.lower():  # YAML 1.1 (PyYAML, Snakemake) reads 1e9 or 1.0e9, without a dot and a sign, as text
+                hint = f" (YAML reads {got} as text: write it with a dot and a signed exponent, e.g. 1.0e+9)"
+            else:  # quoted in the file, or given as text on the command line
+                hint = f" (a number in quotes is text: write {got} without quotes)"
         return f"config key '{where}': expected {schema_value}, got {type(got).__name__} {got!r}{hint}"
     if v in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         op = {"minimum": ">=", "maximum": "<=", "exclusiveMinimum": ">", "exclusiveMaximum": "<"}[v]

@@ -121,11 +121,13 @@ class Landing:
 
     def events(self, t_start_s: float, t_end_s: float) -> np.ndarray:
         """Events with t in [t_start, t_end) s: structured x, y, t (us), p (1 = ON)."""
+        _check_window(t_start_s, t_end_s)
         return held_open(self.folder / "events.h5", EventsReader).window(round(t_start_s * 1e6), round(t_end_s * 1e6))
 
     def labelled_events(self, t_start_s: float, t_end_s: float) -> tuple[np.ndarray, np.ndarray]:
         """As `events`, and each event's cause (uint8: 0 signal, 1 shot_noise, 2 leak,
         3 hot_pixel; `formats.events.EVENT_LABELS`), when the dataset was built with labels."""
+        _check_window(t_start_s, t_end_s)
         reader = held_open(self.folder / "events.h5", EventsReader)
         return reader.labelled_window(round(t_start_s * 1e6), round(t_end_s * 1e6))
 
@@ -142,8 +144,15 @@ class Landing:
     def frame(self, k: int) -> tuple[np.ndarray, np.ndarray]:
         """Pose k's frame: linear radiance (H, W) W m^-2 sr^-1 and depth (H, W) m (frames.h5 kept)."""
         frames = held_open(self.folder / "frames.h5", FramesFile)
+        if not 0 <= k < frames.n_poses:
+            raise IndexError(f"{self.folder / 'frames.h5'}: pose {k}: expected 0 <= k < {frames.n_poses}")
         row = frames.row_of_pose(k)
         return frames.radiance(row), frames.depth_m(row)
+
+
+def _check_window(t_start_s: float, t_end_s: float) -> None:
+    if not t_start_s <= t_end_s:  # (NaN too)
+        raise ValueError(f"events: expected t_start_s <= t_end_s (a window [start, end) s), got {t_start_s}, {t_end_s}")
 
 
 class Dataset:
