@@ -137,3 +137,13 @@ def test_each_module_is_parsed_once_for_all_the_stages(package_copy):
     package_copy("sensor/pixel.py", "two_pi_dt = 2.0 * np.pi * dt", "two_pi_dt = 6.3 * dt")
     assert all_fingerprints()["events"] != before["events"]
     assert fingerprint.read_source.cache_info().misses == len(modules) + 1
+
+
+def test_the_installed_version_is_in_no_closure_and_provenance_in_every_stages():
+    """setuptools-scm rewrites _version.py at each install: a stage's files name the version
+    (provenance) but do not rerun on it."""
+    from traj2events.fingerprint import import_closure
+
+    for stage in ("render", "events", "imu", "base_solution"):
+        closure = import_closure(f"traj2events.stages.{stage}")
+        assert "traj2events._version" not in closure and "traj2events.provenance" in closure

@@ -244,8 +244,10 @@ def test_the_base_install_reads_the_dataset_without_the_pipeline(built, tmp_path
     landing = open_dataset(built / "results").find("descent", 1)
     expected = f"{len(landing.poses()[0])} 13 {len(landing.events(1.0, 1.5))} (32, 32, 2)"
     assert read.stdout.strip() == expected and len(landing.events(1.0, 1.5)) > 0
-    command = subprocess.run([str(venv / "bin" / "traj2events"), "--help"], env=env, capture_output=True, text=True)
+    command = subprocess.run([str(venv / "bin" / "traj2events"), "base"], env=env, capture_output=True, text=True)
     assert command.returncode == 1 and "pip install 'traj2events[pipeline]'" in command.stderr, command.stderr
+    helped = subprocess.run([str(venv / "bin" / "traj2events"), "--help"], env=env, capture_output=True, text=True)
+    assert helped.returncode == 0 and "reads built datasets" in helped.stdout, helped.stderr
 
 
 def test_the_docs_dataloader_example_iterates_the_built_dataset(built):

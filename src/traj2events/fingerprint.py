@@ -22,8 +22,10 @@ from pathlib import Path
 PACKAGE = "traj2events"
 PACKAGE_DIR = Path(__file__).resolve().parent
 # This module names code and computes none of a stage's output (the tile cache imports it
-# for its key): left out of every closure, so that its edits rerun nothing.
-NOT_IN_CLOSURES = {f"{PACKAGE}.fingerprint"}
+# for its key), and _version.py is the version setuptools-scm writes at each install: left
+# out of every closure, so that their changes rerun nothing (a file's version is an
+# attribute of provenance, not of its content).
+NOT_IN_CLOSURES = {f"{PACKAGE}.fingerprint", f"{PACKAGE}._version"}
 
 
 def module_path(name: str) -> Path | None:
