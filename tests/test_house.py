@@ -23,7 +23,7 @@ WITHOUT_TEST_FILE = {
     "settings/solve", "settings/tree", "settings/vehicle", "stages/base_solution", "stages/camera_poses",
     "stages/imu", "stages/index", "stages/motion_field", "stages/pictures", "stages/render",
     "stages/render_events", "stages/sample_trajectories", "stages/summary", "trajectory/external",
-    "trajectory/flight", "trajectory/legs", "trajectory/state",
+    "trajectory/flight", "trajectory/legs",
 }  # fmt: skip
 
 

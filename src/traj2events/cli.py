@@ -32,10 +32,6 @@ def _job(kind, args, keys: dict[str, str]):
         raise ValueError(f"--settings: expected the JSON of {kind.__name__} (the workflow writes it): {exc}") from None
 
 
-def _camera(settings: dict):
-    return importlib.import_module(".geometry.camera", __package__).Camera.from_settings(settings)
-
-
 def cmd_check_config(args) -> int:
     from .config import load_config
     from .plan import dataset_plan
@@ -47,22 +43,9 @@ def cmd_check_config(args) -> int:
     return 0
 
 
-def cmd_base(args) -> int:
-    from .stages.base_solution import base_solution
-    from .trajectory.scenarios import ScenarioSettings
-
-    base_solution(_job(ScenarioSettings, args, SOLVE), args.output, record_failure=args.record_failure)
-    return 0
-
-
-def cmd_sample(args) -> int:
-    from .stages.sample_trajectories import sample_trajectories
-    from .trajectory.scenarios import ScenarioSettings
-
-    if args.jobs < 1:
-        raise ValueError(f"sample: --jobs: expected >= 1, got {args.jobs}")
-    sample_trajectories(_job(ScenarioSettings, args, SOLVE), args.base, args.output, args.table, args.jobs)
-    return 0
+def _scenario_settings(args):
+    """base's and sample's --settings and options as the scenario's ScenarioSettings."""
+    return _job(importlib.import_module(".trajectory.scenarios", __package__).ScenarioSettings, args, SOLVE)
 
 
 def cmd_render(args) -> int:
@@ -72,8 +55,8 @@ def cmd_render(args) -> int:
     settings, files = _job(render.RenderSettings, args, RENDER), (args.frames, args.video, args.preview)
     if args.events:  # the emulator takes the radiance in memory: frames.h5 keeps the depth only
         events = settings_from(argparse.Namespace(settings=args.events_settings, settings_defaults=None), EVENTS)
-        beside = os.path.dirname(args.events)
-        exports = {name: os.path.join(beside, f"events.{EXPORT_SUFFIX[name]}") for name in args.exports}
+        exports = {name: os.path.join(os.path.dirname(args.events), f"events.{EXPORT_SUFFIX[name]}")
+                   for name in args.exports}  # fmt: skip
         render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events, exports,
                                          args.backend, args.tile_cache)  # fmt: skip
     else:
@@ -82,11 +65,12 @@ def cmd_render(args) -> int:
 
 
 def cmd_motion_field(args) -> int:
+    from .geometry.camera import Camera
     from .stages.motion_field import motion_field
 
     s = settings_from(args, MOTION_FIELD)
-    motion_field(args.trajectory, _camera(s), s["moon_radius_m"], s["every_n_frames"], args.output, args.flo_dir,
-                 args.frames, s["compression"])  # fmt: skip
+    motion_field(args.trajectory, Camera.from_settings(s), s["moon_radius_m"], s["every_n_frames"], args.output,
+                 args.flo_dir, args.frames, s["compression"])  # fmt: skip
     return 0
 
 
@@ -102,13 +86,15 @@ def cmd_events(args) -> int:
 
 
 def cmd_picture(args) -> int:
+    from .geometry.camera import Camera
     from .stages import pictures
 
     if args.kind == "frames":
         pictures.frames_picture(args.trajectory, args.video, args.output)
     elif args.kind == "motion-field":
         s = settings_from(args, CAMERA)
-        pictures.motion_field_picture(args.trajectory, _camera(s), s["moon_radius_m"], args.output, args.video)
+        camera = Camera.from_settings(s)
+        pictures.motion_field_picture(args.trajectory, camera, s["moon_radius_m"], args.output, args.video)
     elif args.kind == "events":
         s = settings_from(args, EVENTS_PICTURE)
         pictures.trajectory_events_picture(args.events, args.trajectory, s["window_ms"], args.output)
@@ -128,6 +114,13 @@ def _calls(stage: str, function: str, *arguments):
     return command
 
 
+def _event_exports(p: argparse.ArgumentParser) -> None:
+    """The events' exports (the events command's and `export events`'), the .npz's trajectory."""
+    for flag, what in (("--npz", "an ELOPE-style .npz"), ("--evt3", "Prophesee EVT 3.0 .raw"), ("--aedat4", "AEDAT4")):
+        p.add_argument(flag, help=f"also write {what} here (EVT 3.0, AEDAT4: via faery)")
+    p.add_argument("--trajectory", help="trajectory.h5: the .npz's timestamps and traj (states)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     about = "Synthetic event-camera datasets from mass-optimal lunar landings. The Snakemake workflow calls these "
     about += "subcommands; each can also be run by hand. Defaults are those of the package's defaults.yaml."
@@ -142,18 +135,17 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("base", help="solve a scenario's base problem (every range at its midpoint)")
     add_settings(p, SOLVE, "the scenario's solve settings", defaults=solve_settings)
     p.add_argument("--output", "-o", required=True, help="base.h5 (nodes only)")
-    p.add_argument("--record-failure", action="store_true", help="if the problem does not solve, write base.h5 "
-                   "recording it, exit 0 (the workflow does: summary.csv says so); default: exit 1")  # fmt: skip
-    p.set_defaults(func=cmd_base)
+    p.add_argument("--record-failure", action="store_true", help="unsolved: base.h5 says so, exit 0 (else 1)")
+    p.set_defaults(func=_calls("base_solution", "base_solution", _scenario_settings, "output", "record_failure"))
 
     p = sub.add_parser("sample", help="sample boundary conditions and solve them by continuation from the base")
     add_settings(p, SOLVE, "the scenario's solve settings", defaults=solve_settings)
-    p.add_argument("--base", required=True, help="base.h5 from `traj2events base` (one recording a failed solve "
-                   "gives a solutions.h5 and samples.csv without samples, which say so)")  # fmt: skip
+    p.add_argument("--base", required=True, help="base.h5 from `traj2events base` (a failed one: files that say so)")
     p.add_argument("--output", "-o", required=True, help="solutions.h5: every sample's nodes and status")
     p.add_argument("--table", required=True, help="samples.csv: one row per sample (status, reason, errors)")
     p.add_argument("--jobs", "-j", type=int, default=1, help="worker processes (default 1)")
-    p.set_defaults(func=cmd_sample)
+    p.set_defaults(func=_calls("sample_trajectories", "sample_trajectories", _scenario_settings, "base", "output",
+                               "table", "jobs"))  # fmt: skip
 
     p = sub.add_parser("upsample", help="camera poses at the frame rate for one solved sample")
     p.add_argument("--solutions", required=True, help="solutions.h5 from `traj2events sample`")
@@ -164,8 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
     poses = lambda a: settings_from(a, POSES)  # noqa: E731
     p.set_defaults(func=_calls("camera_poses", "poses_command", "solutions", "id", poses, "output", "manoeuvre"))
 
-    p = sub.add_parser("poses", help="camera poses at the frame rate from a pose file or SPICE kernels (a scenario's "
-                       "`poses`, docs/trajectories.md \"External poses\")")  # fmt: skip
+    p = sub.add_parser("poses", help="camera poses at the frame rate from a pose file or SPICE kernels (`poses`)")
     p.add_argument("source", help="CSV or HDF5 of time, position, attitude; a trajectory.h5; a SPICE meta-kernel (.tm)")
     p.add_argument("--id", type=int, default=0, help="the trajectory's id (default 0)")
     add_settings(p, EXTERNAL_POSES, "the poses' settings (settings.poses.external_pose_settings)",
@@ -187,13 +178,10 @@ def build_parser() -> argparse.ArgumentParser:
                  defaults=render_job_settings)  # fmt: skip
     p.add_argument("--frames", required=True, help="frames.h5: linear radiance and depth per frame")
     p.add_argument("--video", required=True, help="video.mkv: lossless FFV1 of the 8-bit display frames")
-    p.add_argument("--preview", help="preview.mp4: H.264 of the same, to look at (the workflow passes it unless "
-                   "render.preview is false: its encoder takes CPU beside the render); default: none")  # fmt: skip
+    p.add_argument("--preview", help="preview.mp4: H.264 of the same, to look at (unless render.preview: false)")
     add_declared_option(p, "--backend", RenderSection, "backend")
-    p.add_argument("--tile-cache", metavar="FOLDER", help="share built tiles' terrain heights with other render jobs "
-                   "through this folder (the workflow passes render.tile_cache); default: no cache")  # fmt: skip
-    p.add_argument("--events", help="events.h5: also emulate the events, from the frames in memory (frames.h5 then "
-                   "holds the depth only); --events-settings and --seed as for `traj2events events`")  # fmt: skip
+    p.add_argument("--tile-cache", metavar="FOLDER", help="share built tiles with other jobs here (render.tile_cache)")
+    p.add_argument("--events", help="events.h5: also emulate, from the frames in memory (frames.h5: the depth only)")
     p.add_argument("--events-settings", metavar="JSON", help="the emulator's settings (`events --settings`)")
     p.add_argument("--seed", type=int, default=0, help="with --events: the emulator's seed (default 0)")
     p.add_argument("--exports", nargs="*", default=[], choices=list(EXPORT_SUFFIX), help="with --events: also these")
@@ -216,20 +204,27 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc)")
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
-    p.add_argument("--white", type=float, help="with --input-scale display: radiance at full scale (default: "
-                   "frames.h5's display white)")  # fmt: skip
+    p.add_argument("--white", type=float, help="--input-scale display: radiance at 255 (default: frames.h5's white)")
     add_settings(p, EVENTS, "the emulator settings", flags=EVENTS_FLAGS)
     p.add_argument("--chunk", type=int, help="frames read at a time (default 16; the events do not change)")
-    p.add_argument("--threads", type=int, help="CPUs to use: with 2 or more, the next chunk is read in a thread while "
-                   "this one is emulated, and each frame's pixels are split over the CPUs left (a video's decoder, "
-                   "ffmpeg, takes one; at least 65536 pixels each); the events do not change (default: the CPUs "
-                   "this process may use)")  # fmt: skip
-    p.add_argument("--npz", help="also write an ELOPE-style .npz (events; with --trajectory: timestamps, traj; from "
-                   "frames.h5: range_meter)")  # fmt: skip
-    p.add_argument("--trajectory", help="trajectory.h5, for the .npz's timestamps and traj")
-    p.add_argument("--evt3", help="also write Prophesee EVT 3.0 .raw (via faery)")
-    p.add_argument("--aedat4", help="also write AEDAT4 (via faery)")
+    p.add_argument("--threads", type=int, help="CPUs to use: the next chunk read in a thread, each frame's pixels "
+                   "split over the rest; the events do not change (default: the CPUs allowed)")  # fmt: skip
+    _event_exports(p)
     p.set_defaults(func=cmd_events)
+
+    p = sub.add_parser("export", help="convert a built dataset's files for other tools, computing nothing again")
+    kinds = p.add_subparsers(dest="kind", required=True)
+    q = kinds.add_parser("events", help="events.h5 as EVT 3.0 (.raw), AEDAT4 (via faery) or an ELOPE-style .npz")
+    q.add_argument("events", help="events.h5")
+    _event_exports(q)
+    q.add_argument("--frames", help="frames.h5: the .npz's range meter")
+    q.set_defaults(func=_calls("events", "export_events", "events", "npz", "evt3", "aedat4", "trajectory", "frames"))
+    q = kinds.add_parser("poses", help="the camera's poses (mount included) as TUM and EuRoC text, the IMU as EuRoC's")
+    q.add_argument("trajectory", help="trajectory.h5")
+    q.add_argument("--tum", help="TUM text: timestamp tx ty tz qx qy qz qw (s, m; camera to world)")
+    q.add_argument("--euroc", help="EuRoC ground-truth CSV: ns, position, quaternion w x y z, velocity")
+    q.add_argument("--euroc-imu", nargs=2, metavar=("IMU_H5", "CSV"), help="imu.h5's measured streams as EuRoC imu0")
+    q.set_defaults(func=_calls("export", "export_poses", "trajectory", "tum", "euroc", "euroc_imu"))
 
     p = sub.add_parser("picture", help="PNG mosaics at the paper's five times, and the dataset figure")
     kinds = p.add_subparsers(dest="kind", required=True)

@@ -7,6 +7,7 @@
     events = landing.events(1.0, 1.01)       # structured x, y, t (us), p in [1.00, 1.01) s
     events, labels = landing.labelled_events(1.0, 1.01)  # and each event's cause
     t, state = landing.poses()               # (K,) s, (K, 13) in the units of state_units
+    t, position, q_xyzw, T_world_cam = landing.camera_poses()  # the camera, mount included
     landing.source()                         # {"source": "ocp"}, or a pose file's (external poses)
     fields = landing.motion_field(3)         # the 4th field written: arrays by name
     t, slant = landing.range_meter()         # the range meter at every pose (s, m)
@@ -29,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TypeVar
 
+import h5py
 import numpy as np
 
 from .formats.events import EventsReader
@@ -36,6 +38,7 @@ from .formats.flow import MotionFieldReader
 from .formats.frames import FramesFile
 from .formats.imu import read_imu
 from .formats.trajectory import read_trajectory
+from .geometry.camera import camera_poses
 
 # Files this process holds open (events.h5, motion_field.h5, frames.h5 readers), the most
 # recently read last: a read then costs its slices, not an opening and its check. Keyed by
@@ -77,6 +80,19 @@ class Landing:
         """Camera pose times (K,) s and states (K, 13) at the frame rate."""
         tr = read_trajectory(self.folder / "trajectory.h5")
         return tr.t, tr.state
+
+    def camera_poses(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The camera at each pose, as VO and GNC tools take it: (t (K,) s, position (K, 3) m,
+        quaternion_xyzw (K, 4), T_world_cam (K, 4, 4)) in the site frame, OpenCV's camera axes
+        (`geometry.camera.camera_poses`): trajectory.h5's camera/ group, or, for a file
+        written before it, computed from its poses and the mount events.h5 (or frames.h5)
+        records."""
+        with h5py.File(self.folder / "trajectory.h5") as f:
+            if "camera" in f:
+                g = f["camera"]
+                return tuple(g[name][()] for name in ("t", "position_m", "quaternion_xyzw", "T_world_cam"))
+        t, state = self.poses()
+        return (t, *camera_poses(state, float(self._scene_attrs()["camera_mount_height_m"])))
 
     def manoeuvre(self) -> dict:
         """The divert or hover flown: trajectory.h5's `divert`, `hover` ("none" where none was

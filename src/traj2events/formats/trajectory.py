@@ -14,10 +14,19 @@ from dataclasses import dataclass
 import h5py
 import numpy as np
 
+from ..geometry.camera import camera_poses
 from ..trajectory.state import CONTROL_NAMES, CONTROL_UNITS, CONVENTIONS, MASS, STATE_NAMES, STATE_UNITS
 from .atomic import atomic_output
 from .hdf5 import Attributes, FileFormatError, create, open_file, plain, set_attrs, write_dataset
 from .units import UNITS, label_datasets
+
+# How camera/ reads (docs/dataset.md "trajectory.h5").
+CAMERA_POSE_CONVENTIONS = {
+    "world_frame": "the site frame: origin at the landing site, x down-range, y cross-range, z down",
+    "camera_frame": "OpenCV's: x along the image's columns, y along its rows, z the boresight (= the body frame)",
+    "T_world_cam": "p_world = T_world_cam p_cam (4 x 4): the camera's axes and origin in the world frame",
+    "quaternion_xyzw": "the rotation of T_world_cam (camera to world), scalar last, as scipy and TUM write it",
+}
 
 VEHICLE_KEYS = ("mass_kg", "dry_mass_kg", "thrust_main_N", "thrust_rcs_N", "lever_arm_m", "inertia_kgm2", "isp_s",
                 "g_m_s2", "g0_m_s2", "tilt_max_deg")  # fmt: skip
@@ -62,13 +71,23 @@ def write_trajectory(
     nodes: tuple[np.ndarray, np.ndarray, np.ndarray],
     poses: tuple[np.ndarray, np.ndarray, np.ndarray] | None,
     attrs: dict,
+    mount_height_m: float | None = None,
 ) -> None:
     """One trajectory: nodes/{t,state,control}, optional poses/{t,state,control}, attrs
-    (control None: an external flight's, which has none)."""
+    (control None: an external flight's, which has none); with poses and the camera's
+    `mount_height_m`, camera/{t,position_m,quaternion_xyzw,T_world_cam}: the camera's pose
+    at each pose (`geometry.camera.camera_poses`)."""
     with atomic_output(path) as tmp, create(tmp) as f:
         _write_nodes(f.create_group("nodes"), *nodes)
         if poses is not None:
             _write_nodes(f.create_group("poses"), *poses)
+        if poses is not None and mount_height_m is not None:
+            camera = f.create_group("camera")
+            write_dataset(camera, "t", poses[0])
+            for name, value in zip(("position_m", "quaternion_xyzw", "T_world_cam"),
+                                   camera_poses(poses[1], mount_height_m)):  # fmt: skip
+                write_dataset(camera, name, value)
+            set_attrs(camera, {"mount_height_m": float(mount_height_m), **CAMERA_POSE_CONVENTIONS})
         set_attrs(f, {**attrs, **CONVENTIONS})
         label_datasets(f, UNITS["trajectory"])
 

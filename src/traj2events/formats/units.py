@@ -32,7 +32,9 @@ def _flags(values, meanings) -> dict:
     return {"flag_values": values, "flag_meanings": " ".join(m.replace(" ", "_") for m in meanings)}
 
 
-_NODES = {"*/t": {"units": "s"}, "*/state": _columns(STATE_NAMES, STATE_UNITS_CF),
+_NODES = {"camera/position_m": {"units": "m"}, "camera/quaternion_xyzw": {"units": "1"},
+          "camera/T_world_cam": {"units": "1, 1, 1, m", "columns": "x axis, y axis, z axis, origin"},
+          "*/t": {"units": "s"}, "*/state": _columns(STATE_NAMES, STATE_UNITS_CF),
           "*/control": _columns(CONTROL_NAMES, CONTROL_UNITS_CF)}  # fmt: skip
 _STATUS = _flags(np.arange(len(STATUS_NAMES), dtype=np.uint8), STATUS_NAMES)
 _VALID = _flags(np.array([False, True]), ("no_surface_or_not_computed", "valid"))

@@ -20,7 +20,16 @@ import numpy as np
 
 from ..settings.camera import CameraSection
 from ..settings.declare import default
-from ..trajectory.state import ATTITUDE, BODY_RATES, CONVENTIONS, POSITION, VELOCITY, rotation_matrix
+from ..trajectory.state import (
+    ATTITUDE,
+    BODY_RATES,
+    CONVENTIONS,
+    POSITION,
+    VELOCITY,
+    quaternion_body_to_inertial,
+    rotation_body_to_inertial,
+    rotation_matrix,
+)
 from .distortion import MODEL, PINHOLE, Distortion, distortion_from
 
 
@@ -200,6 +209,20 @@ def camera_pose(state: np.ndarray, mount_height_m: float = 0.0) -> CameraPose:
     position r + R_iv (0, 0, -h) (m), rotation R_iv."""
     rotation = rotation_matrix(*state[ATTITUDE])
     return CameraPose(np.asarray(state[POSITION], dtype=float) + rotation @ _mount(mount_height_m), rotation)
+
+
+def camera_poses(states: np.ndarray, mount_height_m: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The camera's pose at each 13-state (K, 13), as VO and GNC tools take it:
+    (position (K, 3) m, quaternion_xyzw (K, 4), T_world_cam (K, 4, 4)), world = the site
+    frame (x, y horizontal, z down), camera frame = OpenCV's (x along the image's columns,
+    y along its rows, z the boresight), the mount included: p_world = T_world_cam p_cam."""
+    states = np.atleast_2d(np.asarray(states, dtype=float))
+    phi, theta, psi = (states[:, ATTITUDE][:, c] for c in range(3))
+    rotation = np.moveaxis(np.array(rotation_body_to_inertial(phi, theta, psi)), -1, 0)  # (K, 3, 3) R_iv
+    position = states[:, POSITION] + rotation @ _mount(mount_height_m)
+    matrix = np.zeros((len(states), 4, 4))
+    matrix[:, :3, :3], matrix[:, :3, 3], matrix[:, 3, 3] = rotation, position, 1.0
+    return position, quaternion_body_to_inertial(phi, theta, psi), matrix
 
 
 def camera_motion(state: np.ndarray, mount_height_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

@@ -21,11 +21,12 @@ class Upsampling:
                           "(the paper's cubic spline, for comparison)", choices=("reintegrate", "spline"))  # fmt: skip
 
 
-POSES = {"fps": "camera.fps", "method": "upsampling.method"}
+POSES = {"fps": "camera.fps", "method": "upsampling.method", "mount_height_m": "camera.mount_height_m"}
 
 
 def pose_settings(config: dict) -> dict:
-    """The frame rate and how the solved nodes are upsampled to it."""
+    """The frame rate, how the solved nodes are upsampled to it, and the camera's mount
+    (trajectory.h5's camera/ group)."""
     return pick(config, POSES)
 
 

@@ -10,6 +10,7 @@ The command line (cli.py), the tests and the benchmarks all call these functions
     motion_field          ground-truth motion field of every n-th frame      -> motion_field.h5, flow/*.flo
     events                event emulation and its exports                    -> events.h5, .npz, .raw, .aedat4
     render_events         render and events in one job, frames in memory     -> the files of both (frames.h5: depth)
+    export                a built trajectory's camera poses and IMU as text  -> TUM, EuRoC (`traj2events export`)
     pictures              mosaics of frames, motion field and events; the dataset figure (PNG)
     index                 one row per trajectory of a scenario               -> index.csv
     summary               one row per scenario                               -> summary.csv

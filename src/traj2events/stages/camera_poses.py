@@ -10,6 +10,8 @@ import numpy as np
 from ..formats.trajectory import read_solution_set, vehicle_attrs, write_trajectory
 from ..progress import log
 from ..provenance import provenance
+from ..settings.camera import CameraSection
+from ..settings.declare import default
 from ..trajectory.divert import Divert, DivertedFlight, divert_flight, manoeuvre_m_s2
 from ..trajectory.dynamics import Dynamics
 from ..trajectory.hover import Hover, HoverFlight, hover_drift_m, hover_flight
@@ -28,8 +30,10 @@ def camera_poses(
     method: str,
     output: str | os.PathLike,
     manoeuvre: dict | None = None,
+    mount_height_m: float = default(CameraSection, "mount_height_m"),
 ) -> None:
-    """Write trajectory.h5 (nodes and poses) of trajectory `sample_id` of solutions.h5 (the
+    """Write trajectory.h5 (nodes, poses, and the camera's poses `mount_height_m` above the
+    trajectory point) of trajectory `sample_id` of solutions.h5 (the
     sample-th solved draw); with a `manoeuvre` (settings.poses.scenario_manoeuvre's), the
     flight re-targeted to its new site (trajectory/divert.py) or with its hover
     (trajectory/hover.py), or the sample's own, recorded as such, where that does not solve."""
@@ -86,7 +90,7 @@ def camera_poses(
         "draw": sample["draw"],
         **provenance(__name__),
     }
-    write_trajectory(output, (t, state, control), poses, attrs)
+    write_trajectory(output, (t, state, control), poses, attrs, mount_height_m)
 
 
 def flown_manoeuvre(settings: ScenarioSettings, sample: tuple, manoeuvre: dict) -> DivertedFlight | HoverFlight | None:
@@ -144,6 +148,7 @@ def poses_command(
     output: str | os.PathLike,
     manoeuvre: dict | None = None,
 ) -> None:
-    """The camera_poses stage as the command runs it: settings.poses (fps, method), and
-    the trajectory's manoeuvre (None: none)."""
-    camera_poses(solutions, sample_id, settings["fps"], settings["method"], output, manoeuvre)
+    """The camera_poses stage as the command runs it: settings.poses (fps, method, the
+    camera's mount), and the trajectory's manoeuvre (None: none)."""
+    camera_poses(solutions, sample_id, settings["fps"], settings["method"], output, manoeuvre,
+                 settings["mount_height_m"])  # fmt: skip

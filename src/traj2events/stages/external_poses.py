@@ -62,4 +62,5 @@ def external_poses(source: str | os.PathLike, trajectory_id: int, settings: dict
         "hover": "none",
         **provenance(__name__),
     }
-    write_trajectory(output, (samples.t_s, flight.states(samples.t_s), None), (t, poses, None), attrs)
+    write_trajectory(output, (samples.t_s, flight.states(samples.t_s), None), (t, poses, None), attrs,
+                     settings["mount_height_m"])  # fmt: skip

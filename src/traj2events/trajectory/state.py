@@ -58,6 +58,17 @@ def rotation_body_to_inertial(phi, theta, psi, lib=np):
     ]
 
 
+def quaternion_body_to_inertial(phi, theta, psi) -> np.ndarray:
+    """R_iv as unit quaternions (..., 4) in (x, y, z, w) order, the scalar last (scipy's
+    and TUM's): q = q_z(psi) q_y(theta) q_x(phi), of angles in radians (scalars or arrays).
+    Its sign is the one with w >= 0 at zero attitude (q and -q are the same rotation)."""
+    cf, sf = np.cos(np.multiply(phi, 0.5)), np.sin(np.multiply(phi, 0.5))
+    ct, st = np.cos(np.multiply(theta, 0.5)), np.sin(np.multiply(theta, 0.5))
+    cp, sp = np.cos(np.multiply(psi, 0.5)), np.sin(np.multiply(psi, 0.5))
+    return np.stack([sf * ct * cp - cf * st * sp, cf * st * cp + sf * ct * sp, cf * ct * sp - sf * st * cp,
+                     cf * ct * cp + sf * st * sp], axis=-1)  # fmt: skip
+
+
 def rotation_matrix(phi: float, theta: float, psi: float) -> np.ndarray:
     """R_iv (3 x 3 numpy array) for scalar angles in radians."""
     return np.array(rotation_body_to_inertial(phi, theta, psi))
