@@ -81,7 +81,9 @@ def cmd_events(args) -> int:
     threads = len(os.sched_getaffinity(0)) if args.threads is None else args.threads
     exports = {"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4}
     events_command(args.input, args.output, settings_from(args, EVENTS), args.seed, fps=args.fps, white=args.white,
-                   chunk=args.chunk, threads=threads, exports=exports, trajectory=args.trajectory)  # fmt: skip
+                   chunk=args.chunk, threads=threads, exports=exports, trajectory=args.trajectory,
+                   timestamps=args.timestamps, window_s=(args.start_s, args.stop_s), crop_px=args.crop,
+                   size_px=args.size)  # fmt: skip
     return 0
 
 
@@ -203,6 +205,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("input", help="frames.h5, a video file, or a folder of images")
     p.add_argument("--output", "-o", required=True, help="events.h5 (DSEC layout, Blosc)")
     p.add_argument("--fps", type=float, help="frame rate for images (required) or to override a video's")
+    p.add_argument("--timestamps", metavar="FILE", help="each frame's time, s, one per line (an irregular video)")
+    p.add_argument("--start-s", type=float, help="emulate from this time on, s (default: the first frame)")
+    p.add_argument("--stop-s", type=float, help="... up to this time, s (default: the last frame)")
+    p.add_argument("--crop", type=int, nargs=4, metavar=("X", "Y", "W", "H"), help="only this rectangle, px")
+    p.add_argument("--size", type=int, nargs=2, metavar=("W", "H"), help="output size, px (area-averaged)")
     p.add_argument("--seed", type=int, default=0, help="random seed: same seed and input, same bytes (default 0)")
     p.add_argument("--white", type=float, help="--input-scale display: radiance at 255 (default: frames.h5's white)")
     add_settings(p, EVENTS, "the emulator settings", flags=EVENTS_FLAGS)

@@ -326,3 +326,30 @@ def test_the_space_environment_in_the_events_command(tmp_path):
             video.write(f)
     with pytest.raises(ValueError, match="events.space: the space environment acts on the sensor's photocurrent"):
         events_command(tmp_path / "in.mkv", tmp_path / "v.h5", {**settings, "sensor": defaults["sensor"]}, 3)
+
+
+def test_the_standalone_emulator_takes_a_window_a_crop_a_size_and_timestamps(tmp_path):
+    """v2e's everyday controls on a folder of images: only the frames in [start, stop] s,
+    the rectangle, the output size; per-frame times from a file; a missing folder refused."""
+    from PIL import Image
+
+    from traj2events.cli import main
+    from traj2events.formats.events import read_events
+    from traj2events.stages.events import progress_line
+
+    (tmp_path / "images").mkdir()
+    for k in range(12):
+        Image.fromarray(np.full((12, 16), 20 + 15 * k, np.uint8)).save(tmp_path / "images" / f"{k:02d}.png")
+    (tmp_path / "t.txt").write_text("\n".join(f"{0.01 * k * k:.4f}" for k in range(12)))
+    argv = ["events", str(tmp_path / "images"), "--fps", "50", "--preset", "clean", "--crop", "2", "2", "12", "8",
+            "--size", "6", "4", "--timestamps", str(tmp_path / "t.txt"), "--start-s", "0.1",
+            "--stop-s", "0.8"]  # fmt: skip
+    assert main([*argv, "-o", str(tmp_path / "e.h5")]) == 0
+    events, attrs = read_events(tmp_path / "e.h5")
+    assert (attrs["width"], attrs["height"]) == (6, 4) and len(events) > 0
+    assert events["x"].max() < 6 and events["y"].max() < 4
+    assert 0.16e6 <= events["t"].min() and events["t"].max() <= 0.64e6  # frames 4..8 of the window: 0.16..0.64 s
+    np.testing.assert_array_equal(attrs["crop_px"], [2, 2, 12, 8])
+    assert main([*argv, "-o", str(tmp_path / "missing" / "e.h5")]) == 2
+    assert not (tmp_path / "missing").exists()
+    assert progress_line(50, 200, 7, 10.0) == "  50/200 frames (25 %, ETA 30 s), 7 events, 5 frames/s"

@@ -14,6 +14,7 @@ Read first (the model):
 
 Machinery a reader may skip:
     sources        the frames it takes: frames.h5, a render job's frames, a video, images
+    frame_transforms  what a user does to them first: retime, time window, crop, resize
     draws          random draws keyed by (seed, interval, pixel, draw): counter-based hashing
     cuda_kernels   the same model on an NVIDIA GPU, one thread per pixel
     ordering       each interval's events sorted by (t, y, x, p) with packed keys

@@ -52,6 +52,7 @@ class FrameSource:
     scene: dict = field(default_factory=dict)  # what frames.h5 says of the camera and the scene
     input_scale: float = 1.0  # the chunks' values times this are the emulator's DN
     decoder_cpus: int = 0  # CPUs a child process takes decoding the input (ffmpeg's, for a video)
+    n_frames: int | None = None  # how many frames the chunks hold, where known (progress, timestamps)
 
 
 # ffmpeg's decoder threads for a video: one, beside the emulator's. ffmpeg's default, a
@@ -96,7 +97,7 @@ def image_folder_source(path: Path, fps: float | None, chunk: int) -> FrameSourc
                 raise ValueError(f"events INPUT: images in {path} differ in size (expected {width} x {height})")
             yield np.stack(batch), times[start : start + chunk]
 
-    return FrameSource(width, height, "images (8-bit)", images(), {"fps": float(fps)})
+    return FrameSource(width, height, "images (8-bit)", images(), {"fps": float(fps)}, n_frames=len(files))
 
 
 def frames_source(
@@ -120,7 +121,7 @@ def frames_source(
             for chunk_frames, times in frames.radiance_chunks(chunk, buffers):
                 yield (chunk_frames if lens is None else through_lens(chunk_frames, *lens)), times
 
-    return FrameSource(width, height, kind, radiance(), scene, scale)
+    return FrameSource(width, height, kind, radiance(), scene, scale, n_frames=len(frames.t))
 
 
 def radiance_input(path, attrs, width: int, height: int, sensor: SensorParams | None, white: float | None):
@@ -185,7 +186,8 @@ def video_source(path: Path, fps: float | None, chunk: int) -> FrameSource:
             k += len(frames)
 
     scene = {"fps": float(fps)}  # events.h5 says its input's rate, as from frames.h5
-    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), scene, decoder_cpus=VIDEO_DECODER_CPUS)
+    return FrameSource(width, height, f"video (8-bit, {fps:g} fps)", video(), scene, decoder_cpus=VIDEO_DECODER_CPUS,
+                       n_frames=count or None)  # fmt: skip
 
 
 def frame_source(

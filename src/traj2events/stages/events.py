@@ -21,6 +21,7 @@ from ..geometry.range_meter import range_readings
 from ..progress import log
 from ..provenance import provenance
 from ..sensor.emulator import EmulatorParams, EventEmulator
+from ..sensor.frame_transforms import crop, read_timestamps, resize, retime, time_window
 from ..sensor.photocurrent import SensorParams
 from ..sensor.radiation import NO_SPACE, SpaceEvents, SpaceParams
 from ..sensor.readout import Readout, ReadoutParams
@@ -106,7 +107,7 @@ def emulate(
             n_frames += len(frames)
             t_last = float(times[-1])
             if n_frames % progress_every < len(frames):
-                log(f"  {n_frames} frames, {n_events} events, {n_frames / (time.perf_counter() - start):.0f} frames/s")
+                log(progress_line(n_frames, source.n_frames, n_events, time.perf_counter() - start))
     except BaseException as exc:
         close = getattr(source.chunks, "close", None)  # a generator's: stops a reader thread now
         if close is not None:
@@ -132,6 +133,17 @@ def emulate(
         f"{n_events / elapsed:.3g} events/s)"
     )
     return n_frames, n_events, t_last
+
+
+def progress_line(n_frames: int, total: int | None, n_events: int, elapsed_s: float) -> str:
+    """A long emulation's progress, one log line: frames done (of how many, with the time
+    left at the rate so far, where the source knows its length), events, frames/s."""
+    rate = n_frames / max(elapsed_s, 1e-9)
+    done = f"{n_frames} frames"
+    if total:
+        left_s = max(total - n_frames, 0) / rate
+        done = f"{n_frames}/{total} frames ({100 * n_frames / total:.0f} %, ETA {left_s:.0f} s)"
+    return f"  {done}, {n_events} events, {rate:.0f} frames/s"
 
 
 def central_range(frames: str | os.PathLike) -> np.ndarray:
@@ -218,13 +230,22 @@ def events_command(
     threads: int = 1,
     exports: dict[str, str | None] | None = None,
     trajectory: str | None = None,
+    timestamps: str | None = None,
+    window_s: tuple[float | None, float | None] = (None, None),
+    crop_px: tuple[int, int, int, int] | None = None,
+    size_px: tuple[int, int] | None = None,
 ) -> None:
     """The events stage as the command runs it: `input` (frames.h5 through the sensor, or on
     the display scale; a video; a folder of images) emulated into events.h5 with the pixel
     model, labels, input scale and sensor of `settings` (settings.events), then the exports
     (`exports`: npz, evt3, aedat4 paths or None; the .npz takes `trajectory`'s states and
-    frames.h5's range meter). The event-frame picture is its own command (`picture events`),
-    so that a figure's change reruns no emulation."""
+    frames.h5's range meter). Before the pixel model (sensor.frame_transforms, in this
+    order): each frame's time from the file `timestamps`, the frames within `window_s`
+    (start, stop) s, the rectangle `crop_px` (x, y, width, height), the output size
+    `size_px` (width, height). The event-frame picture is its own command (`picture
+    events`), so that a figure's change reruns no emulation."""
+    if not Path(output).parent.is_dir():
+        raise FileNotFoundError(f"events: -o {output}: the folder {Path(output).parent} does not exist")
     for option, value in (("fps", fps), ("white", white)):
         if value is not None and not value > 0:
             raise ValueError(f"events: {option}: expected a value > 0, got {value}")
@@ -239,6 +260,14 @@ def events_command(
     params, sensor = pixel_and_sensor(settings)
     chunk = CHUNK_FRAMES if chunk is None else chunk
     source = frame_source(input, chunk, fps, white, sensor, ahead=threads > 1)
+    if timestamps:
+        source = retime(source, read_timestamps(timestamps), f"--timestamps {timestamps}")
+    if window_s != (None, None):
+        source = time_window(source, *window_s)
+    if crop_px is not None:
+        source = crop(source, *crop_px)
+    if size_px is not None:
+        source = resize(source, *size_px)
     emulate_with_settings(source, params, settings, seed, output, str(input), chunk, threads)
     frames = str(input) if Path(input).suffix == ".h5" else None
     e = exports or {}
