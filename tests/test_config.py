@@ -185,7 +185,7 @@ def test_a_new_scenario_must_be_complete():
         resolve_config({"scenarios": {"hover": {"n_trajectories": 1}}})
 
 
-@pytest.mark.parametrize("name", ["logs", "figures"])
+@pytest.mark.parametrize("name", ["logs", "figures", "benchmarks", "tile_cache"])
 def test_reserved_scenario_names_are_refused(name):
     config = with_preset(default_config())
     config["scenarios"][name] = config["scenarios"]["descent"]

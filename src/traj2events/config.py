@@ -26,7 +26,7 @@ from .settings.tree import config_schema, default_config
 
 # Folders of results/ that are not scenarios: a scenario of that name would mix its
 # outputs with them.
-RESERVED_SCENARIO_NAMES = ("logs", "figures")
+RESERVED_SCENARIO_NAMES = ("logs", "figures", "benchmarks", "tile_cache")
 # Keys that moved, so that an older config gets their new place.
 MOVED_KEYS = {f"events.{key}": f"events.pixel.{key}"
               for key in ("refractory_s", "refractory_mode", "hot_pixel_fraction", "hot_pixel_hz")}  # fmt: skip
