@@ -94,3 +94,15 @@ def test_fields_and_frames_read_from_held_files_are_the_written_ones(tmp_path):
         landing.frame(5)
     with pytest.raises(ValueError, match=r"expected t_start_s <= t_end_s.*got 2.0, 1.0"):
         landing.events(2.0, 1.0)
+
+
+def test_another_library_may_register_the_hdf5_filters_again_while_files_are_held(tmp_path):
+    """evlib's import calls hdf5plugin.register(force=True), which HDF5 refuses while a Blosc
+    dataset is open: the loader lets its held files go first, then reads on."""
+    import hdf5plugin
+
+    events = random_events(n=300)
+    landing = landing_with_events(tmp_path / "0000", events)
+    before = landing.events(0.5, 2.0).tobytes()
+    hdf5plugin.register(force=True)  # raised "Unable to unregister filter" with the files held
+    assert landing.events(0.5, 2.0).tobytes() == before

@@ -22,6 +22,8 @@ can wrap `EventWindows` (map-style: `len` and `[i]`) without this module importi
 from __future__ import annotations
 
 import csv
+import functools
+import gc
 import os
 import threading
 from collections import OrderedDict
@@ -47,7 +49,33 @@ from .geometry.camera import camera_poses
 MAX_OPEN_FILES = 16
 Reader = TypeVar("Reader")
 _open_files: OrderedDict[tuple, object] = OrderedDict()
-_open_files_lock = threading.Lock()
+_open_files_lock = threading.RLock()  # (release_files may run inside held_open: a re-registering import)
+
+
+def release_files() -> None:
+    """Let go of every file this process holds open (each reopens at its next read)."""
+    with _open_files_lock:
+        _open_files.clear()  # h5py closes each once no one else holds it
+    gc.collect()  # (a reader in a reference cycle)
+
+
+def _release_before_filters_register() -> None:
+    """Another library's `hdf5plugin.register(force=True)` (evlib's import does it)
+    unregisters the Blosc filter first, which HDF5 refuses while a dataset that uses it is
+    open ("Unable to unregister filter"): the held files are let go first, so that both work."""
+    import hdf5plugin
+
+    register = hdf5plugin.register
+    if getattr(register, "releases_held_files", False):
+        return
+
+    @functools.wraps(register)
+    def releasing_register(*args, **kwargs):
+        release_files()
+        return register(*args, **kwargs)
+
+    releasing_register.releases_held_files = True
+    hdf5plugin.register = releasing_register
 
 
 def held_open(path: Path, reader: Callable[[Path], Reader]) -> Reader:
@@ -61,6 +89,7 @@ def held_open(path: Path, reader: Callable[[Path], Reader]) -> Reader:
     with _open_files_lock:
         held = _open_files.get(key)
         if held is None:
+            _release_before_filters_register()
             held = _open_files[key] = reader(path)
             while len(_open_files) > MAX_OPEN_FILES:
                 _open_files.popitem(last=False)  # closed by h5py once no thread reads from it
