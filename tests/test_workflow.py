@@ -217,6 +217,34 @@ def test_the_docs_tonic_example_runs_on_the_built_dataset(built):
     assert abs(total) <= abs(on_minus_off) + len(events) / 5 and np.sign(total) == np.sign(on_minus_off)
 
 
+@pytest.mark.slow
+def test_a_snakemake_alone_lints_and_dry_runs_the_workflow(tmp_path):
+    """As the workflow catalog lints it and `--sdm conda` drives it: a venv with Snakemake
+    only (no traj2events, no numpy) parses the workflow from the checkout's src/, lints it
+    and plans the smoke dataset's jobs with the same settings as the full install."""
+    import importlib.metadata
+
+    venv = tmp_path / "venv"
+    subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
+    version = importlib.metadata.version("snakemake")
+    install = subprocess.run([str(venv / "bin" / "pip"), "install", "-q", f"snakemake=={version}"],
+                             capture_output=True, text=True, timeout=900)  # fmt: skip
+    assert install.returncode == 0, install.stderr[-3000:]
+    numpy = subprocess.run([str(venv / "bin" / "python"), "-c", "import numpy"], capture_output=True)
+    assert numpy.returncode != 0  # the point: no numpy, no package
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "VIRTUAL_ENV")}
+    shutil.copy(ROOT / "config" / "smoke.yaml", tmp_path / "config.yaml")
+    alone = [str(venv / "bin" / "snakemake"), "-s", str(ROOT / "workflow" / "Snakefile"), "--directory",
+             str(tmp_path), "--configfile", str(tmp_path / "config.yaml"), "--cores", "2"]  # fmt: skip
+    lint = subprocess.run([*alone, "--lint"], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert lint.returncode == 0 and "good condition" in lint.stdout + lint.stderr, lint.stderr[-3000:]
+    planned = subprocess.run([*alone, "-n", "--printshellcmds"], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert planned.returncode == 0, planned.stderr[-3000:]
+    full = snakemake(tmp_path, "-n", "--printshellcmds")
+    commands = lambda out: sorted(line for line in out.splitlines() if line.startswith("Shell command: "))  # noqa: E731
+    assert commands(planned.stdout) == commands(full.stdout) and len(commands(full.stdout)) > 10
+
+
 def test_the_base_install_reads_the_dataset_without_the_pipeline(built, tmp_path):
     """`pip install` of the checkout without extras: numpy, h5py and hdf5plugin only, and the
     loader reads events, poses and a motion field; the command says what it lacks."""

@@ -18,6 +18,7 @@ from typing import Any
 import jsonschema
 import yaml
 
+from . import models_importable
 from .defaults import merge_config, with_preset
 from .settings.camera import lens_problems
 from .settings.declare import non_finite
@@ -221,6 +222,8 @@ def _semantic_errors(config: dict) -> list[str]:
     if timing["mode"] == "adaptive" and timing["max_fps"] <= config["camera"]["fps"]:
         errors.append(f"config key 'render.timing.max_fps': expected more than camera.fps = {config['camera']['fps']} "
                       f"(adaptive frames go between the camera's), got {timing['max_fps']}")  # fmt: skip
+    if errors or not models_importable():  # (a Snakemake alone: check-config and the jobs check these)
+        return errors
     sun_ranges_m = [sc["sun"]["range_m"] for sc in config["scenarios"].values()]
     errors += display_problems(config["render"], sun_ranges_m) + lens_problems(
         config["camera"], config["render"]["supersample"]

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import yaml
 
+from . import models_importable
+
 COSTS_PATH = Path(__file__).with_name("costs.yaml")
 COSTS = yaml.safe_load(COSTS_PATH.read_text())
 BYTES_PER_PX = COSTS["bytes_per_px"]  # per pixel per frame (per field written for the motion field)
@@ -137,15 +139,17 @@ def rendered_per_frame(config: dict) -> float:
 def render_s_per_frame(config: dict, pixels: int) -> float:
     """One core's seconds per rendered frame, encoders included (the preview's only with
     render.preview), and the stars a frame projects (beyond the default's few thousand, a
-    cost of its own: V 12 adds ~45 ms a frame). With render.supersample S, the per-pixel
-    part S^2 times (the encoders' share of it too: an estimate with a margin)."""
-    from .geometry.camera import Camera
-    from .scene.stars import stars_in_view
-
+    cost of its own: V 12 adds ~45 ms a frame; not counted where the models cannot run,
+    `models_importable`). With render.supersample S, the per-pixel part S^2 times (the
+    encoders' share of it too: an estimate with a margin)."""
     preview = 0.0 if config["render"]["preview"] else PREVIEW_S_PER_PX * pixels
-    stars = config["render"]["stars"]
-    camera = Camera(config["camera"]["width"], config["camera"]["height"], config["camera"]["fov_deg"])
-    star_s = STAR_S * stars_in_view(stars["magnitude_limit"], camera) if stars["enabled"] else 0.0
+    stars, star_s = config["render"]["stars"], 0.0
+    if stars["enabled"] and models_importable():
+        from .geometry.camera import Camera
+        from .scene.stars import stars_in_view
+
+        camera = Camera(config["camera"]["width"], config["camera"]["height"], config["camera"]["fov_deg"])
+        star_s = STAR_S * stars_in_view(stars["magnitude_limit"], camera)
     drawn = pixels * config["render"]["supersample"] ** 2
     return RENDER_S[0] + RENDER_S[1] * drawn - preview + star_s
 

@@ -106,11 +106,3 @@ def test_a_mounted_camera_stays_above_the_ground_at_touchdown_and_moves_with_the
     assert cam.intrinsics_attrs()["camera_mount_height_m"] == 3.0
     with pytest.raises(ValueError, match="mount_height_m"):
         Camera(32, 32, 45.0, mount_height_m=-1.0)
-
-
-def test_horizon_distance():
-    from traj2events.geometry.camera import horizon_distance_m
-
-    r_moon = 1737400.0  # the tangent from 2 km up: sqrt(2 R h + h^2)
-    assert horizon_distance_m(2000.0, 0.0, r_moon) == pytest.approx(np.sqrt(2 * r_moon * 2000 + 2000**2))
-    assert horizon_distance_m(2000.0, 100.0, r_moon) > horizon_distance_m(2000.0, 0.0, r_moon)

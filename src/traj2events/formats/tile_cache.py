@@ -38,8 +38,10 @@ import tempfile
 import time
 import zipfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:  # numpy is imported where an array is read or written: the workflow's DAG imports this module
+    import numpy as np
 
 FORMAT = 2  # bumped when the stored arrays change meaning or form (2: .npz with a CRC)
 STALE_S = 86400.0  # a temporary file older than this is a killed job's, whoever wrote it
@@ -61,9 +63,11 @@ class TileCache:
         level, i, j = key
         return self.folder / str(level) / f"{i}_{j}.npz"
 
-    def load(self, key: tuple[int, int, int], shape: tuple[int, ...], dtype=np.float64) -> np.ndarray | None:
+    def load(self, key: tuple[int, int, int], shape: tuple[int, ...], dtype="float64") -> np.ndarray | None:
         """The tile's stored array, or None (not stored, unreadable, damaged: its CRC-32 fails,
         or not `shape` and `dtype`): the caller builds it and saves it again."""
+        import numpy as np
+
         try:
             with np.load(self.path(key), allow_pickle=False) as stored:
                 array = stored["data"]
@@ -75,6 +79,8 @@ class TileCache:
         return array
 
     def save(self, key: tuple[int, int, int], array: np.ndarray) -> None:
+        import numpy as np
+
         if self._write(self.path(key), lambda f: np.savez(f, data=array)):
             self.n_written += 1
 

@@ -5,6 +5,7 @@ Read first (the model):
     distortion     the lens's radial-tangential distortion (OpenCV's model) and its inverse
     motion_field   the motion field's equations in numpy: flow, exact displacement, status
     range_meter    ELOPE's range meter: the slant range read at a fixed rate
+    horizon        how far a camera sees over the sphere (plain floats: the DAG computes it)
 
 Machinery a reader may skip:
     motion_pass    the same motion field in one compiled pass per field (numba), bit for bit

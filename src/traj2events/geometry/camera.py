@@ -247,10 +247,3 @@ def opengl_camera_to_world(pose: CameraPose) -> np.ndarray:
     matrix[:3, :3] = pose.rotation @ CAMERA_TO_OPENGL
     matrix[:3, 3] = pose.position
     return matrix
-
-
-def horizon_distance_m(altitude_m: float, relief_m: float, radius_m: float) -> float:
-    """Ground range beyond which terrain of height <= relief_m is hidden from a camera at
-    altitude_m: the two tangent distances to the sphere, camera's and the peaks'."""
-    a, r = max(altitude_m, 0.0), max(relief_m, 0.0)
-    return float(np.sqrt(a * (2 * radius_m + a)) + np.sqrt(r * (2 * radius_m + r)))

@@ -9,8 +9,6 @@ import json
 import math
 import os
 
-import numpy as np
-
 from . import pick, trajectory_rng
 from .declare import section, setting
 
@@ -158,6 +156,8 @@ def _modified(path: str) -> float:
 
 @functools.lru_cache(maxsize=256)
 def _extent(path: str, modified: float, settings_json: str) -> dict:
+    import numpy as np
+
     from ..stages.external_poses import external_samples
 
     samples, _ = external_samples(path, json.loads(settings_json))

@@ -7,7 +7,7 @@ import json
 import math
 from dataclasses import dataclass
 
-from ..geometry.camera import Camera, horizon_distance_m
+from ..geometry.horizon import horizon_distance_m
 from . import trajectory_rng
 from .camera import CameraSection
 from .declare import non_finite, section, setting
@@ -406,6 +406,7 @@ class RenderSettings:
         """(camera, tiles, sun, reflectance) ready for render.TerrainRenderer; `tile_cache`:
         the folder of the tile cache shared between jobs (None: none). The scene's modules are
         imported here, so that the settings import without them."""
+        from ..geometry.camera import Camera
         from ..scene.sun import Sun
         from ..scene.terrain import ProceduralTerrain, load_elevation_grid
         from ..scene.tiles import TileSet
@@ -441,7 +442,7 @@ class RenderSettings:
             return None
         return StarField.draw(float(self.stars["magnitude_limit"]), int(self.stars["seed"]))
 
-    def frame_attrs(self, camera: Camera, sun) -> dict:
+    def frame_attrs(self, camera, sun) -> dict:
         """The scene's description, stored with the frames."""
         return {
             "width": self.width,
