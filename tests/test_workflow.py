@@ -324,7 +324,7 @@ def test_the_overview_page_counts_what_was_built(built):
         with h5py.File(landing.folder / "events.h5") as f:
             n_events = len(f["events/t"])
         n_frames = len(landing.poses()[0])
-        assert f"<td>{n_events}</td>" in page and f"<td>{n_frames}</td>" in page
+        assert f"<td>{n_events:,}</td>" in page and f"<td>{n_frames:,}</td>" in page
         total_bytes += sum(p.stat().st_size for p in landing.folder.rglob("*") if p.is_file())
     assert f"{total_bytes / 1e6:.1f} MB on disk" in page
     assert f"{len(dataset)} trajectories" in page and "data:image/png;base64," in page

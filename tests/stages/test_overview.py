@@ -48,14 +48,23 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
     config = {"camera": {"width": 4, "height": 2}, "seed": 7}
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), tmp_path / "o.html")
     page = (tmp_path / "o.html").read_text()
-    assert "2 trajectories, 22 frames of 4 x 2 px, 2050 events" in page
+    assert "2 trajectories, 22 frames of 4 x 2 px, 2,050 events" in page  # numbers as people read them
     # Mean rate over the recorded second; per pixel over its 8 pixels; peak: 10 ms bins.
-    assert "<td>2000</td>" in page and "<td>250</td>" in page and "<td>2000</td>\n      <td>2000</td>" in page
+    assert "<td>2,000</td>" in page and "<td>250</td>" in page and "<td>2,000</td>\n      <td>2,000</td>" in page
     assert "<td>descent</td>\n      <td>2</td>\n      <td>22</td>" in page  # the scenario's row
     assert "&quot;seed&quot;: 7" in page and page.count("<table") == 5
+    assert page.count("<div class='scroll'><table") == 5 and "<details><summary>" in page  # scrolls; folded
+    assert "<a href='results/descent/0001/'>" in page  # each trajectory's folder, relative to the page
     # The diverts' table: one flown, none failed, its offset and added acceleration.
     assert "<td>divert</td>\n      <td>1</td>\n      <td>0</td>\n      <td>42</td>\n      <td>42</td>" in page
     assert "<td>0.75</td>" in page and "<td>file</td>" in page and "<td>OCP</td>" in page
     again = tmp_path / "again.html"
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), again)
     assert again.read_bytes() == (tmp_path / "o.html").read_bytes()
+
+
+def test_numbers_read_as_people_write_them():
+    from traj2events.stages.overview import readable
+
+    assert [readable(v) for v in (101362685, 2.431e5, 0.0421, 42.0, 1.5, float("nan"), "a<b")] == [
+        "101,362,685", "243,100", "0.0421", "42", "1.5", "", "a&lt;b"]  # fmt: skip

@@ -60,8 +60,27 @@ def trajectory_stats(folder: Path, names: list[str]) -> dict:
     }
 
 
-def _table(frame: pd.DataFrame) -> str:
-    return frame.to_html(index=False, border=0, classes="t", float_format=lambda v: f"{v:.4g}")
+def readable(value) -> str:
+    """A number as a person reads it: integers with thousands separators (101,362,685),
+    others to 3 significant digits, those of 1,000 and more whole (243,100); blank: NaN."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        return html.escape(str(value))
+    if isinstance(value, (int, np.integer)):
+        return f"{int(value):,}"
+    if not np.isfinite(value):
+        return ""
+    return f"{value:,.0f}" if abs(value) >= 1000 else f"{value:.3g}"
+
+
+def _table(frame: pd.DataFrame, links: str | None = None) -> str:
+    """A table that scrolls within the page when wider than it; `links`: a column of
+    relative paths, shown as links to them."""
+    shown = frame.copy()
+    formatters = {name: readable for name in shown.columns if name != links}
+    if links is not None:
+        formatters[links] = lambda path: f"<a href='{html.escape(path)}'>{html.escape(path)}</a>"
+    table = shown.to_html(index=False, border=0, classes="t", formatters=formatters, escape=False)
+    return f"<div class='scroll'>{table}</div>"
 
 
 def overview_html(
@@ -85,7 +104,8 @@ def overview_html(
     style = (
         "body{font-family:sans-serif;margin:1.5em;max-width:70em}table.t{border-collapse:collapse;font-size:90%}"
         "table.t td,table.t th{padding:2px 8px;text-align:right;border-bottom:1px solid #ddd}"
-        "pre{background:#f6f6f6;padding:1em;font-size:85%}"
+        ".scroll{overflow-x:auto}img{max-width:100%}"
+        "pre{background:#f6f6f6;padding:1em;font-size:85%;white-space:pre-wrap;overflow-wrap:anywhere}"
     )
     return "\n".join([
         "<!DOCTYPE html>", "<html><head><meta charset='utf-8'><title>traj2events dataset</title>",
@@ -94,21 +114,23 @@ def overview_html(
         f"<code>{html.escape(made['traj2events_commit'])}</code>; every file's root attributes name its version, "
         "commit and its stage's code fingerprint, docs/dataset.md \"Provenance\"): "
         f"{len(trajectories)} trajectories, "
-        f"{int(trajectories['frames'].sum())} frames of {html.escape(str(config['camera']['width']))} x "
-        f"{html.escape(str(config['camera']['height']))} px, {int(trajectories['events'].sum())} events, "
+        f"{readable(int(trajectories['frames'].sum()))} frames of {html.escape(str(config['camera']['width']))} x "
+        f"{html.escape(str(config['camera']['height']))} px, {readable(int(trajectories['events'].sum()))} events, "
         f"{trajectories['MB'].sum():.1f} MB on disk (docs/dataset.md describes every file).</p>",
         "<h2>Per scenario</h2>", _table(per_scenario),
         "<h2>Event rate</h2>", f"<img alt='event rate over each flight' src='data:image/png;base64,{image}'>",
         f"<p>Events per second in {RATE_BIN_MS} ms bins (the paper's event-frame window) against the flight's "
         "normalised time, one line per trajectory; bins without events drawn at 1.</p>",
-        "<h2>Per trajectory</h2>", _table(trajectories),
+        "<h2>Per trajectory</h2><p>Each row's folder holds its files (frames.png, events.png: "
+        "its pictures).</p>", _table(trajectories, links="folder" if "folder" in trajectories else None),
         *(["<h2>Diverts and hovers</h2><p>Per scenario and kind: flown, failed (the sample's flight kept), and the "
            "median and largest of each statistic over the flown ones (index.csv's columns, docs/dataset.md).</p>",
            _table(manoeuvres)] if manoeuvres is not None and len(manoeuvres) else []),
         "<h2>Bytes on disk per kind of file</h2>", _table(sizes),
         "<h2>Solves (summary.csv)</h2>", _table(summary),
-        "<h2>Configuration</h2><p>The resolved config (defaults.yaml with the overlays), as the jobs got it.</p>",
-        f"<pre>{html.escape(json.dumps(config, indent=1, sort_keys=True))}</pre>",
+        "<h2>Configuration</h2><details><summary>The resolved config (defaults.yaml with the overlays), as the "
+        "jobs got it</summary>",
+        f"<pre>{html.escape(json.dumps(config, indent=1, sort_keys=True))}</pre></details>",
         "</body></html>", "",
     ])  # fmt: skip
 
@@ -140,6 +162,7 @@ def dataset_overview(
                 "peak_events_per_s": stats["peak_rate"],
                 "events_per_pixel_s": stats["mean_rate"] / stats["pixels"],
                 "MB": sum(stats["bytes"].values()) / 1e6,
+                "folder": Path(os.path.relpath(folder, Path(output).parent)).as_posix() + "/",
             })  # fmt: skip
     if not rows:
         raise ValueError(f"overview: {', '.join(map(str, indexes))} list no trajectory")
