@@ -1,16 +1,25 @@
 """Shared fixtures: the default vehicle, small problems that solve in well under a second;
 the order the files run in."""
 
+import os
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from traj2events.trajectory.dynamics import Dynamics, Vehicle
 from traj2events.trajectory.ocp import BoundaryConditions, LandingProblem, OcpSettings
 
 ROOT = Path(__file__).resolve().parents[1]
+
+# The numerical-stability search (docs/accuracy.md): derandomized and bounded in the suite
+# (the same examples every run, each law's search well under a second); HYPOTHESIS_PROFILE=long
+# searches a hundred times longer, on demand.
+settings.register_profile("ci", derandomize=True, max_examples=300, deadline=None, print_blob=True)
+settings.register_profile("long", max_examples=30_000, deadline=None, print_blob=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
 def landing_bc(downrange=1500.0, altitude=600.0, speed=15.0, pitch_deg=5.0, mass=Vehicle().mass_kg, tf_guess=50.0):

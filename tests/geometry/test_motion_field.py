@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from traj2events.geometry.camera import Camera, camera_motion, camera_pose
@@ -519,3 +521,32 @@ def test_the_numpy_fields_follow_the_lens_too():
     h = inverse_depth_sphere(*cam.rays(), *local_vertical(pose.position, pose.rotation, R))
     from_depth, _ = depth_flow(cam, state, np.where(h > 0, 1.0 / np.where(h > 0, h, 1.0), 0.0))
     np.testing.assert_allclose(from_depth[terrain], flow[terrain], rtol=1e-9, atol=1e-9)
+
+
+@given(st.floats(1e-3, 2e5), st.floats(-1, 1), st.floats(-1, 1), st.floats(0, 1), st.floats(-2, 2), st.floats(-2, 2),
+       st.sampled_from([np.float64, np.float32]))  # fmt: skip
+def test_the_spheres_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h, nx, ny, nz, a, b, dtype):
+    """Its stated bound (docs/accuracy.md): relative error <= 4 eps kappa, kappa the dot's
+    condition (grazing rays) plus the limb's, (R+H)^2 A^2 / D, from 1 mm to 200 km up."""
+    import mpmath as mp
+    from hypothesis import assume
+
+    n = np.array([nx, ny, nz])
+    assume(np.linalg.norm(n) > 1e-3)
+    n, radius = n / np.linalg.norm(n), 1737400.0
+    got = float(inverse_depth_sphere(np.array([[a]], dtype), np.array([[b]], dtype), n, h, radius)[0, 0])
+    with mp.workdps(50):  # the same rounded inputs the code sees, then exact arithmetic
+        a_, b_ = mp.mpf(float(dtype(a))), mp.mpf(float(dtype(b)))
+        alpha, beta, gamma = (mp.mpf(float(dtype(c))) for c in n)
+        big, k = mp.mpf(radius) + h, mp.mpf(h) * (2 * mp.mpf(radius) + h)
+        dot = alpha * a_ + beta * b_ + gamma
+        disc = big**2 * dot**2 - (a_**2 + b_**2 + 1) * k
+        eps, magnitude = np.finfo(dtype).eps, abs(alpha * a_) + abs(beta * b_) + abs(gamma)
+        if abs(dot) <= 8 * eps * magnitude or abs(disc) <= 8 * eps * big**2 * dot**2:
+            return  # along the horizon or the limb to within the inputs' rounding: hit or sky, both right
+        if disc < 0 or dot < 0:
+            assert got == 0.0  # a ray that misses the sphere is sky
+            return
+        reference = (big * dot + mp.sqrt(disc)) / k
+        kappa = magnitude / dot + big**2 * dot**2 / disc
+        assert got > 0 and float(abs(got - reference) / reference) <= 4 * eps * float(kappa)

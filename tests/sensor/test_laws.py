@@ -3,6 +3,8 @@ the lin-log response), and the compiled kernels computing the very same values."
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from traj2events.sensor.laws import (
     KNEE_DN,
@@ -75,3 +77,27 @@ def test_the_shot_noise_rate_is_v2es_gain_times_the_nominal_over_the_pixels_thre
                                np.array([0.25, 0.25, 0.2]), 0.25)  # fmt: skip
     assert np.allclose(rates, [5.0 * (1 - 0.75 * 20 / 275), 5.0 * 0.25, 5.0 * (1 - 0.75 * 20 / 275) * 1.25])
     assert shot_noise_rate_hz(400.0, 5.0, 0.25, 0.25, 0.25) == 0.0  # no noise above 346 DN
+
+
+@given(st.floats(0, 1e6), st.floats(1e-3, 1e4), st.floats(1e-9, 10.0))
+def test_the_low_pass_gain_is_within_2_ulp_of_a_50_digit_reference(intensity_dn, cutoff_hz, dt_s):
+    """eps = -expm1(-2 pi f_c(I) dt), no cancellation for small steps (dt -> 0: eps ~ 2 pi f_c dt)
+    nor rounding to 1 for large ones (docs/accuracy.md)."""
+    import mpmath as mp
+
+    got = float(lowpass_gain(np.array([intensity_dn]), cutoff_hz, dt_s)[0])
+    with mp.workdps(50):
+        reference = -mp.expm1(-2 * mp.pi * mp.mpf(dt_s) * mp.mpf(cutoff_hz) * (mp.mpf(intensity_dn) + 20) / 275)
+        assert float(abs(got - reference)) <= 2 * np.finfo(float).eps * float(reference)
+
+
+@given(st.floats(0, 1e12))
+def test_the_log_response_is_within_2_ulp_of_a_50_digit_reference(intensity_dn):
+    """L(I) = I ln 20 / 20 up to the 20 DN knee, ln I above, continuous there (docs/accuracy.md)."""
+    import mpmath as mp
+
+    got = float(log_intensity_8bit(np.array([intensity_dn]))[0])
+    with mp.workdps(50):
+        i = mp.mpf(intensity_dn)
+        reference = i * mp.log(20) / 20 if intensity_dn <= 20 else mp.log(i)
+        assert float(abs(got - reference)) <= 2 * np.finfo(float).eps * max(float(abs(reference)), 1.0)
