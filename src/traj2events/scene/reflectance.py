@@ -32,7 +32,8 @@ MODELS = REFLECTANCE_MODELS
 
 
 def chandrasekhar_h(x: np.ndarray, w: float) -> np.ndarray:
-    """Hapke (2002) approximation of Chandrasekhar's H function (error < 1 %)."""
+    """Hapke (2002) approximation of Chandrasekhar's H function: within 1 % of the exact H
+    for x 1e-4..1 and w up to 0.999 (worst 0.96 % at w 0.99, x 1; docs/accuracy.md)."""
     x = np.asarray(x, dtype=float)
     gamma = np.sqrt(1.0 - w)
     r0 = (1.0 - gamma) / (1.0 + gamma)
