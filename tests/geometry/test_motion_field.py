@@ -550,3 +550,16 @@ def test_the_spheres_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h
         reference = (big * dot + mp.sqrt(disc)) / k
         kappa = magnitude / dot + big**2 * dot**2 / disc
         assert got > 0 and float(abs(got - reference) / reference) <= 4 * eps * float(kappa)
+
+
+@given(st.floats(-2e5, 2e5), st.floats(-2e5, 2e5), st.floats(1e-3, 2e5))
+def test_the_height_above_the_sphere_is_within_4_eps_of_a_50_digit_reference(x, y, height_m):
+    """Its stated bound (docs/accuracy.md): the camera's height above the sphere to 4 eps
+    relative, from 1 mm to 200 km up and 200 km out (|p - c| - R would keep no digit at 1 mm)."""
+    import mpmath as mp
+
+    radius = 1737400.0
+    _, got = local_vertical(np.array([x, y, -height_m]), np.eye(3), radius)
+    with mp.workdps(50):
+        reference = mp.sqrt(mp.mpf(x) ** 2 + mp.mpf(y) ** 2 + (radius + mp.mpf(height_m)) ** 2) - radius
+        assert float(abs(got - reference) / reference) <= 4 * np.finfo(float).eps
