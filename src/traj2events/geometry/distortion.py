@@ -108,9 +108,9 @@ class Distortion:
 
     def radially_monotonic(self, r_max: float) -> bool:
         """Whether the distorted radius grows with the pinhole's over [0, r_max]:
-        d(r radial)/dr = 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6 > 0 (the tangential terms apart)."""
-        r2 = np.linspace(0.0, r_max, 2001) ** 2
-        return bool(np.all(1.0 + r2 * (3.0 * self.k1 + r2 * (5.0 * self.k2 + 7.0 * r2 * self.k3)) > 0))
+        d(r radial)/dr = 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6 > 0 (the tangential terms apart),
+        that is r_max within the fold radius."""
+        return bool(r_max * r_max < _fold_radius2(self.k1, self.k2, self.k3, max(r_max * r_max, _FOLD_SEARCH_R2)))
 
     def determinant(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """det d(a_d, b_d)/d(a, b): > 0 where the lens keeps the image's orientation."""
@@ -126,23 +126,31 @@ _FOLD_SEARCH_R2 = 100.0
 
 
 @functools.lru_cache(maxsize=64)
-def _fold_radius2(k1: float, k2: float, k3: float) -> float:
-    """The first zero of g(s) = 1 + 3 k1 s + 5 k2 s^2 + 7 k3 s^3 on (0, 100]: its first sign
-    change on a fine grid, then bisection (robust to tiny and zero coefficients, as a
-    polynomial root finder is not)."""
+def _fold_radius2(k1: float, k2: float, k3: float, s_max: float = _FOLD_SEARCH_R2) -> float:
+    """The first zero of g(s) = 1 + 3 k1 s + 5 k2 s^2 + 7 k3 s^3 on (0, s_max] (inf: none).
+    g is monotonic between its critical points (the roots of g' = 3 k1 + 10 k2 s + 21 k3 s^2),
+    so its first zero lies in the first of those pieces whose end is not above 0, found there
+    by bisection: exact, and robust to tiny and zero coefficients, as a polynomial root
+    finder is not."""
 
     def g(s):
         return 1.0 + s * (3.0 * k1 + s * (5.0 * k2 + 7.0 * k3 * s))
 
-    s = np.linspace(0.0, _FOLD_SEARCH_R2, 20001)
-    below = np.flatnonzero(g(s) <= 0.0)
-    if not below.size:
-        return np.inf
-    lo, hi = float(s[below[0] - 1]), float(s[below[0]])
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if g(mid) > 0.0 else (lo, mid)
-    return lo
+    with np.errstate(all="ignore"):  # a tiny leading coefficient puts a critical point at +-inf
+        a, b, c = 21.0 * k3, 10.0 * k2, 3.0 * k1
+        if a != 0.0:
+            disc = b * b - 4.0 * a * c
+            critical = [(-b - np.sqrt(disc)) / (2 * a), (-b + np.sqrt(disc)) / (2 * a)] if disc >= 0 else []
+        else:
+            critical = [-c / b] if b != 0.0 else []
+    knots = sorted({0.0, s_max, *(float(x) for x in critical if 0.0 < x < s_max)})
+    for lo, hi in zip(knots, knots[1:]):
+        if g(hi) <= 0.0:  # g(lo) > 0 (g(0) = 1, and each earlier piece ended above 0)
+            for _ in range(80):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if g(mid) > 0.0 else (lo, mid)
+            return lo
+    return np.inf
 
 
 def distortion_from(config_value: dict | None) -> Distortion:
