@@ -12,9 +12,8 @@ from ..formats.exports import write_euroc_imu, write_euroc_poses, write_tum
 from ..formats.hdf5 import open_file
 from ..formats.imu import read_imu
 from ..formats.trajectory import read_trajectory
-from ..geometry.camera import camera_poses
+from ..geometry.camera import camera_motion, camera_poses
 from ..progress import log
-from ..trajectory.state import BODY_RATES, VELOCITY
 
 
 def trajectory_camera(trajectory: str | os.PathLike):
@@ -30,10 +29,9 @@ def trajectory_camera(trajectory: str | os.PathLike):
         else:
             raise ValueError(f"{trajectory}: no camera/ group and no camera_mount_height_m (written before either)")
     position, quaternion, matrix = camera_poses(tr.state, mount)
-    # The camera's velocity in the world frame: v + R_iv (omega x mount), the lever arm's share.
-    lever = np.cross(tr.state[:, BODY_RATES], np.array([0.0, 0.0, -mount]))
-    velocity = tr.state[:, VELOCITY] + np.einsum("kij,kj->ki", matrix[:, :3, :3], lever)
-    return tr.t, position, quaternion, velocity
+    # The camera's own velocity (camera_motion's, the lever arm's share in), in the world frame.
+    velocity = np.array([r @ camera_motion(state, mount)[0] for r, state in zip(matrix[:, :3, :3], tr.state)])
+    return tr.t, position, quaternion, velocity.reshape(-1, 3)
 
 
 def export_poses(
