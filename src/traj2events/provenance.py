@@ -28,19 +28,19 @@ UNKNOWN = "unknown"  # no git tree, and none recorded at install
 def commit() -> str:
     """The commit the package runs from: 40 hex digits, "-dirty" appended when tracked
     files differ from it; `UNKNOWN` when it is neither a checkout nor recorded."""
-    source = Path(__file__).resolve().parent
     try:
-
-        def git(*args: str) -> str:
-            return subprocess.run(["git", "-C", str(source), *args], capture_output=True, text=True, check=True,
-                                  timeout=10).stdout.strip()  # fmt: skip
-
-        git("ls-files", "--error-unmatch", "__init__.py")  # a checkout's own file, not one installed in a repo's venv
-        dirty = git("status", "--porcelain", "--untracked-files=no")
-        return git("rev-parse", "HEAD") + ("-dirty" if dirty else "")
+        _git("ls-files", "--error-unmatch", "__init__.py")  # a checkout's own file, not one installed in a repo's venv
+        dirty = _git("status", "--porcelain", "--untracked-files=no")
+        return _git("rev-parse", "HEAD") + ("-dirty" if dirty else "")
     except (OSError, subprocess.SubprocessError):
-        pass
-    return _installed_commit()
+        return _installed_commit()
+
+
+def _git(*args: str) -> str:
+    """git's answer, run in the package's own folder."""
+    source = Path(__file__).resolve().parent
+    return subprocess.run(["git", "-C", str(source), *args], capture_output=True, text=True, check=True,
+                          timeout=10).stdout.strip()  # fmt: skip
 
 
 def _installed_commit() -> str:
