@@ -111,8 +111,7 @@ def external_pose_defaults(config: dict, name: str) -> dict:
 
 
 # The numbers of external_pose_settings, each as its config key declares it.
-EXTERNAL_POSE_KEYS = {"fps": ("camera", "fps"), "mount_height_m": ("camera", "mount_height_m"),
-                      "moon_radius_m": ("motion_field", "moon_radius_m"), "g_m_s2": ("vehicle", "g_m_s2")}  # fmt: skip
+EXTERNAL_POSE_KEYS = {key: tuple(path.split(".")) for key, path in EXTERNAL_POSES.items() if key != "seed"}
 
 
 def check_external_pose_settings(settings: object) -> dict:
