@@ -193,6 +193,22 @@ def test_reserved_scenario_names_are_refused(name):
         validate_config(config)
 
 
+@pytest.mark.parametrize("kind, manoeuvre", [
+    ("divert", {"time_fraction": [0.3, 0.5], "offset_m": [20.0, 1.0e6], "direction_deg": [0.0, 90.0]}),
+    ("hover", {"altitude_m": [20.0, 30.0], "duration_s": [1.0, 2.0], "offset_m": [9000.0, 9000.0],
+               "direction_deg": [0.0, 90.0]}),
+])  # fmt: skip
+def test_a_manoeuvre_beyond_the_flights_reach_is_refused(kind, manoeuvre):
+    # The descent starts at most ~2501 m from the site (50 m down-range, 20 m cross, 2500 m up).
+    config = with_preset(default_config())
+    config["scenarios"]["descent"][kind] = manoeuvre
+    reach = "expected at most the flight's reach, 2501 m"
+    with pytest.raises(ConfigError, match=rf"scenarios.descent.{kind}.offset_m': {reach}"):
+        validate_config(config)
+    config["scenarios"]["descent"][kind]["offset_m"] = [20.0, 2400.0]
+    validate_config(config)
+
+
 def test_non_utf8_and_non_mapping_configs_are_named(tmp_path):
     latin = tmp_path / "latin.yaml"
     latin.write_bytes("seed: 1 # caf\xe9\n".encode("latin-1"))

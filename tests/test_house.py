@@ -16,13 +16,13 @@ TESTS = ROOT / "tests"
 # only shrinks. A module that gets a test file must leave it.
 WITHOUT_TEST_FILE = {
     "defaults", "memory", "progress", "formats/atomic", "formats/exports", "formats/flow", "formats/imu",
-    "formats/poses", "formats/rounding", "formats/spice", "geometry/motion_pass", "renderer/camera_matrices",
+    "formats/rounding", "formats/spice", "geometry/motion_pass", "renderer/camera_matrices",
     "renderer/context", "renderer/law_uniforms", "renderer/lens", "renderer/shading_array", "scene/populations",
     "scene/sun", "scene/terrain_kernels", "scene/view", "sensor/noise", "sensor/ordering", "sensor/parallel",
     "settings/camera", "settings/events", "settings/generate", "settings/imu", "settings/poses",
     "settings/solve", "settings/tree", "settings/vehicle", "stages/base_solution", "stages/camera_poses",
     "stages/imu", "stages/index", "stages/motion_field", "stages/pictures", "stages/render",
-    "stages/render_events", "stages/sample_trajectories", "stages/summary", "trajectory/external",
+    "stages/render_events", "stages/sample_trajectories", "trajectory/external",
     "trajectory/flight", "trajectory/legs",
 }  # fmt: skip
 

@@ -643,9 +643,14 @@ def test_invalid_config_stops_before_any_job(tmp_path):
     [
         ({"render": {"tile_cache": "/proc/nonexistent/cache"}}, "render.tile_cache: cannot create a file in /proc"),
         ({"camera": {"width": 6144, "height": 6144}}, "the dataset does not fit: ~"),  # 32 TB planned (< 50)
+        ({"events": {"device": "cuda"}}, "events.device: cuda: numba finds no usable NVIDIA GPU here"),
     ],
 )
 def test_what_the_working_directory_cannot_give_stops_before_any_job(tmp_path, change, message):
+    from traj2events.sensor.emulator import device_problem
+
+    if "cuda" in message and not device_problem("cuda"):
+        pytest.skip("this machine has a GPU")
     config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
     config["scenarios"]["descent"]["n_trajectories"] = 20
     for key, value in change.items():
@@ -658,6 +663,21 @@ def test_what_the_working_directory_cannot_give_stops_before_any_job(tmp_path, c
     refused = "does not fit" not in message
     assert (dry.returncode != 0) == refused and message in dry.stdout + dry.stderr, dry.stderr[-2000:]
     assert refused or "warning: a run (not a dry run) stops here" in dry.stderr
+
+
+def test_unlock_is_refused_while_a_run_lives_in_the_folder(tmp_path):
+    # The README's recovery typed beside a live run would let the two delete each other's files.
+    (tmp_path / "config.yaml").write_text((ROOT / "config" / "smoke.yaml").read_text())
+    (tmp_path / "snakemake").write_text("import time\ntime.sleep(60)\n")
+    live = subprocess.Popen([sys.executable, str(tmp_path / "snakemake")], cwd=tmp_path)
+    try:
+        run = snakemake(tmp_path, "--unlock", check=False)
+        assert run.returncode != 0 and f"a run is still alive here (pid {live.pid}:" in run.stderr, run.stderr[-2000:]
+    finally:
+        live.kill()
+        live.wait()
+    done = snakemake(tmp_path, "--unlock")
+    assert "Unlocked working directory" in done.stdout + done.stderr
 
 
 def test_a_config_file_that_is_not_utf8_is_named(tmp_path):

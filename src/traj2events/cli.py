@@ -40,6 +40,8 @@ def cmd_check_config(args) -> int:
     plan = dataset_plan(config)
     print(f"{', '.join(args.config)}: valid ({len(config['scenarios'])} scenarios, {plan.trajectories} trajectories)")
     print(plan.summary())
+    if problem := importlib.import_module(".sensor.emulator", __package__).device_problem(config["events"]["device"]):
+        print(f"warning: {problem} (a run here is refused; a cluster's GPU jobs may have one)")
     return 0
 
 
@@ -270,6 +272,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--config", required=True, help="the resolved config as JSON (the workflow passes its own)")
     p.add_argument("--output", "-o", required=True, help="overview.html")
     p.set_defaults(func=_calls("overview", "dataset_overview", "indexes", "summary", "config", "output"))
+
     return parser
 
 

@@ -113,6 +113,14 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
     for key, (lo, hi) in [(key, sc[key]) for key in RANGE_KEYS] + sun + manoeuvres:
         if lo > hi:
             errors.append(f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}")
+    # A re-target farther than the flight starts from the site is no re-target: its
+    # re-solve would fail in every job after the upstream ones ran.
+    reach_m = math.dist((0, 0, 0), [max(map(abs, sc[k])) for k in ("downrange_m", "crossrange_m", "altitude_m")])
+    for kind in kinds:
+        if sc[kind]["offset_m"][1] > reach_m:
+            errors.append(f"config key 'scenarios.{name}.{kind}.offset_m': expected at most the flight's reach, "
+                          f"{reach_m:.4g} m (the largest start's distance from the site: downrange_m, crossrange_m, "
+                          f"altitude_m), got {sc[kind]['offset_m']}")  # fmt: skip
     tilt = config["vehicle"]["tilt_max_deg"]
     roll, pitch = (math.radians(max(map(abs, sc[k]))) for k in ("roll_deg", "pitch_deg"))
     if math.cos(roll) * math.cos(pitch) < math.cos(math.radians(tilt)):

@@ -184,3 +184,26 @@ def test_a_damaged_file_is_refused_naming_it_or_reads_back_the_same(tmp_path):
         assert all(np.array_equal(got[k], v) for k, v in arrays.items()), position
         outcomes["same"] += 1
     assert outcomes["refused"] > 100 and outcomes["same"] > 10
+
+
+def test_a_full_disk_is_an_error_naming_the_file_before_hdf5_writes(tmp_path, monkeypatch):
+    # HDF5 cannot recover from a write that fails on a full disk (it may crash at exit, and
+    # the job's log stays empty): every dataset and chunk is checked first, with room left
+    # for the log and the writer's clean close.
+    import shutil
+    from collections import namedtuple
+
+    from traj2events.formats import atomic
+    from traj2events.formats.hdf5 import write_dataset
+
+    usage = namedtuple("usage", "total used free")
+    free = atomic.FREE_SPACE_MARGIN_BYTES + 4096
+    monkeypatch.setattr(atomic.shutil, "disk_usage", lambda _: usage(1 << 30, 1 << 30, free))
+    with create(tmp_path / "x.h5") as f:
+        write_dataset(f, "scalar", np.float64(1.0))  # nothing to speak of: a margin's worth is free
+        with pytest.raises(OSError, match=r"x.h5: cannot write \(No space left on device"):
+            write_dataset(f, "a", np.zeros(1024))
+        dataset = f.create_dataset("b", shape=(2, 4096), dtype=np.float32, chunks=(1, 4096), **blosc())
+        with pytest.raises(OSError, match=r"x.h5: cannot write"):
+            ChunkWriter(dataset)[0] = np.zeros(4096, np.float32)
+    monkeypatch.setattr(atomic.shutil, "disk_usage", shutil.disk_usage)

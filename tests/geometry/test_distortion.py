@@ -89,6 +89,22 @@ def test_a_lens_that_folds_over_inside_the_image_is_refused_naming_the_key(tmp_p
         distortion_from({"k4": 0.1})
 
 
+@pytest.mark.parametrize("k1, refused", [(100.0, True), (30.0, True), (0.5, False)])
+def test_a_pincushion_beyond_any_lens_is_refused_by_the_field_it_keeps(k1, refused):
+    """A pincushion's widest ray is through the middle of an edge: at r_d = tan(22.5 deg) in a
+    45 deg square image, its ray at the r solving r (1 + k1 r^2) = r_d, so that the image
+    sees r / r_d of the field camera.fov_deg names along its axes."""
+    r_d = np.tan(np.radians(22.5))
+    r = min(root.real for root in np.roots([k1, 0.0, 1.0, -r_d]) if abs(root.imag) < 1e-12 and root.real > 0)
+    camera = Camera(128, 128, 45.0, 0.0, Distortion(k1=k1))
+    assert (r / r_d < 0.5) == refused
+    if refused:
+        with pytest.raises(ValueError, match=rf"camera\.distortion: .* shrinks .* field to {r / r_d:.2g} of"):
+            camera.pinhole_cover()
+    else:
+        assert camera.pinhole_cover().width < camera.width  # a pincushion's cover is the smaller
+
+
 @pytest.mark.parametrize("lens", LENSES.values(), ids=LENSES)
 def test_pinhole_cover_holds_every_ray_at_the_same_focal_length(lens):
     camera = Camera(200, 150, 60.0, 0.0, lens)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from snakemake.settings.types import DeploymentMethod
 
+from traj2events import models_importable
 from traj2events.config import ConfigError, resolve_config, too_large_reason
 from traj2events.fingerprint import code_fingerprint
 from traj2events.formats.tile_cache import unusable as tile_cache_unusable
@@ -18,6 +19,7 @@ from traj2events.plan import dataset_plan, disk_shortfall, job_resources
 from traj2events.settings.events import EXPORT_SUFFIX
 from traj2events.settings.jobs import job_settings_json
 from traj2events.settings.poses import is_external, scenario_count, trajectory_source
+from traj2events.unlock import unlock_problem
 
 # A dataset too large to build is refused by the real run only (`refuse_too_large`, the
 # Snakefile's onstart, which a dry run skips): `snakemake -n` prints its plan and a warning.
@@ -62,7 +64,16 @@ def check_working_directory():
     folder (every render job would fail on it)."""
     if config["render"]["tile_cache"] and (unusable := tile_cache_unusable(config["render"]["tile_cache"])):
         raise WorkflowError(f"invalid configuration: render.tile_cache: {unusable}")
+    # A GPU the jobs need but this machine lacks; a cluster's jobs run where the GPUs are.
+    if workflow.local_exec and models_importable():
+        from traj2events.sensor.emulator import device_problem
 
+        if problem := device_problem(config["events"]["device"]):
+            raise WorkflowError(f"invalid configuration: {problem}")
+
+
+if "--unlock" in sys.argv and (problem := unlock_problem()):
+    raise WorkflowError(f"--unlock refused: {problem}")
 
 # By the controller only: a job that runs the workflow again (a group's, on SLURM) would walk
 # results/ in every submission, and could refuse itself as the disk fills as planned.

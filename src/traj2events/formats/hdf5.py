@@ -14,6 +14,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from .atomic import ensure_free_space
+
 # What a reader needs, in every file's root attributes (docs/dataset.md "Reading the files
 # without Python"): gzip by default; files with Blosc datasets say so (mark_blosc).
 GZIP_READING = {
@@ -83,6 +85,7 @@ def write_dataset(group: h5py.Group, name: str, data: np.ndarray) -> None:
     """A dataset, gzip-4 + shuffle when larger than 1024 values, with HDF5's Fletcher-32
     checksum (a reader then tells damaged values from good ones) unless it is a scalar."""
     data = np.asarray(data)
+    ensure_free_space(group.file.filename, data.nbytes)  # a full disk: an error, not HDF5's crash
     kwargs = {"compression": "gzip", "compression_opts": 4, "shuffle": True} if data.size > 1024 else {}
     checksum = {"fletcher32": True} if data.ndim and data.size else {}
     group.create_dataset(name, data=data, track_times=False, **kwargs, **checksum)
@@ -318,6 +321,7 @@ class ChunkWriter:
             raise ValueError(
                 f"{self.dataset.name}: expected an item of shape {self.dataset.shape[1:]}, got {data.shape}"
             )
+        ensure_free_space(self.dataset.file.filename, data.nbytes)  # a full disk: an error, not HDF5's crash
         chunk = None if self._codec is None else self._codec.compress(data, *self._parameters, self._buffer)
         if chunk is None:  # not Blosc, no library, or incompressible: HDF5's pipeline writes it
             self.dataset[i] = data

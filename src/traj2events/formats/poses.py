@@ -88,6 +88,11 @@ def _read_csv(path: str | os.PathLike) -> PoseSamples:
         values = table.astype(float)
     except ValueError as exc:
         raise FileFormatError(f"{path}: expected numbers in every column: {exc}") from None
+    missing_values = values.isna().to_numpy()
+    if missing_values.any():  # a row cut short or a field left empty: named by its line
+        row, column = np.argwhere(missing_values)[0]
+        raise FileFormatError(f"{path}: line {row + 2} has no number in column {table.columns[column]} (empty, cut "
+                              "short or NaN): expected a number in every column of every row")  # fmt: skip
     if attitude:
         q = values[list(QUATERNION_COLUMNS)].to_numpy()
     else:

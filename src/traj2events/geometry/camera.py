@@ -32,6 +32,8 @@ from ..trajectory.state import (
 )
 from .distortion import MODEL, PINHOLE, Distortion, distortion_from
 
+MIN_FIELD_FRACTION = 0.5  # of the nominal field a distorted image may still see (pinhole_cover)
+
 
 @dataclass(frozen=True)
 class Camera:
@@ -137,6 +139,15 @@ class Camera:
             raise ValueError(
                 f"camera.distortion: {self.distortion} needs a {width} x {height} pinhole image to cover "
                 f"the {self.width} x {self.height} sensor (more than 4x its size): a lens this strong is not modelled"
+            )
+        # A pincushion that strong would see less than half the field camera.fov_deg names:
+        # beyond any lens the model describes (real ones stay within ~10 % at the corners).
+        shrink = min(a_max * f / (self.width / 2), b_max * f / (self.height / 2))
+        if shrink < MIN_FIELD_FRACTION:
+            raise ValueError(
+                f"camera.distortion: {self.distortion} shrinks the {self.width} x {self.height} image's field to "
+                f"{shrink:.2g} of what camera.fov_deg = {self.fov_deg} gives (expected at least "
+                f"{MIN_FIELD_FRACTION}): a lens this strong is not modelled (smaller coefficients)"
             )
         fov = float(np.degrees(2.0 * np.arctan(width / (2.0 * f))))
         return Camera(width, height, fov, self.mount_height_m)

@@ -200,11 +200,6 @@ class CudaPixels:
     """The emulator's per-pixel state on the GPU, and one frame interval's three launches."""
 
     def __init__(self, theta_on, theta_off, leak_step, majorants, hot_pixels, labels: bool) -> None:
-        if not cuda.is_available():
-            raise RuntimeError(
-                "events.device: cuda: numba finds no usable NVIDIA GPU here (a driver, and `pip install "
-                "traj2events[gpu]` for numba-cuda); set events.device: cpu to emulate on the CPUs"
-            )
         n = theta_on.size
         self.n = n
         self.thresholds = Thresholds(*(cuda.to_device(a) for a in (theta_on, theta_off, leak_step)))

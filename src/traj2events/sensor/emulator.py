@@ -59,6 +59,22 @@ _NO_PIXELS = np.empty(0, np.int64)
 DEVICES = ("cpu", "cuda")
 
 
+def device_problem(device: str) -> str | None:
+    """Why `device` cannot run the pixel model on this machine (None: it can): the
+    workflow asks before any job, a cluster's login node aside (its GPU jobs run elsewhere)."""
+    if device != "cuda":
+        return None
+    try:
+        from numba import cuda
+
+        if cuda.is_available():
+            return None
+    except ImportError:
+        pass
+    return ("events.device: cuda: numba finds no usable NVIDIA GPU here (a driver, and `pip install "
+            "traj2events[gpu]` for numba-cuda); set events.device: cpu to emulate on the CPUs")  # fmt: skip
+
+
 class EventEmulator:
     """Streaming emulator for frames of a fixed size; see the module docstring."""
 
@@ -120,6 +136,8 @@ class EventEmulator:
         self._ranged_pass = RangedPass(pixel_ranges(n, threads))
         self._gpu = None
         if device == "cuda":
+            if problem := device_problem(device):
+                raise RuntimeError(problem)
             from .cuda_kernels import CudaPixels  # numba.cuda only where asked for
 
             self._gpu = CudaPixels(

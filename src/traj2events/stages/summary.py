@@ -3,6 +3,7 @@ failures, final mass and t_f ranges, worst re-integration error)."""
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 
@@ -33,7 +34,29 @@ def read_sample_table(path: str | os.PathLike) -> pd.DataFrame:
     missing = [c for c in SAMPLE_COLUMNS if c not in table.columns]
     if missing:
         raise ValueError(f"{path}: not a samples.csv from `traj2events sample` (missing columns {missing})")
+    if problem := damaged_row(table):
+        raise ValueError(f"{path}: {problem}; the file is damaged (rebuild it: remove it and run the workflow again)")
     return table
+
+
+SOLVED_NUMBERS = ("id", "tf_s", "final_mass_kg", "error_position_m", "error_velocity_m_s")
+
+
+def damaged_row(table: pd.DataFrame) -> str | None:
+    """The first row a damaged samples.csv (cut short, edited) cannot count, by its line:
+    each row has a whole draw number and success True or False, and a solved one its id,
+    t_f, final mass and errors as finite numbers."""
+    success = table["success"].astype(str)
+    numbers = table[list(SOLVED_NUMBERS)].apply(pd.to_numeric, errors="coerce")
+    draw = pd.to_numeric(table["draw"], errors="coerce")
+    bad = (~success.isin(("True", "False"))) | ~(draw % 1 == 0)
+    bad |= (success == "True") & ~(numbers.apply(lambda c: c.map(math.isfinite)).all(axis=1) & (numbers["id"] % 1 == 0))
+    if not bad.any():
+        return None
+    row = table.astype(str).iloc[int(bad.to_numpy().argmax())]
+    return (f"line {row.name + 2} has draw {row['draw']}, success {row['success']}, "
+            f"{', '.join(f'{c} {row[c]}' for c in SOLVED_NUMBERS)}: expected a whole draw, success True or False, "
+            "and finite numbers where it solved")  # fmt: skip
 
 
 def summary_table(
