@@ -17,6 +17,7 @@ command -v ffmpeg >/dev/null || need_apt+=(ffmpeg)                     # video (
 { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libOSMesa.so || need_apt+=(libosmesa6)  # headless OpenGL on the CPU
 { ldconfig -p || /sbin/ldconfig -p; } 2>/dev/null | grep -q libEGL_mesa.so || need_apt+=(libegl1 libegl-mesa0)  # EGL (render.backend)
 if [[ "$extras" == *test* ]]; then command -v h5dump >/dev/null || need_apt+=(hdf5-tools); fi  # tests read the files as C users do
+if [[ "$extras" == *test* ]]; then command -v chromium >/dev/null || need_apt+=(chromium); fi  # the overview, read in a browser
 if ((${#need_apt[@]})); then
   echo "setup: installing system packages: ${need_apt[*]}"
   SUDO=""; [[ $(id -u) -ne 0 ]] && SUDO="sudo"

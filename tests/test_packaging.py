@@ -53,12 +53,15 @@ def test_pypi_metadata_and_its_page_work_off_the_repository():
 def test_the_sdist_carries_the_workflow_and_the_pypi_page(tmp_path):
     """What a PyPI user downloads to build a dataset (docs/pypi.md): the workflow, configs,
     profiles, environments, docs and setup.sh, with the metadata PyPI shows."""
+    # From a clone of the committed tree: setuptools-scm rewrites _version.py where it builds,
+    # which in the checkout would change the version every file of a concurrent build records.
+    subprocess.run(["git", "clone", "-q", str(ROOT), str(tmp_path / "repo")], check=True)
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True)
     py = str(venv / "bin" / "python")
     subprocess.run([py, "-m", "pip", "install", "-q", "build"], check=True, timeout=300)
-    built = subprocess.run([py, "-m", "build", "--sdist", "--outdir", str(tmp_path), str(ROOT)], capture_output=True,
-                           text=True, timeout=600)  # fmt: skip
+    built = subprocess.run([py, "-m", "build", "--sdist", "--outdir", str(tmp_path), str(tmp_path / "repo")],
+                           capture_output=True, text=True, timeout=600)  # fmt: skip
     assert built.returncode == 0, built.stderr[-3000:]
     (sdist,) = tmp_path.glob("traj2events-*.tar.gz")
     with tarfile.open(sdist) as archive:

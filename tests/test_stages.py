@@ -16,7 +16,8 @@ from traj2events.settings.render import RenderSettings
 from traj2events.stages import pictures
 from traj2events.stages.base_solution import BaseSolveError, base_solution
 from traj2events.stages.camera_poses import camera_poses
-from traj2events.stages.events import emulate, export_events, preset_params
+from traj2events.stages.events import emulate, preset_params
+from traj2events.stages.export import export_events
 from traj2events.stages.index import dataset_index
 from traj2events.stages.motion_field import motion_field
 from traj2events.stages.render import render_trajectory
@@ -301,7 +302,7 @@ def test_a_scenario_without_a_solved_sample_is_an_error_not_an_empty_index(tmp_p
 
     samples = tmp_path / "samples.csv"
     table = {c: [np.nan] * 3 for c in SAMPLE_COLUMNS}
-    table.update(id=[0, 1, 2], success=[False] * 3, method=["failed"] * 3,
+    table.update(draw=[0, 1, 2], id=[0, 1, 2], success=[False] * 3, method=["failed"] * 3,
                  reason=["infeasible", "infeasible", "iteration limit"])  # fmt: skip
     pd.DataFrame(table).to_csv(samples, index=False)
     with pytest.raises(NoSolvedSampleError, match=r"none of the 3 samples solved \(infeasible \(2\), iteration limit"):

@@ -9,8 +9,11 @@ from traj2events.video import (
     decode_command,
     display_code,
     display_frame,
+    event_video_frame,
     iter_video,
     read_video,
+    video_info,
+    write_event_video,
 )
 
 
@@ -129,3 +132,26 @@ def test_the_pipe_to_ffmpeg_holds_a_whole_frame(tmp_path):
         assert pipe_bytes(video._process.stdin.fileno()) >= 65536
         video.write(np.zeros((24, 40), np.uint8))
     np.testing.assert_array_equal(read_video(tmp_path / "big.mkv"), np.zeros((1, 1024, 1024), np.uint8))
+
+
+def test_an_event_video_frame_is_grey_with_on_lighter_and_off_darker_saturating_at_two():
+    """128 + 127 clip((ON - OFF) / 2, -1, 1): one ON 191.5 -> 192, one OFF 64.5 -> 64 (numpy
+    rounds halves to even), ON and OFF cancel, three ON saturate."""
+    x, y = np.array([0, 1, 2, 2, 3, 3, 3]), np.array([0, 0, 0, 0, 1, 1, 1])
+    p = np.array([1, 0, 1, 0, 1, 1, 1])
+    frame = event_video_frame(x, y, p, 4, 2)
+    assert frame.dtype == np.uint8 and frame.shape == (2, 4)
+    assert frame[0].tolist() == [192, 64, 128, 128] and frame[1].tolist() == [128, 128, 128, 255]
+
+
+def test_an_event_video_has_a_frame_per_interval_and_shows_where_the_events_are(tmp_path):
+    events = np.zeros(40, dtype=[("x", "<u2"), ("y", "<u2"), ("t", "<i8"), ("p", "u1")])
+    events["x"], events["y"], events["p"] = 5, 6, 1
+    events["t"] = np.linspace(20_000, 29_000, 40)  # all in the third interval: [20, 30) ms
+    write_event_video(tmp_path / "e.mp4", events, 16, 12, np.arange(0, 60_000, 10_000))
+    width, height, fps, count = video_info(tmp_path / "e.mp4")
+    assert (width, height, count) == (16, 12, 5) and fps == pytest.approx(100.0)
+    frames = read_video(tmp_path / "e.mp4").astype(int)
+    assert abs(frames[0] - 128).max() <= 3 and frames[2, 6, 5] > 220  # H.264: near, not exact
+    with pytest.raises(ValueError, match="2 or more increasing frame times"):
+        write_event_video(tmp_path / "f.mp4", events, 16, 12, np.array([0, 0]))

@@ -1,5 +1,7 @@
 """The real `snakemake` command on the smoke config, in a temporary directory."""
 
+import html
+import json
 import os
 import re
 import shutil
@@ -307,7 +309,9 @@ def test_the_report_holds_every_figure(built, tmp_path):
         for i in ids:
             for name in ("frames.png", "motion_field.png", "events.png"):
                 assert f'"results/{scenario}/{i:04d}/{name}"' in html, (scenario, i, name)
-    assert "results/figures/trajectories.png" in html and "results/summary.csv" in html
+    assert "results/figures/trajectories.png" in html
+    results = json.loads(re.search(r"results = (\{.*?\});\n", html)[1])
+    assert "results/overview.html" in results and "results/summary.csv" not in results  # shown in place
     assert '"results/overview.html"' in html and "a synthetic event-camera dataset" in html  # the front page
     assert report.stat().st_size > 100_000  # the images are embedded
 
@@ -329,6 +333,43 @@ def test_the_overview_page_counts_what_was_built(built):
     assert f"{total_bytes / 1e6:.1f} MB on disk" in page
     assert f"{len(dataset)} trajectories" in page and "data:image/png;base64," in page
     assert page.count("<table") == 4 and "&quot;seed&quot;" in page  # the tables in place; the config
+
+
+# Injected into a copy of the overview beside it: what a reader's browser makes of the page.
+PROBE = """<script>window.addEventListener('load', () => {
+  const images = [...document.images], root = document.documentElement;
+  document.body.dataset.probe = JSON.stringify({scroll_width: root.scrollWidth, client_width: root.clientWidth,
+    images: images.length, broken: images.filter(i => !(i.complete && i.naturalWidth > 0)).length});
+});</script>"""
+
+
+def test_the_overview_reads_in_a_headless_browser(built):
+    """Chromium at 1,400 px: the page does not scroll sideways, every image loads, the
+    screenshot is a page and not a blank, and every link leads to a file of the dataset."""
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
+    if chromium is None:
+        pytest.skip("Chromium is not installed (bash setup.sh --test installs it)")
+    from PIL import Image
+
+    page = built / "results" / "overview.html"
+    probe = page.with_name(".overview-probe.html")
+    probe.write_text(page.read_text().replace("</body>", PROBE + "</body>"))
+    browser = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--window-size=1400,2400"]
+    try:
+        dom = subprocess.run([*browser, "--virtual-time-budget=10000", "--dump-dom", probe.as_uri()],
+                             capture_output=True, text=True, timeout=120)  # fmt: skip
+        shot = page.with_name(".overview-shot.png")
+        subprocess.run([*browser, f"--screenshot={shot}", page.as_uri()], capture_output=True, timeout=120)
+        image = np.asarray(Image.open(shot).convert("L"))
+    finally:
+        probe.unlink()
+        page.with_name(".overview-shot.png").unlink(missing_ok=True)
+    measured = json.loads(html.unescape(re.search(r'data-probe="([^"]*)"', dom.stdout)[1]))
+    assert measured["scroll_width"] <= measured["client_width"] == 1400, measured  # no sideways scroll
+    assert measured["images"] >= 3 and measured["broken"] == 0, measured  # the rate figure and a panel per scenario
+    assert image.shape == (2400, 1400) and image.std() > 10  # text, tables and figures, not a blank
+    links = re.findall(r"href='([^']+)'", page.read_text())
+    assert links and all((page.parent / link).exists() for link in links), links
 
 
 def test_second_run_has_nothing_to_do(built):
@@ -458,7 +499,7 @@ def test_help_text_docstring_and_comment_edits_rerun_nothing(edited_source):
 
 def test_emulator_change_reruns_events_and_their_dependants_only(edited_source):
     jobs = edited_source("sensor/pixel.py", "two_pi_dt = 2.0 * np.pi * dt", "two_pi_dt = 6.3 * dt")
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
+    assert jobs == {"events": 3, "export_events": 9, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
 def test_figure_change_reruns_pictures_only(edited_source):
@@ -500,10 +541,27 @@ def test_picture_setting_reruns_pictures_only(built, tmp_path):
 def test_emulator_setting_reruns_events_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.setdefault("events", {}).update(preset="clean"))
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
+    assert jobs == {"events": 3, "export_events": 9, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
     shutil.copytree(built, tmp_path / "wf2")
     jobs = edit_config(tmp_path / "wf2", lambda c: c.setdefault("events", {}).update(pixel={"refractory_s": 1e-3}))
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
+    assert jobs == {"events": 3, "export_events": 9, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
+
+
+def test_exports_added_to_a_built_dataset_emulate_nothing_again(built, tmp_path):
+    from traj2events.video import video_info
+
+    shutil.copytree(built, tmp_path / "wf")
+    events = tmp_path / "wf" / "results" / "descent" / "0001" / "events.h5"
+    emulated = events.stat().st_mtime_ns
+    jobs = edit_config(tmp_path / "wf", lambda c: c["events"]["exports"].append("video"))  # smoke: 3 already
+    assert jobs == {"export_events": 3, "dataset_index": 2, "dataset_overview": 1}
+    snakemake(tmp_path / "wf")
+    assert events.stat().st_mtime_ns == emulated
+    npz = np.load(events.with_suffix(".npz"))
+    with h5py.File(events) as f:
+        assert len(npz["events"]) == len(f["events/t"]) and npz["range_meter"][:, 1].max() > 0
+    poses = h5py.File(events.with_name("trajectory.h5"))["poses/t"][()]
+    assert video_info(events.with_suffix(".mp4"))[3] == len(poses) - 1  # a frame per pose interval
 
 
 def test_an_imu_setting_or_a_readout_setting_reruns_its_stage_only(built, tmp_path):
@@ -512,7 +570,7 @@ def test_an_imu_setting_or_a_readout_setting_reruns_its_stage_only(built, tmp_pa
     assert jobs == {"imu": 3, "dataset_index": 2, "dataset_overview": 1}
     shutil.copytree(built, tmp_path / "wf2")
     jobs = edit_config(tmp_path / "wf2", lambda c: c.setdefault("events", {}).update(readout={"latency_s": 1e-4}))
-    assert jobs == {"events": 3, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
+    assert jobs == {"events": 3, "export_events": 9, "events_picture": 3, "dataset_index": 2, "dataset_overview": 1}
 
 
 def test_a_deleted_output_is_built_again(built, tmp_path):
@@ -563,6 +621,7 @@ def test_one_sun_reruns_that_scenarios_rendering_and_dependants_only(built, tmp_
         "render": 1,
         "motion_field": 1,
         "events": 1,
+        "export_events": 3,
         "frames_picture": 1,
         "motion_field_picture": 1,
         "events_picture": 1,
@@ -584,16 +643,20 @@ def test_the_catalog_layout_finds_the_workflow_from_the_root_with_its_test_confi
 
 
 def test_frames_not_kept_render_and_emulate_in_one_job(tmp_path):
-    """render.keep_frames false: the render jobs write events.h5 and the exports from the
-    frames in memory (the same events as two jobs: tests/test_stages.py); no events job."""
+    """render.keep_frames false: the render jobs write events.h5 from the frames in memory
+    (the same events as two jobs: tests/test_stages.py); no events job; each export is a job
+    of its own, from events.h5."""
     config = two_scenario_smoke()
     config["render"] = {**config.get("render", {}), "keep_frames": False}
     config["events"] = {**config.get("events", {}), "exports": ["npz"]}
     (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
     jobs = jobs_in_dry_run(tmp_path)
-    assert "events" not in jobs and jobs["render"] == jobs["events_picture"] == jobs["motion_field"] == 3
+    assert "events" not in jobs and jobs["render"] == jobs["events_picture"] == jobs["export_events"] == 3
     out = snakemake(tmp_path, "-n", "-p", "results/hover/0000/events.npz").stdout
-    assert "traj2events render" in out and "--events results/hover/0000/events.h5" in out and "--exports npz" in out
+    assert "traj2events render" in out and "--events results/hover/0000/events.h5" in out
+    f = "results/hover/0000"
+    assert (f"traj2events export events {f}/events.h5 --npz {f}/events.npz --trajectory {f}/trajectory.h5 "
+            f"--motion-field {f}/motion_field.h5") in out  # fmt: skip
 
 
 def test_a_failing_scenario_does_not_stop_the_others(built, tmp_path):

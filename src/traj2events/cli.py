@@ -17,7 +17,7 @@ from . import __version__, missing_dependency
 from .memory import keep_freed_memory
 from .options import add_declared_option, add_settings, json_or_null, settings_from
 from .settings.camera import CAMERA, MOTION_FIELD
-from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE, EXPORT_SUFFIX
+from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE
 from .settings.imu import IMU
 from .settings.poses import EXTERNAL_POSES, POSES, external_pose_defaults
 from .settings.render import RENDER, RENDER_FLAGS, RenderSection, render_job_settings
@@ -57,9 +57,7 @@ def cmd_render(args) -> int:
     settings, files = _job(render.RenderSettings, args, RENDER), (args.frames, args.video, args.preview)
     if args.events:  # the emulator takes the radiance in memory: frames.h5 keeps the depth only
         events = settings_from(argparse.Namespace(settings=args.events_settings, settings_defaults=None), EVENTS)
-        exports = {name: os.path.join(os.path.dirname(args.events), f"events.{EXPORT_SUFFIX[name]}")
-                   for name in args.exports}  # fmt: skip
-        render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events, exports,
+        render_events.render_and_emulate(args.trajectory, settings, events, args.seed, *files, args.events,
                                          args.backend, args.tile_cache)  # fmt: skip
     else:
         render.render_trajectory(args.trajectory, settings, *files, args.backend, args.tile_cache)
@@ -81,7 +79,7 @@ def cmd_events(args) -> int:
 
     keep_freed_memory()
     threads = len(os.sched_getaffinity(0)) if args.threads is None else args.threads
-    exports = {"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4}
+    exports = {"npz": args.npz, "evt3": args.evt3, "aedat4": args.aedat4, "video": args.video}
     events_command(args.input, args.output, settings_from(args, EVENTS), args.seed, fps=args.fps, white=args.white,
                    chunk=args.chunk, threads=threads, exports=exports, trajectory=args.trajectory,
                    timestamps=args.timestamps, window_s=(args.start_s, args.stop_s), crop_px=args.crop,
@@ -120,7 +118,8 @@ def _calls(stage: str, function: str, *arguments):
 
 def _event_exports(p: argparse.ArgumentParser) -> None:
     """The events' exports (the events command's and `export events`'), the .npz's trajectory."""
-    for flag, what in (("--npz", "an ELOPE-style .npz"), ("--evt3", "Prophesee EVT 3.0 .raw"), ("--aedat4", "AEDAT4")):
+    for flag, what in (("--npz", "an ELOPE-style .npz"), ("--evt3", "Prophesee EVT 3.0 .raw"), ("--aedat4", "AEDAT4"),
+                       ("--video", "an event video (H.264 .mp4: ON light, OFF dark on grey)")):  # fmt: skip
         p.add_argument(flag, help=f"also write {what} here (EVT 3.0, AEDAT4: via faery)")
     p.add_argument("--trajectory", help="trajectory.h5: the .npz's timestamps and traj (states)")
 
@@ -188,7 +187,6 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--events", help="events.h5: also emulate, from the frames in memory (frames.h5: the depth only)")
     p.add_argument("--events-settings", metavar="JSON", help="the emulator's settings (`events --settings`)")
     p.add_argument("--seed", type=int, default=0, help="with --events: the emulator's seed (default 0)")
-    p.add_argument("--exports", nargs="*", default=[], choices=list(EXPORT_SUFFIX), help="with --events: also these")
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser("motion-field", help="ground-truth motion field of a trajectory (sphere; terrain: frames.h5)")
@@ -226,8 +224,10 @@ def build_parser() -> argparse.ArgumentParser:
     q = kinds.add_parser("events", help="events.h5 as EVT 3.0 (.raw), AEDAT4 (via faery) or an ELOPE-style .npz")
     q.add_argument("events", help="events.h5")
     _event_exports(q)
+    q.add_argument("--motion-field", help="motion_field.h5: the .npz's range meter (or --frames: frames.h5's)")
     q.add_argument("--frames", help="frames.h5: the .npz's range meter")
-    q.set_defaults(func=_calls("events", "export_events", "events", "npz", "evt3", "aedat4", "trajectory", "frames"))
+    q.set_defaults(func=_calls("export", "export_events", "events", "npz", "evt3", "aedat4", "video", "trajectory",
+                               "frames", "motion_field"))  # fmt: skip
     q = kinds.add_parser("poses", help="the camera's poses (mount included) as TUM and EuRoC text, the IMU as EuRoC's")
     q.add_argument("trajectory", help="trajectory.h5")
     q.add_argument("--tum", help="TUM text: timestamp tx ty tz qx qy qz qw (s, m; camera to world)")

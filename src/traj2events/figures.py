@@ -210,6 +210,19 @@ def event_frame(events: np.ndarray, width: int, height: int, t_start_us: int, t_
     return image
 
 
+def scene_figure(frame: np.ndarray, events_rgb: np.ndarray, frame_label: str, events_label: str, title: str):
+    """A display frame (grey, 0-255) beside the events around it (event_frame's RGB)."""
+    fig, axes = plt.subplots(1, 2, figsize=(5.4, 3.1), layout="constrained")
+    axes[0].imshow(frame, cmap="gray", vmin=0, vmax=255, interpolation="nearest")
+    axes[1].imshow(events_rgb, interpolation="nearest")
+    for ax, label in zip(axes, (frame_label, events_label)):
+        ax.set_title(label, fontsize=9)
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.suptitle(title)
+    return fig
+
+
 def event_mosaic(
     times_s: list[float], frames: list[np.ndarray], counts: list[int], labels: list[str], title: str, window_ms: float
 ) -> plt.Figure:

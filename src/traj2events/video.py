@@ -1,5 +1,5 @@
-"""Display frames and videos: 8-bit tone mapping, lossless FFV1 and an H.264 preview,
-through ffmpeg (ffmpeg-python builds the command lines)."""
+"""Display frames and videos: 8-bit tone mapping, lossless FFV1 and an H.264 preview, and
+event videos, through ffmpeg (ffmpeg-python builds the command lines)."""
 
 from __future__ import annotations
 
@@ -278,3 +278,31 @@ def iter_video(path: str | os.PathLike, chunk: int = 64, info: tuple | None = No
     if reported:
         raise ValueError(f"{path}: corrupt video: ffmpeg reported {len(reported)} decoding errors, the first: "
                          f"{reported[0].strip()}")  # fmt: skip
+
+
+# An event video's grey levels (v2e's DVS video convention: ON lighter, OFF darker, no event
+# mid-grey): a pixel's net count saturates at EVENT_VIDEO_FULL_SCALE events.
+EVENT_VIDEO_FULL_SCALE = 2
+
+
+def event_video_frame(x: np.ndarray, y: np.ndarray, p: np.ndarray, width: int, height: int) -> np.ndarray:
+    """One frame of an event video: 128 + 127 clip((ON - OFF) / EVENT_VIDEO_FULL_SCALE, -1, 1)
+    per pixel, from the events of its interval (x, y, p with p = 1 for ON)."""
+    net = np.zeros(height * width, np.int64)
+    np.add.at(net, np.asarray(y, np.int64) * width + np.asarray(x, np.int64), np.where(np.asarray(p) == 1, 1, -1))
+    level = 128 + np.round(127 * np.clip(net / EVENT_VIDEO_FULL_SCALE, -1.0, 1.0))
+    return level.astype(np.uint8).reshape(height, width)
+
+
+def write_event_video(path: str | os.PathLike, events: np.ndarray, width: int, height: int, times_us: np.ndarray):
+    """An H.264 event video: frame k shows the events (structured x, y, t us, p) with t in
+    [times_us[k], times_us[k + 1]), at the frame rate of the times' mean step."""
+    times_us = np.asarray(times_us, np.int64)
+    if len(times_us) < 2 or np.any(np.diff(times_us) <= 0):
+        raise ValueError(f"{path}: an event video needs 2 or more increasing frame times, got {len(times_us)}")
+    fps = (len(times_us) - 1) / ((times_us[-1] - times_us[0]) / 1e6)
+    edges = np.searchsorted(events["t"], times_us, side="left")
+    with VideoWriter(path, width, height, fps, kind="h264") as writer:
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            window = events[lo:hi]
+            writer.write(event_video_frame(window["x"], window["y"], window["p"], width, height))

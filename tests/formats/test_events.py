@@ -178,3 +178,19 @@ def test_merged_events_are_in_time_order_the_first_sets_first_among_equal_times(
     assert labels.tolist() == [0, 4, 4, 0]
     none_due = {k: v[:0] for k, v in due.items()}
     assert merge_events(events, None, none_due)[0] is events
+
+
+def test_a_constant_count_slice_is_centred_on_its_time_and_kept_inside_the_recording(tmp_path):
+    from traj2events.formats.events import EventsReader
+
+    events = np.zeros(100, EVENT_DTYPE)
+    events["t"] = np.arange(100) * 1000 + 250_000  # one event per ms from 250 ms; t_offset 0
+    writer = EventsWriter(tmp_path / "e.h5", 4, 4, {})
+    writer.append(events)
+    writer.close(400_000)
+    with EventsReader(tmp_path / "e.h5") as reader:
+        middle = reader.around(300_000, 10)  # the first event at or after 300 ms is the 51st
+        assert list(middle["t"] // 1000) == list(range(295, 305))
+        assert list(reader.around(0, 10)["t"] // 1000) == list(range(250, 260))  # shifted inside
+        assert list(reader.around(10**9, 10)["t"] // 1000) == list(range(340, 350))
+        assert len(reader.around(300_000, 1000)) == 100  # fewer where the recording has fewer

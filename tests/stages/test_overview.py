@@ -7,7 +7,8 @@ import numpy as np
 import pandas as pd
 
 from traj2events.formats.events import EventsWriter
-from traj2events.stages.overview import dataset_overview, event_rate_per_s, folder_bytes
+from traj2events.stages.overview import EVENTS_PER_PIXEL_SHOWN, dataset_overview, event_rate_per_s, folder_bytes
+from traj2events.video import VideoWriter
 
 
 def test_the_event_rate_counts_each_bin_from_ms_to_idx():
@@ -38,6 +39,9 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
         writer.append(events)
         writer.close(1_000_000)
         (folder / "trajectory.h5").write_bytes(b"t" * 1000)
+        with VideoWriter(folder / "video.mkv", 4, 2, 10.0) as video:
+            for k in range(11):
+                video.write(np.full((2, 4), 20 * k, np.uint8))
         folders.append(folder)
     index = pd.DataFrame({"scenario": "descent", "id": [0, 1], "path": [str(f / "trajectory.h5") for f in folders],
                           "tf_s": [1.0, 1.0], "n_poses": [11, 11], "continuation": ["warm", "external"],
@@ -58,6 +62,7 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
     # The diverts' table: one flown, none failed, its offset and added acceleration.
     assert "<td>divert</td>\n      <td>1</td>\n      <td>0</td>\n      <td>42</td>\n      <td>42</td>" in page
     assert "<td>0.75</td>" in page and "<td>file</td>" in page and "<td>OCP</td>" in page
+    assert page.count("alt='frame and events'") == 1 and f"{EVENTS_PER_PIXEL_SHOWN:g} events per pixel" in page
     again = tmp_path / "again.html"
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), again)
     assert again.read_bytes() == (tmp_path / "o.html").read_bytes()

@@ -153,12 +153,12 @@ def frames_output(path):
 
 def render_outputs(folder):
     """The render job's files: frames.h5, video.mkv and, with render.preview, preview.mp4;
-    as one job with the events (ONE_JOB), events.h5 and its exports too."""
+    as one job with the events (ONE_JOB), events.h5 too."""
     outputs = {"frames": frames_output(f"{folder}/frames.h5"), "video": f"{folder}/video.mkv"}
     if config["render"]["preview"]:
         outputs["preview"] = f"{folder}/preview.mp4"
     if ONE_JOB:
-        outputs.update(events=f"{folder}/events.h5", **export_outputs(folder))
+        outputs["events"] = f"{folder}/events.h5"
     return outputs
 
 
@@ -167,11 +167,8 @@ def events_in_render(wildcards, output):
     settings, seed and code are also the rule's own params, so that they rerun it."""
     if not ONE_JOB:
         return ""
-    exports = " ".join(config["events"]["exports"])
     settings = shlex.quote(job_settings_json(config, "events"))
-    return f"--events {output.events} --events-settings {settings} --seed {trajectory_seed(wildcards)}" + (
-        f" --exports {exports}" if exports else ""
-    )
+    return f"--events {output.events} --events-settings {settings} --seed {trajectory_seed(wildcards)}"
 
 
 def preview_option(wildcards, output):
@@ -182,15 +179,22 @@ def preview_option(wildcards, output):
 
 
 EXPORT_FILES = {name: f"events.{suffix}" for name, suffix in EXPORT_SUFFIX.items()}
+EXPORT_FLAG = {suffix: name for name, suffix in EXPORT_SUFFIX.items()}  # events.mp4 -> --video
 
 
-def export_outputs(folder):
-    """The event exports the config asks for, as named outputs."""
-    return {name: f"{folder}/{EXPORT_FILES[name]}" for name in config["events"]["exports"]}
+def export_inputs(wildcards):
+    """An export's inputs: events.h5, and the poses (the .npz's states, the video's frame
+    times) and the range meter (the .npz's) where the format takes them."""
+    folder = f"results/{wildcards.scenario}/{wildcards.id}"
+    inputs = {"events": f"{folder}/events.h5", "trajectory": f"{folder}/trajectory.h5"}
+    if wildcards.suffix == EXPORT_SUFFIX["npz"]:
+        inputs["motion_field"] = f"{folder}/motion_field.h5"
+    return inputs
 
 
-def export_flags(wildcards, output):
-    return " ".join(f"--{name} {output[name]}" for name in config["events"]["exports"])
+def export_options(wildcards, input):
+    """`export events`'s options for one format: its output flag's inputs."""
+    return " ".join(f"--{name.replace('_', '-')} {path}" for name, path in input.items() if name != "events")
 
 
 def trajectory_seed(wildcards):

@@ -1,6 +1,7 @@
 # Stage 7: event emulation per trajectory, from the rendered linear radiance (the HDR
-# path), with the exports the config asks for. Its own job when frames.h5 is kept (an
-# emulator setting then reruns this job only); else the render job does it (render.smk).
+# path). Its own job when frames.h5 is kept (an emulator setting then reruns this job
+# only); else the render job does it (render.smk). Each export the config asks for is a job
+# of its own, from events.h5: adding one to a built dataset emulates nothing again.
 
 
 if not ONE_JOB:
@@ -10,7 +11,6 @@ if not ONE_JOB:
             frames="results/{scenario}/{id}/frames.h5",
             trajectory="results/{scenario}/{id}/trajectory.h5",
         output:
-            **export_outputs("results/{scenario}/{id}"),
             events="results/{scenario}/{id}/events.h5",
         log:
             "results/logs/{scenario}/{id}/events.log",
@@ -26,8 +26,31 @@ if not ONE_JOB:
         params:
             settings=settings("events"),
             seed=trajectory_seed,
-            exports=export_flags,
             code=code("events"),
         shell:
             "traj2events events {input.frames} --output {output.events} --seed {params.seed} --settings {params.settings:q} "
-            "--trajectory {input.trajectory} {params.exports} --threads {threads} 2> {log}"
+            "--threads {threads} 2> {log}"
+
+
+rule export_events:
+    input:
+        unpack(export_inputs),
+    output:
+        "results/{scenario}/{id}/events.{suffix}",
+    log:
+        "results/logs/{scenario}/{id}/export_events_{suffix}.log",
+    benchmark:
+        "results/benchmarks/{scenario}/{id}/export_events_{suffix}.tsv"
+    wildcard_constraints:
+        suffix="|".join(EXPORT_FLAG),
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=resources_of("events", "mem_mb"),
+    params:
+        flag=lambda wildcards: EXPORT_FLAG[wildcards.suffix],
+        options=export_options,
+        code=code("export"),
+    shell:
+        "traj2events export events {input.events} --{params.flag} {output} {params.options} 2> {log}"

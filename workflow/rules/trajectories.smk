@@ -129,11 +129,8 @@ rule trajectory_summary:
         solutions=expand("results/{scenario}/solutions.h5", scenario=SOLVED),
         tables=expand("results/{scenario}/samples.csv", scenario=SOLVED),
     output:
-        report(
-            "results/summary.csv",
-            caption="../report/summary.rst",
-            category="Trajectories",
-        ),
+        # In the report through the overview, which shows it in place (a CSV entry would only download).
+        "results/summary.csv",
     log:
         "results/logs/trajectory_summary.log",
     benchmark:

@@ -236,6 +236,18 @@ class EventsReader(HeldFile):
         """As `window`, and the events' labels (uint8, index in EVENT_LABELS)."""
         return self._read(t_start_us, t_end_us, labels=True)
 
+    def around(self, centre_us: int, count: int) -> np.ndarray:
+        """The `count` consecutive events centred on `centre_us` (absolute us; fewer where the
+        recording has fewer): a constant-count slice, as event-based methods cut windows."""
+        m = min(max((centre_us - self.t_offset_us) // 1000, 0), len(self.ms_to_idx) - 1)
+        lo = max(min(int(self.ms_to_idx[m]) - count // 2, self.n_events - count), 0)
+        hi = min(lo + count, self.n_events)
+        g, out = self._columns, np.empty(hi - lo, EVENT_DTYPE)
+        with read_errors_named(self.path, EXPECTED):
+            out["x"], out["y"], out["p"], out["t"] = g["x"][lo:hi], g["y"][lo:hi], g["p"][lo:hi], g["t"][lo:hi]
+        out["t"] += self.t_offset_us
+        return out
+
     def _read(self, t_start_us: int, t_end_us: int, labels: bool) -> tuple[np.ndarray, np.ndarray | None]:
         if labels and "label" not in self._columns:
             raise ValueError(f"{self.path}: no events/label dataset (emulated without labels; see events.labels)")

@@ -12,8 +12,9 @@ from .declare import section, setting
 IMX636 = "Sony IMX636 / Prophesee Gen4.1: photodiode area 4.86 x 4.86 um (Prophesee's QE note)"
 REFRACTORY_MODES = ("drop", "defer")
 READOUT_MODES = ("delay", "drop")
-# events.exports: each format's file suffix beside events.h5 (events.npz, events.raw, events.aedat4).
-EXPORT_SUFFIX = {"npz": "npz", "evt3": "raw", "aedat4": "aedat4"}
+# events.exports: each format's file suffix beside events.h5 (events.npz, events.raw,
+# events.aedat4, events.mp4).
+EXPORT_SUFFIX = {"npz": "npz", "evt3": "raw", "aedat4": "aedat4", "video": "mp4"}
 EXPORT_FORMATS = tuple(EXPORT_SUFFIX)
 
 
@@ -155,8 +156,10 @@ class EventsSection:
     device: str = setting("cpu", "", "where the pixel model runs: cpu, or cuda (an NVIDIA GPU, pip install "
                           ".[gpu]): the same events but where the GPU rounds a crossing time differently",
                           choices=("cpu", "cuda"))  # fmt: skip
-    exports: list[str] = setting([], "", "copies of events.h5 in other formats, on request: npz (ELOPE), evt3 "
-                                 "(Prophesee EVT 3.0 .raw), aedat4", choices=EXPORT_FORMATS,
+    exports: list[str] = setting([], "", "copies of events.h5 in other formats, on request, each its own job "
+                                 "(added to a built dataset without emulating again): npz (ELOPE), evt3 (Prophesee "
+                                 "EVT 3.0 .raw), aedat4, video (events.mp4: ON light, OFF dark on grey, a frame "
+                                 "per pose)", choices=EXPORT_FORMATS,
                                  schema={"uniqueItems": True})  # fmt: skip
 
 

@@ -13,11 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from ..defaults import preset_pixel
-from ..formats.events import EVENT_DTYPE, EVENT_LABELS, EventsWriter, merge_events, read_events
-from ..formats.exports import write_elope_npz, write_faery
-from ..formats.frames import FramesFile
+from ..formats.events import EVENT_DTYPE, EVENT_LABELS, EventsWriter, merge_events
 from ..formats.trajectory import read_trajectory
-from ..geometry.range_meter import range_readings
 from ..progress import log
 from ..provenance import provenance
 from ..sensor.emulator import EmulatorParams, EventEmulator
@@ -26,7 +23,7 @@ from ..sensor.photocurrent import SensorParams
 from ..sensor.radiation import NO_SPACE, SpaceEvents, SpaceParams
 from ..sensor.readout import Readout, ReadoutParams
 from ..sensor.sources import CHUNK_FRAMES, SENSOR_KIND, FrameSource, frame_source
-from ..trajectory.state import BODY_RATES
+from .export import export_events
 
 
 def preset_params(name: str, **changes) -> EmulatorParams:
@@ -146,36 +143,6 @@ def progress_line(n_frames: int, total: int | None, n_events: int, elapsed_s: fl
     return f"  {done}, {n_events} events, {rate:.0f} frames/s"
 
 
-def central_range(frames: str | os.PathLike) -> np.ndarray:
-    """ELOPE's range meter over frames.h5's frames (geometry/range_meter.py)."""
-    with FramesFile(frames) as f:
-        return range_readings(f.t, f.slant_range_m())
-
-
-def export_events(
-    events: str | os.PathLike,
-    npz: str | None = None,
-    evt3: str | None = None,
-    aedat4: str | None = None,
-    trajectory: str | None = None,
-    frames: str | None = None,
-) -> None:
-    """Write the asked-for exports of events.h5: ELOPE-style .npz (with trajectory.h5: its
-    timestamps and states; with frames.h5: the range meter), EVT 3.0, AEDAT4."""
-    if not (npz or evt3 or aedat4):
-        return
-    stream, attrs = read_events(events)  # the exports take the whole stream: ~13 bytes/event in memory
-    if npz:
-        timestamps = traj = None
-        if trajectory is not None:
-            tr = read_trajectory(trajectory)
-            timestamps, traj = tr.t, tr.state[:, : BODY_RATES.stop]
-        write_elope_npz(npz, stream, timestamps, traj, central_range(frames) if frames else None)
-    for path in (evt3, aedat4):
-        if path:
-            write_faery(path, stream, int(attrs["width"]), int(attrs["height"]))
-
-
 def pixel_and_sensor(settings: dict) -> tuple[EmulatorParams, SensorParams | None]:
     """settings.events' pixel model and sensor (None: the display scale), checked now."""
     sensor = SensorParams.from_config(settings["sensor"]) if settings["input"] == "sensor" else None
@@ -238,8 +205,8 @@ def events_command(
     """The events stage as the command runs it: `input` (frames.h5 through the sensor, or on
     the display scale; a video; a folder of images) emulated into events.h5 with the pixel
     model, labels, input scale and sensor of `settings` (settings.events), then the exports
-    (`exports`: npz, evt3, aedat4 paths or None; the .npz takes `trajectory`'s states and
-    frames.h5's range meter). Before the pixel model (sensor.frame_transforms, in this
+    (`exports`: npz, evt3, aedat4, video paths or None; the .npz takes `trajectory`'s states
+    and frames.h5's range meter). Before the pixel model (sensor.frame_transforms, in this
     order): each frame's time from the file `timestamps`, the frames within `window_s`
     (start, stop) s, the rectangle `crop_px` (x, y, width, height), the output size
     `size_px` (width, height). The event-frame picture is its own command (`picture
@@ -270,5 +237,4 @@ def events_command(
         source = resize(source, *size_px)
     emulate_with_settings(source, params, settings, seed, output, str(input), chunk, threads)
     frames = str(input) if Path(input).suffix == ".h5" else None
-    e = exports or {}
-    export_events(output, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)
+    export_events(output, **(exports or {}), trajectory=trajectory, frames=frames)

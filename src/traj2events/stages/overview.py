@@ -1,6 +1,7 @@
 """The dataset's overview page (results/overview.html, the report's "Dataset" page): what was
-built, in numbers and one figure. Per scenario and per trajectory: frames, flight time,
-events and their rate, bytes on disk; the event rate over each flight; the diverts and
+built, in numbers and figures. Per scenario and per trajectory: frames, flight time,
+events and their rate, bytes on disk; per scenario a frame and its events at mid-flight;
+the event rate over each flight; the diverts and
 hovers flown; bytes per kind of file; summary.csv as a table; the code version and the
 resolved config. One self-contained HTML file (the figure embedded), the same bytes for
 the same dataset."""
@@ -16,13 +17,19 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..figures import event_rate_figure, png_bytes
+from ..figures import event_frame, event_rate_figure, png_bytes, scene_figure
 from ..formats.atomic import atomic_output
+from ..formats.events import EventsReader
 from ..formats.hdf5 import open_file
 from ..provenance import provenance
+from ..video import read_video, video_info
 from .index import manoeuvre_stats
 
 RATE_BIN_MS = 10  # the event rate's bin: the paper's event-frame window
+# Events shown per pixel in a scene panel: a quarter of the pixels' count, enough for the
+# edges to show as lines whatever the event rate (a fixed window shows noise at one rate,
+# a smear at another).
+EVENTS_PER_PIXEL_SHOWN = 0.25
 
 
 def event_rate_per_s(ms_to_idx: np.ndarray, n_events: int, bin_ms: int = RATE_BIN_MS) -> np.ndarray:
@@ -60,6 +67,23 @@ def trajectory_stats(folder: Path, names: list[str]) -> dict:
     }
 
 
+def scene_panel(folder: Path, title: str) -> bytes:
+    """One trajectory's scene at mid-flight, as PNG: its display frame (video.mkv, frame k at
+    k / fps) beside the W x H x EVENTS_PER_PIXEL_SHOWN events centred on that frame's time
+    (ON blue, OFF red)."""
+    width, height, fps, count = video_info(folder / "video.mkv")
+    k = count // 2
+    frame = read_video(folder / "video.mkv", [k])[0]
+    with EventsReader(folder / "events.h5") as reader:
+        events = reader.around(round(k / fps * 1e6), round(EVENTS_PER_PIXEL_SHOWN * width * height))
+    span_ms = (int(events["t"][-1]) - int(events["t"][0])) / 1000 if len(events) else 0.0
+    image = event_frame(events, width, height, int(events["t"][0]) if len(events) else 0, 1 << 62)
+    return png_bytes(scene_figure(
+        frame, image, f"frame {k} at t = {k / fps:.2f} s (video.mkv)",
+        f"the {len(events):,} events around it ({span_ms:.3g} ms)", f"{title}, mid-flight",
+    ), dpi=100)  # fmt: skip
+
+
 def readable(value) -> str:
     """A number as a person reads it: integers with thousands separators (101,362,685),
     others to 3 significant digits, those of 1,000 and more whole (243,100); blank: NaN."""
@@ -90,10 +114,12 @@ def overview_html(
     figure_png: bytes,
     config: dict,
     manoeuvres: pd.DataFrame | None = None,
+    panels: list[bytes] = (),
+    summary_href: str = "summary.csv",
 ) -> str:
-    """The page: per-scenario and per-trajectory tables, the rate figure, the diverts and
-    hovers flown (where any was tried), bytes per kind of file, summary.csv, the version,
-    commit and the config."""
+    """The page: per-scenario and per-trajectory tables, a scene panel per scenario, the
+    rate figure, the diverts and hovers flown (where any was tried), bytes per kind of file,
+    summary.csv, the version, commit and the config."""
     made = provenance(__name__)
     per_scenario = trajectories.groupby("scenario", sort=False).agg(
         trajectories=("id", "size"), frames=("frames", "sum"), flight_s=("t_f_s", "sum"), events=("events", "sum"),
@@ -104,7 +130,7 @@ def overview_html(
     style = (
         "body{font-family:sans-serif;margin:1.5em;max-width:70em}table.t{border-collapse:collapse;font-size:90%}"
         "table.t td,table.t th{padding:2px 8px;text-align:right;border-bottom:1px solid #ddd}"
-        ".scroll{overflow-x:auto}img{max-width:100%}"
+        ".scroll{overflow-x:auto}img{max-width:100%}.panels{display:flex;flex-wrap:wrap;gap:8px}"
         "pre{background:#f6f6f6;padding:1em;font-size:85%;white-space:pre-wrap;overflow-wrap:anywhere}"
     )
     return "\n".join([
@@ -118,6 +144,13 @@ def overview_html(
         f"{html.escape(str(config['camera']['height']))} px, {readable(int(trajectories['events'].sum()))} events, "
         f"{trajectories['MB'].sum():.1f} MB on disk (docs/dataset.md describes every file).</p>",
         "<h2>Per scenario</h2>", _table(per_scenario),
+        *(["<h2>What the camera sees</h2><p>Per scenario, its first trajectory at mid-flight: the display frame "
+           "(video.mkv: linear radiance through the display white and gamma) and the events around that instant, a "
+           f"constant-count slice of {EVENTS_PER_PIXEL_SHOWN:g} events per pixel (ON blue, OFF red: a pixel shows "
+           "its last), so that the terrain's edges show as lines whatever the event rate.</p>"]
+          + ["<div class='panels'>"] + [f"<img alt='frame and events' src='data:image/png;base64,"
+                                          f"{base64.b64encode(p).decode()}'>" for p in panels] + ["</div>"]
+          if panels else []),
         "<h2>Event rate</h2>", f"<img alt='event rate over each flight' src='data:image/png;base64,{image}'>",
         f"<p>Events per second in {RATE_BIN_MS} ms bins (the paper's event-frame window) against the flight's "
         "normalised time, one line per trajectory; bins without events drawn at 1.</p>",
@@ -127,7 +160,7 @@ def overview_html(
            "median and largest of each statistic over the flown ones (index.csv's columns, docs/dataset.md).</p>",
            _table(manoeuvres)] if manoeuvres is not None and len(manoeuvres) else []),
         "<h2>Bytes on disk per kind of file</h2>", _table(sizes),
-        "<h2>Solves (summary.csv)</h2>", _table(summary),
+        f"<h2>Solves (<a href='{html.escape(summary_href)}'>summary.csv</a>)</h2>", _table(summary),
         "<h2>Configuration</h2><details><summary>The resolved config (defaults.yaml with the overlays), as the "
         "jobs got it</summary>",
         f"<pre>{html.escape(json.dumps(config, indent=1, sort_keys=True))}</pre></details>",
@@ -144,11 +177,13 @@ def dataset_overview(
     """overview.html from each scenario's index.csv (the trajectories and their folders),
     summary.csv and the resolved config (JSON). Every file and folder in a trajectory's
     folder is counted on disk (frames.h5 where kept: a temporary one is gone by then)."""
-    rows, curves, sizes, manoeuvres = [], [], [], []
+    rows, curves, sizes, manoeuvres, panels = [], [], [], [], []
     for index in indexes:
         listed = pd.read_csv(index)
         if len(listed):  # one scenario's index
             manoeuvres += [{"scenario": listed["scenario"].iloc[0], **row} for row in manoeuvre_stats(listed)]
+            first = listed.iloc[0]
+            panels.append(scene_panel(Path(first["path"]).parent, f"{first['scenario']} {int(first['id']):04d}"))
         for row in listed.itertuples():
             folder = Path(row.path).parent
             stats = trajectory_stats(folder, sorted(p.name for p in folder.iterdir()))
@@ -171,6 +206,7 @@ def dataset_overview(
     kinds = pd.DataFrame({"file": by_kind.index, "MB": by_kind.values / 1e6, "MB_per_trajectory": by_kind.values / 1e6
                           / len(rows), "share": by_kind.values / max(by_kind.sum(), 1)})  # fmt: skip
     figure = png_bytes(event_rate_figure(curves, RATE_BIN_MS), dpi=100)
-    page = overview_html(table, pd.read_csv(summary), kinds, figure, json.loads(config_json), pd.DataFrame(manoeuvres))
+    page = overview_html(table, pd.read_csv(summary), kinds, figure, json.loads(config_json), pd.DataFrame(manoeuvres),
+                         panels, Path(os.path.relpath(summary, Path(output).parent)).as_posix())  # fmt: skip
     with atomic_output(output) as tmp:
         Path(tmp).write_text(page)

@@ -11,7 +11,7 @@ import os
 
 from ..formats.trajectory import read_trajectory
 from ..sensor.sources import CHUNK_FRAMES, check_recording_length, rendered_source
-from .events import emulate_with_settings, export_events, pixel_and_sensor
+from .events import emulate_with_settings, pixel_and_sensor
 from .render import RenderSettings, TrajectoryRender
 
 
@@ -24,15 +24,14 @@ def render_and_emulate(
     video: str | os.PathLike,
     preview: str | os.PathLike | None,
     events: str | os.PathLike,
-    exports: dict[str, str | None] | None = None,
     backend: str = "auto",
     tile_cache: str | None = None,
     keep_radiance: bool = False,
 ) -> None:
     """`render.render_trajectory` and `events.events_command` on its frames in one pass:
     frames.h5 (depth, and the radiance only with `keep_radiance`), video.mkv, preview.mp4,
-    events.h5 with the settings.events of `events_settings` and the trajectory's `seed`,
-    and the exports (npz, evt3, aedat4 paths or None). One core: the emulator runs between
+    events.h5 with the settings.events of `events_settings` and the trajectory's `seed`
+    (the exports are jobs of their own: `traj2events export events`). One core: the emulator runs between
     the renderer's frames."""
     if seed < 0:
         raise ValueError(f"render: seed: expected a value >= 0, got {seed}")
@@ -43,5 +42,3 @@ def render_and_emulate(
     source = rendered_source(job.attrs, rendered, sensor, CHUNK_FRAMES)
     input_name = f"{trajectory} (rendered in the same job)"
     emulate_with_settings(source, params, events_settings, seed, events, input_name, CHUNK_FRAMES)
-    e = exports or {}
-    export_events(events, e.get("npz"), e.get("evt3"), e.get("aedat4"), trajectory, frames)
