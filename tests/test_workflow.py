@@ -659,6 +659,30 @@ def test_frames_not_kept_render_and_emulate_in_one_job(tmp_path):
             f"--motion-field {f}/motion_field.h5") in out  # fmt: skip
 
 
+def test_a_real_site_flies_over_its_dem_product_and_an_edit_of_it_reruns_the_render(tmp_path):
+    """The smoke dataset over a stand-in LOLA-style GeoTIFF (tests/stand_in_dem.py): the
+    config takes the sphere through the site from it, frames.h5 names and hashes it, and
+    rewriting the product reruns what reads the surface."""
+    pytest.importorskip("rasterio")
+    from stand_in_dem import SITE, R, relief, stereographic, write_site_dem
+
+    write_site_dem(tmp_path / "site.tif")
+    config = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+    config["events"].pop("exports")
+    config["scenarios"]["descent"]["n_trajectories"] = 1
+    config["terrain"] = {"dem": {"file": "site.tif", "site": {"lat_deg": SITE[0], "lon_deg": SITE[1]}}}
+    (tmp_path / "config.yaml").write_text(yaml.safe_dump(config))
+    snakemake(tmp_path)
+    with h5py.File(tmp_path / "results" / "descent" / "0000" / "frames.h5") as f:
+        assert f.attrs["dem_file"] == "site.tif" and len(f.attrs["dem_sha256"]) == 64
+        assert f.attrs["moon_radius_m"] == pytest.approx(R + relief(*stereographic(*SITE)), abs=0.05)
+        assert "South Polar" in f.attrs["dem_crs"] and 0 < f["depth_m"][0].min()
+    write_site_dem(tmp_path / "site.tif", scale=1.01)  # heights 1 % lower: another site radius, another surface
+    jobs = {k: v for k, v in jobs_in_dry_run(tmp_path).items() if k != "all"}
+    assert jobs.get("render") == jobs.get("motion_field") == jobs.get("imu") == 1, jobs  # the sphere moved too
+    assert "sample_trajectories" not in jobs and "camera_poses" not in jobs  # the flights are the site frame's
+
+
 def test_a_failing_scenario_does_not_stop_the_others(built, tmp_path):
     # The built dataset with its "hover" scenario made to fail and a "crash" one added: the
     # healthy descent scenario's jobs are up to date (its settings are unchanged).

@@ -196,6 +196,40 @@ def _elevation_grid_error(terrain: dict) -> list[str]:
     return []
 
 
+def _dem_errors(config: dict) -> list[str]:
+    """The real site's product, opened and placed once here (scene.dem), so that a product
+    that cannot place the site stops the run before any job, naming the key."""
+    dem = config["terrain"].get("dem")
+    if not dem:
+        return []
+    if config["terrain"].get("elevation_grid"):
+        return ["config key 'terrain.elevation_grid': a site flies one surface: terrain.dem or terrain.elevation_grid, "
+                "not both"]  # fmt: skip
+    from .scene.dem import DemError, dem_terrain
+
+    try:
+        dem_terrain(dem, float(config["motion_field"]["moon_radius_m"]))
+    except DemError as exc:
+        return [f"config key '{exc.key}': {exc}"]
+    return []
+
+
+def with_dem_radius(config: dict, overlay: dict) -> dict:
+    """With terrain.dem, the sphere through its site as motion_field.moon_radius_m, unless the
+    overlay gives the key (the check then says whether it is that sphere's)."""
+    dem = config.get("terrain", {}).get("dem") if isinstance(config.get("terrain"), dict) else None
+    given = isinstance(overlay.get("motion_field"), dict) and "moon_radius_m" in overlay["motion_field"]
+    if not isinstance(dem, dict) or given or not models_importable():
+        return config
+    from .scene.dem import DemError, site_radius_m
+
+    try:
+        radius = site_radius_m(dem)
+    except (DemError, KeyError, TypeError):  # the check names what is wrong
+        return config
+    return merge_config(config, {"motion_field": {"moon_radius_m": radius}})
+
+
 def _semantic_errors(config: dict) -> list[str]:
     """What a schema cannot say: finite numbers, ordered ranges and bounds, initial
     attitudes within the tilt limit, start times within the time bounds, a usable DEM."""
@@ -236,7 +270,7 @@ def _semantic_errors(config: dict) -> list[str]:
     errors += display_problems(config["render"], sun_ranges_m) + lens_problems(
         config["camera"], config["render"]["supersample"]
     )
-    return errors or _elevation_grid_error(config["terrain"])
+    return errors or _elevation_grid_error(config["terrain"]) or _dem_errors(config)
 
 
 def _section_errors(config: dict) -> list[str]:
@@ -331,6 +365,7 @@ def resolve_config(overlay: Any, refuse_large: bool = True) -> dict:
             config = with_preset(config, own if isinstance(own, dict) else {})
         except ValueError as exc:  # an unknown preset
             raise ConfigError(str(exc)) from None
+    config = with_dem_radius(config, overlay)
     validate_config(config)
     reason = too_large_reason(config) if refuse_large else None
     if reason:

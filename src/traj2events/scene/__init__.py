@@ -3,6 +3,7 @@ knows of OpenGL; `renderer` draws what these modules describe.
 
 Read first (the model):
     terrain        procedural heights: craters, boulders, a DEM when given
+    dem            a real site: a DEM product's heights placed on the site's frame
     sun            the Sun: direction and irradiance
     illumination   horizon-march shadows under it
     reflectance    the Hapke law (the shaders evaluate the same law)

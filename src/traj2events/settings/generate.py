@@ -98,6 +98,8 @@ def _rows(cls, values: dict, prefix: str) -> list[str]:
         if f.name == "scenarios":
             continue
         if is_section(tp) and f.name != "pixel":
+            if f.name in values and values[f.name] is None:  # a section off by default (terrain.dem): its own row
+                rows.append(f"| `{key}` | `null` |  |  | {f.metadata['doc'].replace('|', '/')} |")
             rows += _rows(tp, values.get(f.name) or {}, f"{key}.")
             continue
         meaning = f.metadata["doc"] + (f" (source: {f.metadata['source']})" if f.metadata["source"] else "")

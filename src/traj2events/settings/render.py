@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 from ..geometry.horizon import horizon_distance_m
 from . import trajectory_rng
@@ -18,6 +19,32 @@ PIKE = "Pike (1977)"
 REFLECTANCE_MODELS = ("hapke", "lunar-lambert")
 TEXTURE_FILTERS = ("box", "trilinear", "point")
 TIMING_MODES = ("fixed", "adaptive")
+
+
+@section("terrain.dem.site", "the landing site on the product (planetocentric, as the IAU 2015 Moon CRSs)")
+class DemSite:
+    lat_deg: float = setting(unit="deg", doc="latitude", ge=-90, le=90)
+    lon_deg: float = setting(unit="deg", doc="east longitude", ge=-360, le=360)
+
+
+@section("terrain.dem", 'a real site: a DEM product users download and the landing site on it (docs/rendering.md "Real '
+         'sites"; pip install traj2events[dem])')  # fmt: skip
+class DemSection:
+    file: str = setting(doc="the product: GeoTIFF or cloud-optimised GeoTIFF, PDS3 .IMG (with its .LBL), PDS4 .xml, "
+                        "ISIS3 .cub; read through GDAL with its map projection, nodata, scale and offset")  # fmt: skip
+    site: DemSite = setting(DemSite, "", "where the trajectories land (x north, y east of it)")
+
+
+def terrain_files(terrain: dict) -> list[str]:
+    """The files the surface is read from (the render rule's inputs): terrain.elevation_grid,
+    or terrain.dem's product with a PDS3 image's detached label or a label's image beside it."""
+    if terrain.get("elevation_grid"):
+        return [terrain["elevation_grid"]]
+    if not terrain.get("dem"):
+        return []
+    path = Path(terrain["dem"]["file"])
+    siblings = [path.with_suffix(s) for s in (".LBL", ".lbl", ".IMG", ".img")]
+    return [str(path), *sorted(str(p) for p in siblings if p != path and p.exists())]
 
 
 @section("terrain", "the procedural surface (sources in docs/rendering.md), or a DEM in its place")
@@ -56,6 +83,9 @@ class TerrainParams:
                                                  "flat pad", ge=0)  # fmt: skip
     elevation_grid: str | None = setting(None, "", "a DEM file (.npy, .npz, .tif) in place of the procedural surface")
     grid_spacing_m: float | None = setting(None, "m", "the DEM's spacing where its file does not give it", gt=0)
+    dem: DemSection | None = setting(None, "", "a real site's elevation model in place of the procedural surface "
+                                     "(null: procedural); the sphere through its site sets motion_field.moon_radius_m",
+                                     optional=True)  # fmt: skip
     # Sites diverts re-target to, (x, y) m: each gets a pad as the site's (the render
     # settings add a trajectory's; not a config key).
     divert_sites_m: tuple = ()
@@ -412,8 +442,13 @@ class RenderSettings:
         from ..scene.tiles import TileSet
 
         t = dict(self.terrain)
-        grid, spacing = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None)
-        terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
+        grid, spacing, dem = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None), t.pop("dem", None)
+        if dem:
+            from ..scene.dem import dem_terrain
+
+            terrain = dem_terrain(dem, self.moon_radius_m)
+        else:
+            terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
         sun = Sun(**self.sun)
         lod = LodSettings(**self.lod)
         azimuths = int(self.scattered_light["azimuths"])

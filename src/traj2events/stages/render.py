@@ -71,7 +71,8 @@ class TrajectoryRender:
             "id": int(tr.attrs["id"]),
             **provenance(__name__),
         }
-        self.attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER}
+        dem = getattr(self.tiles.terrain, "attrs", None)  # a real site's product (scene.dem), named and hashed
+        self.attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER} | (dem() if dem else {})
 
     def frames(
         self,

@@ -1,0 +1,259 @@
+"""A real site: heights from a digital elevation model product, placed on the site's frame.
+
+A product (LOLA's polar stereographic GeoTIFFs, USGS NAC DTMs in equirectangular, PDS3
+IMG+LBL, PDS4, ISIS3 cubes) is read through rasterio (GDAL: every format with its map
+projection; PROJ knows the IAU 2015 Moon CRSs), honouring its CRS, nodata, scale and
+offset, a window at a time: a large product is never loaded whole.
+
+The site frame (docs/geometry.md) has x north, y east, z down at the site, the Moon's centre
+at (0, 0, R) with R the radius of the sphere through the site: R = R_ref + h_site, the
+product's reference radius plus the DEM's height at the site. A terrain point at horizontal
+coordinates (x, y) of the site's tangent plane (the gnomonic grid of `scene.terrain`) lies
+on the ray from the centre along
+
+    d = R up + x north + y east            (Moon-fixed; up, north, east at the site)
+
+whose planetocentric latitude and longitude the product's CRS maps to its own (x, y); the
+DEM's height there (bilinear between posts) puts the point at R_ref + h_dem from the
+centre, so its height above the site's sphere is h = R_ref + h_dem - R: curvature exact,
+the site at h = 0. Beyond the product, and where it has no data, h = 0 (the site's sphere).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..settings.render import terrain_files
+from .terrain import bilinear
+
+# A CRS is the Moon's when its body's semi-major axis is within these (IAU 2015: 1737.4 km;
+# older products' spheres are within a few km of it). The Earth's is 6378 km, Mars' 3396 km.
+MOON_RADIUS_RANGE_M = (1.70e6, 1.78e6)
+# Heights about the reference sphere beyond these are not the Moon's (its relief: -9.1 to
+# +10.8 km about 1737.4 km): radii stored as heights, or other units.
+HEIGHT_RANGE_M = (-12_000.0, 12_000.0)
+INSTALL = "pip install 'traj2events[dem]' (rasterio and pyproj)"
+
+
+class DemError(ValueError):
+    """A product that cannot place a site, naming the file and what was expected; `key`:
+    the config key at fault."""
+
+    def __init__(self, message: str, key: str = "terrain.dem.file"):
+        super().__init__(message)
+        self.key = key
+
+
+def _modules():
+    try:
+        import pyproj
+        import rasterio
+    except ModuleNotFoundError as exc:
+        raise DemError(f"terrain.dem needs {exc.name}: {INSTALL}") from None
+    return rasterio, pyproj
+
+
+def _version(path: str) -> tuple[int, int]:
+    stat = os.stat(path)
+    return stat.st_size, stat.st_mtime_ns
+
+
+@functools.lru_cache(maxsize=8)
+def file_sha256(path: str, size: int, mtime_ns: int) -> str:
+    """The product's content hash (the tile cache's key), computed once per file version."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 24), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def site_axes(lat_deg: float, lon_deg: float) -> np.ndarray:
+    """(3, 3) rows: north, east, up at a planetocentric latitude and east longitude, in the
+    Moon-fixed frame (x to longitude 0 on the equator, z to the north pole)."""
+    lat, lon = math.radians(lat_deg), math.radians(lon_deg)
+    north = [-math.sin(lat) * math.cos(lon), -math.sin(lat) * math.sin(lon), math.cos(lat)]
+    east = [-math.sin(lon), math.cos(lon), 0.0]
+    up = [math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)]
+    return np.array([north, east, up])
+
+
+def grid_directions(x_m: np.ndarray, y_m: np.ndarray, radius_m: float, axes: np.ndarray):
+    """Planetocentric (latitude, east longitude) in degrees of the rays d = R up + x north +
+    y east through the gnomonic grid points (x, y)."""
+    x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
+    d = x_m[..., None] * axes[0] + y_m[..., None] * axes[1] + radius_m * axes[2]
+    lat = np.degrees(np.arctan2(d[..., 2], np.hypot(d[..., 0], d[..., 1])))
+    return lat, np.degrees(np.arctan2(d[..., 1], d[..., 0]))
+
+
+@dataclass(frozen=True)
+class DemProduct:
+    """An open product: its CRS, reference radius, posts' placement, nodata, scale and offset."""
+
+    path: str
+    sha256: str
+    crs_wkt: str
+    reference_radius_m: float
+    shape: tuple[int, int]  # rows, columns
+    transform: tuple[float, ...]  # GDAL's affine (a, b, c, d, e, f): x = a col + b row + c
+    units: str
+
+    @classmethod
+    def open(cls, path: str | os.PathLike) -> DemProduct:
+        rasterio, pyproj = _modules()
+        path = str(path)
+        if not Path(path).exists():
+            raise DemError(f"{path} does not exist")
+        try:
+            with rasterio.open(path) as src:
+                crs, transform, shape = src.crs, src.transform, (src.height, src.width)
+                units, count = (src.units[0] or "").strip().lower(), src.count
+        except rasterio.errors.RasterioError as exc:
+            raise DemError(f"{path}: not a DEM GDAL reads ({exc})") from None
+        if count < 1:
+            raise DemError(f"{path}: no raster band of heights")
+        if crs is None:
+            raise DemError(f"{path}: no map projection (CRS): expected a product that says where its posts are")
+        radius = pyproj.CRS.from_wkt(crs.to_wkt()).ellipsoid.semi_major_metre
+        if not MOON_RADIUS_RANGE_M[0] <= radius <= MOON_RADIUS_RANGE_M[1]:
+            raise DemError(f"{path}: its CRS ({crs.to_string()[:60]}) is on a body of radius {radius / 1000:.6g} km, "
+                           "not the Moon's (1737.4 km)")  # fmt: skip
+        if units in ("km", "kilometer", "kilometers", "kilometre", "kilometres"):
+            raise DemError(f"{path}: heights in {units}: expected metres (rescale it, e.g. gdal_translate -scale)")
+        files = terrain_files({"dem": {"file": path}})  # a PDS3 label's image too
+        digest = hashlib.sha256("".join(file_sha256(f, *_version(f)) for f in files).encode()).hexdigest()
+        return cls(path, digest, crs.to_wkt(), float(radius), shape, tuple(transform)[:6], units)
+
+    @functools.cached_property
+    def _to_product(self):
+        """(lon deg, lat deg) planetocentric -> the product's projected (x, y)."""
+        _, pyproj = _modules()
+        crs = pyproj.CRS.from_wkt(self.crs_wkt)
+        geographic = crs.geodetic_crs  # the body's own latitudes and longitudes
+        return pyproj.Transformer.from_crs(geographic, crs, always_xy=True)
+
+    def post_indices(self, lat_deg: np.ndarray, lon_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Continuous (row, column) of points, in posts (post (0, 0) at the first pixel's centre)."""
+        px, py = self._to_product.transform(np.asarray(lon_deg, float), np.asarray(lat_deg, float))
+        a, b, c, d, e, f = self.transform
+        det = a * e - b * d
+        col = (e * (px - c) - b * (py - f)) / det
+        row = (-d * (px - c) + a * (py - f)) / det
+        return row - 0.5, col - 0.5
+
+    def heights(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """Heights about the reference sphere, m, bilinear between posts at continuous
+        (row, column) indices; NaN outside the product and where a post has no data. One
+        window read covers the points."""
+        rasterio, _ = _modules()
+        rows, cols = np.asarray(rows, float), np.asarray(cols, float)
+        out = np.full(rows.shape, np.nan)
+        finite = np.isfinite(rows) & np.isfinite(cols)
+        if not finite.any():
+            return out
+        n_rows, n_cols = self.shape
+        r0 = max(int(np.floor(rows[finite].min())), 0)
+        r1 = min(int(np.floor(rows[finite].max())) + 2, n_rows)
+        c0 = max(int(np.floor(cols[finite].min())), 0)
+        c1 = min(int(np.floor(cols[finite].max())) + 2, n_cols)
+        if r1 <= r0 or c1 <= c0:
+            return out
+        window = rasterio.windows.Window(c0, r0, c1 - c0, r1 - r0)
+        try:
+            with rasterio.open(self.path) as src:
+                band = src.read(1, window=window, masked=True)
+                scale, offset = src.scales[0], src.offsets[0]
+        except rasterio.errors.RasterioError as exc:
+            raise DemError(
+                f"{self.path}: a window of rows {r0}-{r1}, columns {c0}-{c1} cannot be read ({exc})"
+            ) from None
+        posts = np.ma.filled(band.astype(np.float64), np.nan) * scale + offset
+        inside = finite & (rows >= 0) & (rows <= n_rows - 1) & (cols >= 0) & (cols <= n_cols - 1)
+        out[inside] = bilinear(posts, (r0, c0), 1.0, rows[inside], cols[inside], fill=np.nan)
+        return out
+
+
+@dataclass(frozen=True)
+class DemTerrain:
+    """`scene.terrain.Terrain` from a product: heights above the sphere through the site
+    (module docstring). `radius_m`: that sphere's radius, R_ref + h_site (`site_radius_m`)."""
+
+    product: DemProduct
+    lat_deg: float
+    lon_deg: float
+    radius_m: float
+
+    def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
+        lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg))
+        h_dem = self.product.heights(*self.product.post_indices(lat, lon))
+        h = (self.product.reference_radius_m + h_dem) - self.radius_m
+        return np.where(np.isfinite(h), h, 0.0)
+
+    def identity(self) -> dict:
+        """What the heights depend on (the tile cache's key): the product's content and the site."""
+        return {"dem_sha256": self.product.sha256, "site_deg": [self.lat_deg, self.lon_deg], "radius_m": self.radius_m}
+
+    def attrs(self) -> dict:
+        """What a file records of the DEM it was made from."""
+        return {"dem_file": Path(self.product.path).name, "dem_sha256": self.product.sha256,
+                "dem_crs": self.product.crs_wkt, "dem_site_lat_deg": self.lat_deg, "dem_site_lon_deg": self.lon_deg,
+                "dem_reference_radius_m": self.product.reference_radius_m}  # fmt: skip
+
+
+# How far around the site the product must have data: the landing pad (terrain.site_radius_m
+# of the procedural surface is 30 m).
+SITE_CHECK_RADIUS_M = 50.0
+
+
+def site_height_m(product: DemProduct, lat_deg: float, lon_deg: float) -> float:
+    """The DEM's height at the site about the product's reference sphere, m; a DemError where
+    the site is outside the product, under nodata within SITE_CHECK_RADIUS_M, or its heights
+    are beyond HEIGHT_RANGE_M."""
+    radius = product.reference_radius_m
+    ring = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
+    x = np.concatenate([[0.0], SITE_CHECK_RADIUS_M * np.cos(ring)])
+    y = np.concatenate([[0.0], SITE_CHECK_RADIUS_M * np.sin(ring)])
+    lat, lon = grid_directions(x, y, radius, site_axes(lat_deg, lon_deg))
+    rows, cols = product.post_indices(lat, lon)
+    n_rows, n_cols = product.shape
+    if not (0 <= rows[0] <= n_rows - 1 and 0 <= cols[0] <= n_cols - 1):
+        raise DemError(f"{product.path}: the site ({lat_deg:g} deg, {lon_deg:g} deg) falls at post ({rows[0]:.1f}, "
+                       f"{cols[0]:.1f}), outside its {n_rows} x {n_cols} posts", "terrain.dem.site")  # fmt: skip
+    heights = product.heights(rows, cols)
+    if np.isnan(heights).any():
+        raise DemError(f"{product.path}: no data within {SITE_CHECK_RADIUS_M:g} m of the site ({lat_deg:g} deg, "
+                       f"{lon_deg:g} deg): expected heights under the landing (another site, or a filled product)",
+                       "terrain.dem.site")  # fmt: skip
+    if not HEIGHT_RANGE_M[0] <= heights[0] <= HEIGHT_RANGE_M[1]:
+        raise DemError(f"{product.path}: a height of {heights[0]:.6g} at the site; expected metres about the "
+                       f"{radius / 1000:g} km sphere within {HEIGHT_RANGE_M[0]:g} to {HEIGHT_RANGE_M[1]:g} m (the "
+                       "Moon's relief: -9.1 to +10.8 km): radii, or kilometres?")  # fmt: skip
+    return float(heights[0])
+
+
+def site_radius_m(dem: dict) -> float:
+    """The radius of the sphere through the site of `terrain.dem` ({file, site: {lat_deg,
+    lon_deg}}): R_ref + h_site, m (what motion_field.moon_radius_m must be with it)."""
+    product = DemProduct.open(dem["file"])
+    return product.reference_radius_m + site_height_m(product, dem["site"]["lat_deg"], dem["site"]["lon_deg"])
+
+
+def dem_terrain(dem: dict, radius_m: float) -> DemTerrain:
+    """The terrain of `terrain.dem`, on the sphere of `radius_m` through the site (a
+    DemError naming motion_field.moon_radius_m where it is not that sphere's)."""
+    product = DemProduct.open(dem["file"])
+    lat, lon = float(dem["site"]["lat_deg"]), float(dem["site"]["lon_deg"])
+    expected = product.reference_radius_m + site_height_m(product, lat, lon)
+    if abs(radius_m - expected) > 0.01:
+        raise DemError(f"{radius_m} m, but the sphere through the site of {dem['file']} is {expected:.3f} m (its "
+                       f"reference {product.reference_radius_m:g} m plus the site's height): leave the key out, and "
+                       "the config takes it from the DEM", "motion_field.moon_radius_m")  # fmt: skip
+    return DemTerrain(product, lat, lon, radius_m)
