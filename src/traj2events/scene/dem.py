@@ -149,35 +149,47 @@ class DemProduct:
         row = (-d * (px - c) + a * (py - f)) / det
         return row - 0.5, col - 0.5
 
-    def heights(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    @functools.cached_property
+    def post_spacing_m(self) -> float:
+        """The posts' spacing on the ground, m (a geographic product's: at the equator)."""
+        _, pyproj = _modules()
+        crs = pyproj.CRS.from_wkt(self.crs_wkt)
+        a, b, _, d, e, _ = self.transform
+        spacing = math.sqrt(abs(a * e - b * d))
+        if crs.is_geographic:
+            return spacing * self.reference_radius_m * math.pi / 180
+        return spacing * crs.axis_info[0].unit_conversion_factor
+
+    def heights(self, rows: np.ndarray, cols: np.ndarray, step: int = 1) -> np.ndarray:
         """Heights about the reference sphere, m, bilinear between posts at continuous
         (row, column) indices; NaN outside the product and where a post has no data. One
-        window read covers the points."""
+        window read covers the points. `step` > 1: between the means of step x step blocks
+        of posts (GDAL's average, from the product's overviews where it has them), the
+        blocks aligned on the whole product so that neighbouring tiles agree: a coarse
+        tile's low-pass surface, as `scene.terrain`'s level of detail asks."""
         rasterio, _ = _modules()
         rows, cols = np.asarray(rows, float), np.asarray(cols, float)
         out = np.full(rows.shape, np.nan)
-        finite = np.isfinite(rows) & np.isfinite(cols)
-        if not finite.any():
-            return out
         n_rows, n_cols = self.shape
-        r0 = max(int(np.floor(rows[finite].min())), 0)
-        r1 = min(int(np.floor(rows[finite].max())) + 2, n_rows)
-        c0 = max(int(np.floor(cols[finite].min())), 0)
-        c1 = min(int(np.floor(cols[finite].max())) + 2, n_cols)
-        if r1 <= r0 or c1 <= c0:
+        inside = np.isfinite(rows) & np.isfinite(cols) & (rows >= 0) & (rows <= n_rows - 1)
+        inside &= (cols >= 0) & (cols <= n_cols - 1)
+        if not inside.any():
             return out
-        window = rasterio.windows.Window(c0, r0, c1 - c0, r1 - r0)
+        # Post p is in block p // step, whose mean sits at post (k + 0.5) step - 0.5.
+        u, v = (rows[inside] + 0.5) / step - 0.5, (cols[inside] + 0.5) / step - 0.5
+        u0, v0 = max(int(np.floor(u.min())), 0), max(int(np.floor(v.min())), 0)
+        u1, v1 = int(np.floor(u.max())) + 2, int(np.floor(v.max())) + 2
+        # Whole blocks, past the product's edge where it ends mid-block (masked: no data).
+        window = rasterio.windows.Window(v0 * step, u0 * step, (v1 - v0) * step, (u1 - u0) * step)
         try:
             with rasterio.open(self.path) as src:
-                band = src.read(1, window=window, masked=True)
+                band = src.read(1, window=window, masked=True, boundless=True, out_shape=(u1 - u0, v1 - v0),
+                                resampling=rasterio.enums.Resampling.average)  # fmt: skip
                 scale, offset = src.scales[0], src.offsets[0]
         except rasterio.errors.RasterioError as exc:
-            raise DemError(
-                f"{self.path}: a window of rows {r0}-{r1}, columns {c0}-{c1} cannot be read ({exc})"
-            ) from None
+            raise DemError(f"{self.path}: a window of rows {u0 * step}-{u1 * step} cannot be read ({exc})") from None
         posts = np.ma.filled(band.astype(np.float64), np.nan) * scale + offset
-        inside = finite & (rows >= 0) & (rows <= n_rows - 1) & (cols >= 0) & (cols <= n_cols - 1)
-        out[inside] = bilinear(posts, (r0, c0), 1.0, rows[inside], cols[inside], fill=np.nan)
+        out[inside] = bilinear(posts, (u0, v0), 1.0, u, v, fill=np.nan)
         return out
 
 
@@ -192,8 +204,11 @@ class DemTerrain:
     radius_m: float
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
+        """Heights (m, up) above the site's sphere; a tile of `spacing_m` wider than the posts
+        reads their block means (DemProduct.heights' `step`)."""
         lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg))
-        h_dem = self.product.heights(*self.product.post_indices(lat, lon))
+        step = max(int(spacing_m // self.product.post_spacing_m), 1)
+        h_dem = self.product.heights(*self.product.post_indices(lat, lon), step)
         h = (self.product.reference_radius_m + h_dem) - self.radius_m
         return np.where(np.isfinite(h), h, 0.0)
 
