@@ -35,22 +35,22 @@ def relief(x, y):
     return -1500.0 + 200.0 * np.sin(2 * np.pi * x / 4000.0) * np.cos(2 * np.pi * y / 5000.0) + 0.01 * x
 
 
-def site_posts(n=600):
+def site_posts(n=600, post_m=POST_M):
     """A 12 km square of 20 m posts around SITE, as LOLA's polar products lay them out: the
     upper-left corner (x_min, y_max) and the heights, rows southwards in the map's y."""
     x0, y0 = stereographic(*SITE)
-    x_min, y_max = x0 - n * POST_M / 2, y0 + n * POST_M / 2
+    x_min, y_max = x0 - n * post_m / 2, y0 + n * post_m / 2
     cols, rows = np.meshgrid(np.arange(n), np.arange(n))
-    return x_min, y_max, relief(x_min + (cols + 0.5) * POST_M, y_max - (rows + 0.5) * POST_M)
+    return x_min, y_max, relief(x_min + (cols + 0.5) * post_m, y_max - (rows + 0.5) * post_m)
 
 
-def write_site_dem(path, n=600, crs="IAU_2015:30135", scale=1.0, hole=False, units=None):
+def write_site_dem(path, n=600, crs="IAU_2015:30135", scale=1.0, hole=False, units=None, post_m=POST_M):
     """The posts as a tiled GeoTIFF with its IAU CRS."""
-    x_min, y_max, heights = site_posts(n)
+    x_min, y_max, heights = site_posts(n, post_m)
     heights = heights / scale
     if hole:
         heights[n // 2 - 1 : n // 2 + 2, n // 2 - 1 : n // 2 + 2] = NODATA  # under the site
-    transform = rasterio.transform.Affine(POST_M, 0.0, x_min, 0.0, -POST_M, y_max)
+    transform = rasterio.transform.Affine(post_m, 0.0, x_min, 0.0, -post_m, y_max)
     profile = {"driver": "GTiff", "width": n, "height": n, "count": 1, "dtype": "float32", "nodata": NODATA,
                "transform": transform, "tiled": True, "blockxsize": 256, "blockysize": 256,
                **({"crs": crs} if crs else {})}  # fmt: skip

@@ -25,13 +25,13 @@ import functools
 import hashlib
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
-from ..settings.render import terrain_files
-from .terrain import bilinear
+from ..settings.render import TerrainParams, terrain_files
+from .terrain import ProceduralTerrain, bilinear
 
 # A CRS is the Moon's when its body's semi-major axis is within these (IAU 2015: 1737.4 km;
 # older products' spheres are within a few km of it). The Earth's is 6378 km, Mars' 3396 km.
@@ -193,15 +193,37 @@ class DemProduct:
         return out
 
 
+def detail_params(params: TerrainParams, post_m: float) -> TerrainParams:
+    """The procedural surface below posts of `post_m`: craters and roughness shorter than
+    half a post, boulders and rocks small enough that one alone moves its post's mean by at
+    most DETAIL_POST_SHIFT_M (a hemisphere of diameter D: pi D^3 / 12 over post_m^2), so
+    that the product keeps its posts' means and the detail fills in what it cannot resolve."""
+    half = post_m / 2
+    boulder_max = min(params.boulder_diameter_max_m, (12 * DETAIL_POST_SHIFT_M * post_m**2 / math.pi) ** (1 / 3))
+    craters = {"crater_diameter_max_m": max(min(params.crater_diameter_max_m, half), params.crater_diameter_min_m)}
+    if half < params.crater_diameter_min_m:
+        craters["crater_density_k"] = 0.0
+    # (posts under ~0.6 m keep the smallest boulders, 0.5 m: within a cm of their means)
+    boulders = {"boulder_diameter_max_m": max(boulder_max, params.boulder_diameter_min_m)}
+    short = {"roughness_wavelength_max_m": min(params.roughness_wavelength_max_m, half),
+             "pad_relief_wavelength_max_m": min(params.pad_relief_wavelength_max_m, half)}  # fmt: skip
+    return replace(params, **craters, **boulders, **short)
+
+
+DETAIL_POST_SHIFT_M = 0.1  # the most one boulder may move its post's mean (issue 70's bound)
+
+
 @dataclass(frozen=True)
 class DemTerrain:
     """`scene.terrain.Terrain` from a product: heights above the sphere through the site
-    (module docstring). `radius_m`: that sphere's radius, R_ref + h_site (`site_radius_m`)."""
+    (module docstring). `radius_m`: that sphere's radius, R_ref + h_site (`site_radius_m`);
+    `detail`: the procedural surface below the posts (`detail_params`), added, or None."""
 
     product: DemProduct
     lat_deg: float
     lon_deg: float
     radius_m: float
+    detail: ProceduralTerrain | None = None
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
         """Heights (m, up) above the site's sphere; a tile of `spacing_m` wider than the posts
@@ -209,12 +231,14 @@ class DemTerrain:
         lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg))
         step = max(int(spacing_m // self.product.post_spacing_m), 1)
         h_dem = self.product.heights(*self.product.post_indices(lat, lon), step)
-        h = (self.product.reference_radius_m + h_dem) - self.radius_m
-        return np.where(np.isfinite(h), h, 0.0)
+        h = np.where(np.isfinite(h_dem), (self.product.reference_radius_m + h_dem) - self.radius_m, 0.0)
+        return h if self.detail is None else h + self.detail.height_m(x_m, y_m, spacing_m)
 
     def identity(self) -> dict:
-        """What the heights depend on (the tile cache's key): the product's content and the site."""
-        return {"dem_sha256": self.product.sha256, "site_deg": [self.lat_deg, self.lon_deg], "radius_m": self.radius_m}
+        """What the heights depend on (the tile cache's key): the product's content, the site, the detail."""
+        detail = self.detail.identity() if self.detail is not None else None
+        return {"dem_sha256": self.product.sha256, "site_deg": [self.lat_deg, self.lon_deg], "radius_m": self.radius_m,
+                "detail": detail}  # fmt: skip
 
     def attrs(self) -> dict:
         """What a file records of the DEM it was made from."""
@@ -261,9 +285,10 @@ def site_radius_m(dem: dict) -> float:
     return product.reference_radius_m + site_height_m(product, dem["site"]["lat_deg"], dem["site"]["lon_deg"])
 
 
-def dem_terrain(dem: dict, radius_m: float) -> DemTerrain:
+def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None) -> DemTerrain:
     """The terrain of `terrain.dem`, on the sphere of `radius_m` through the site (a
-    DemError naming motion_field.moon_radius_m where it is not that sphere's)."""
+    DemError naming motion_field.moon_radius_m where it is not that sphere's), with the
+    procedural surface of `detail` below its posts (`detail_params`; None: none)."""
     product = DemProduct.open(dem["file"])
     lat, lon = float(dem["site"]["lat_deg"]), float(dem["site"]["lon_deg"])
     expected = product.reference_radius_m + site_height_m(product, lat, lon)
@@ -271,4 +296,5 @@ def dem_terrain(dem: dict, radius_m: float) -> DemTerrain:
         raise DemError(f"{radius_m} m, but the sphere through the site of {dem['file']} is {expected:.3f} m (its "
                        f"reference {product.reference_radius_m:g} m plus the site's height): leave the key out, and "
                        "the config takes it from the DEM", "motion_field.moon_radius_m")  # fmt: skip
-    return DemTerrain(product, lat, lon, radius_m)
+    below = ProceduralTerrain(detail_params(detail, product.post_spacing_m)) if detail is not None else None
+    return DemTerrain(product, lat, lon, radius_m, below)

@@ -33,6 +33,9 @@ class DemSection:
     file: str = setting(doc="the product: GeoTIFF or cloud-optimised GeoTIFF, PDS3 .IMG (with its .LBL), PDS4 .xml, "
                         "ISIS3 .cub; read through GDAL with its map projection, nodata, scale and offset")  # fmt: skip
     site: DemSite = setting(DemSite, "", "where the trajectories land (x north, y east of it)")
+    detail: bool = setting(True, "", "add the procedural surface's craters, boulders, rocks and roughness (terrain's "
+                           "other keys) below the posts' resolution, so that the last seconds have texture; the "
+                           "posts' means are kept (docs/rendering.md \"Real sites\")", optional=True)  # fmt: skip
 
 
 def terrain_files(terrain: dict) -> list[str]:
@@ -446,7 +449,7 @@ class RenderSettings:
         if dem:
             from ..scene.dem import dem_terrain
 
-            terrain = dem_terrain(dem, self.moon_radius_m)
+            terrain = dem_terrain(dem, self.moon_radius_m, TerrainParams(**t) if dem.get("detail", True) else None)
         else:
             terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
         sun = Sun(**self.sun)
