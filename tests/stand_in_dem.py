@@ -105,3 +105,30 @@ END
 
 WRITERS = {"geotiff": lambda folder: write_site_dem(folder / "site.tif"),
            "pds3": lambda folder: write_site_pds3(folder / "SITE.IMG")}  # fmt: skip
+
+
+# A far-field massif: 3 km high, 8 km wide (sigma), 60 km from the site in the map's +x.
+MASSIF = (60_000.0, 0.0, 3000.0, 8000.0)
+
+
+def far_posts(n=1200, post_m=250.0, massif=MASSIF):
+    """A 300 km square of 250 m posts around SITE (LOLA's large-area products' layout): a
+    level -1500 m plain and the massif."""
+    x0, y0 = stereographic(*SITE)
+    x_min, y_max = x0 - n * post_m / 2, y0 + n * post_m / 2
+    cols, rows = np.meshgrid(np.arange(n), np.arange(n))
+    x, y = x_min + (cols + 0.5) * post_m, y_max - (rows + 0.5) * post_m
+    dx, dy, height, sigma = massif
+    d2 = (x - x0 - dx) ** 2 + (y - y0 - dy) ** 2
+    return x_min, y_max, -1500.0 + height * np.exp(-d2 / (2 * sigma**2))
+
+
+def write_far_dem(path, n=1200, post_m=250.0):
+    x_min, y_max, heights = far_posts(n, post_m)
+    transform = rasterio.transform.Affine(post_m, 0.0, x_min, 0.0, -post_m, y_max)
+    profile = {"driver": "GTiff", "width": n, "height": n, "count": 1, "dtype": "float32", "nodata": NODATA,
+               "transform": transform, "tiled": True, "blockxsize": 256, "blockysize": 256,
+               "crs": "IAU_2015:30135"}  # fmt: skip
+    with rasterio.open(path, "w", **profile) as dst:
+        dst.write(heights.astype(np.float32), 1)
+    return path

@@ -105,10 +105,28 @@ def test_a_coarse_tile_reads_block_means_aligned_on_the_product(tmp_path):
     np.testing.assert_array_equal(part, whole)
 
 
-def ray_cast_depth(posts, x_min, y_max, radius, rays_world, origin, t_max=20_000.0, step=10.0):
+def posts_height(grids, sx, sy):
+    """Bilinear heights of the first of `grids` ((x_min, y_max, post_m, posts) each) that holds
+    each stereographic point (sx, sy); 0 (the reference sphere) outside them all."""
+    h = np.zeros(np.shape(sx))
+    todo = np.ones(np.shape(sx), bool)
+    for x_min, y_max, post_m, posts in grids:
+        col, row = (sx - x_min) / post_m - 0.5, (y_max - sy) / post_m - 0.5
+        inside = todo & (row >= 0) & (row <= len(posts) - 1) & (col >= 0) & (col <= posts.shape[1] - 1)
+        i = np.clip(np.floor(row).astype(int), 0, len(posts) - 2)
+        j = np.clip(np.floor(col).astype(int), 0, posts.shape[1] - 2)
+        fr, fc = row - i, col - j
+        value = (posts[i, j] * (1 - fc) + posts[i, j + 1] * fc) * (1 - fr) + (
+            posts[i + 1, j] * (1 - fc) + posts[i + 1, j + 1] * fc
+        ) * fr
+        h, todo = np.where(inside, value, h), todo & ~inside
+    return h
+
+
+def ray_cast_depth(grids, radius, rays_world, origin, t_max=20_000.0, step=10.0):
     """Depth along each ray (m per unit of its camera-frame z) to the surface of bilinear
-    posts on the sphere, by marching and bisection, written here: the site's axes from the
-    site's latitude and longitude, Snyder's stereographic, the posts' bilinear heights."""
+    posts on the sphere (`posts_height`), by marching and bisection, written here: the
+    site's axes from its latitude and longitude, Snyder's stereographic; inf: no hit."""
     lat0, lon0 = np.radians(SITE)
     up = np.array([np.cos(lat0) * np.cos(lon0), np.cos(lat0) * np.sin(lon0), np.sin(lat0)])
     north = np.array([-np.sin(lat0) * np.cos(lon0), -np.sin(lat0) * np.sin(lon0), np.cos(lat0)])
@@ -119,26 +137,17 @@ def ray_cast_depth(posts, x_min, y_max, radius, rays_world, origin, t_max=20_000
         v = p[..., :1] * north + p[..., 1:2] * east + (radius - p[..., 2:3]) * up  # from the Moon's centre
         lat = np.degrees(np.arcsin(v[..., 2] / np.linalg.norm(v, axis=-1)))
         lon = np.degrees(np.arctan2(v[..., 1], v[..., 0]))
-        sx, sy = stereographic(lat, lon)
-        col, row = (sx - x_min) / POST_M - 0.5, (y_max - sy) / POST_M - 0.5
-        i, j = (
-            np.clip(np.floor(row).astype(int), 0, len(posts) - 2),
-            np.clip(np.floor(col).astype(int), 0, len(posts) - 2),
-        )
-        fr, fc = row - i, col - j
-        h = (posts[i, j] * (1 - fc) + posts[i, j + 1] * fc) * (1 - fr) + (
-            posts[i + 1, j] * (1 - fc) + posts[i + 1, j + 1] * fc
-        ) * fr
-        return np.linalg.norm(v, axis=-1) - (R + h)
+        return np.linalg.norm(v, axis=-1) - (R + posts_height(grids, *stereographic(lat, lon)))
 
     t = np.arange(step, t_max, step)[None, :].repeat(len(rays_world), 0)
-    first = np.argmax(above(t) < 0, axis=1)  # the first sample below the surface
+    below = above(t) < 0
+    hit, first = below.any(axis=1), np.argmax(below, axis=1)  # the first sample below the surface
     lo, hi = t[np.arange(len(t)), first] - step, t[np.arange(len(t)), first]
     for _ in range(40):
         mid = (lo + hi) / 2
-        below = above(mid[:, None])[:, 0] < 0
-        lo, hi = np.where(below, lo, mid), np.where(below, mid, hi)
-    return (lo + hi) / 2
+        under = above(mid[:, None])[:, 0] < 0
+        lo, hi = np.where(under, lo, mid), np.where(under, mid, hi)
+    return np.where(hit, (lo + hi) / 2, np.inf)
 
 
 def test_the_rendered_depth_is_the_dem_surfaces(tmp_path):
@@ -168,7 +177,7 @@ def test_the_rendered_depth_is_the_dem_surfaces(tmp_path):
     picked = (slice(2, None, 4), slice(2, None, 4))
     rays = np.stack([a[picked], b[picked], np.ones_like(a[picked])], -1).reshape(-1, 3) @ pose.rotation.T
     x_min, y_max, posts = site_posts()
-    cast = ray_cast_depth(posts, x_min, y_max, radius, rays, pose.position)
+    cast = ray_cast_depth([(x_min, y_max, POST_M, posts)], radius, rays, pose.position)
     rendered = depth[picked].ravel()
     ground = (rendered > 0) & (cast < 19_000)
     assert ground.mean() > 0.9
@@ -238,3 +247,46 @@ def test_a_5m_site_is_textured_at_touchdown_with_its_detail_and_smooth_without(t
             frame = renderer.render(camera_pose(state))
         texture[name] = frame.radiance.std() / frame.radiance.mean()
     assert texture["detail"] > 0.05 > texture["bare"], texture
+
+
+@pytest.mark.slow  # two renders and a 140 km ray cast of 6,144 rays: ~20 s
+def test_the_far_field_dem_shapes_the_horizon(tmp_path):
+    """10 m above a level site product (6 km across), looking at a 3 km massif 60 km away that
+    only the far-field product (300 km of 250 m posts) holds: along every line of the frame
+    across the horizon, the rendered ground ends within one pixel of where a ray cast of both
+    products' posts on the sphere (written here) ends it; without the far product, the
+    massif is gone."""
+    from stand_in_dem import MASSIF, far_posts, site_posts, write_far_dem
+    from traj2events.geometry.camera import Camera, camera_pose
+    from traj2events.renderer.supersample import sensor_renderer
+    from traj2events.scene.reflectance import ReflectanceParams
+    from traj2events.scene.sun import Sun
+    from traj2events.scene.tiles import LodSettings, TileSet
+
+    site = write_site_dem(tmp_path / "site.tif", n=300)
+    with rasterio.open(site, "r+") as dst:
+        dst.write(np.full((300, 300), -1500.0, np.float32), 1)
+    far = write_far_dem(tmp_path / "far.tif")
+    dem = {**site_config(site)["terrain"]["dem"], "far": str(far)}
+    radius = site_radius_m(dem)
+    x0, y0 = stereographic(*SITE)
+    north, east = gnomonic(*inverse_stereographic(x0 + MASSIF[0], y0 + MASSIF[1]), radius, *SITE)
+    state = np.zeros(13)
+    state[2], state[7], state[8], state[12] = -10.0, np.radians(90.0), np.arctan2(east, north), 1e4
+    pose, camera, sun = camera_pose(state), Camera(96, 64, 12.0), Sun(1.496e11, 105.0, 20.0)
+    ground = {}
+    for name, products in (("both", dem), ("site only", {**dem, "far": None})):
+        tiles = TileSet(dem_terrain(products, radius), sun.direction, radius, 140e3, LodSettings())
+        with sensor_renderer(tiles, camera, sun, ReflectanceParams(), backend="osmesa") as renderer:
+            # Pitched 90 deg, the image's columns run along the vertical: ground pixels per row.
+            ground[name] = (renderer.render(pose).depth_m > 0).sum(axis=1)
+    a, b = camera.rays()
+    rays = np.stack([a, b, np.ones_like(a)], -1).reshape(-1, 3) @ pose.rotation.T
+    x_min, y_max, posts = site_posts(300)
+    far_x_min, far_y_max, far_heights = far_posts()
+    site_grid = (x_min, y_max, POST_M, np.full_like(posts, -1500.0))
+    cast = ray_cast_depth([site_grid, (far_x_min, far_y_max, 250.0, far_heights)], radius, rays, pose.position,
+                          t_max=140_000.0, step=100.0)  # fmt: skip
+    cast_ground = np.isfinite(cast).reshape(a.shape).sum(axis=1)
+    assert np.abs(ground["both"] - cast_ground).max() <= 1, (ground["both"], cast_ground)
+    assert (ground["both"] - ground["site only"]).max() >= 5  # the massif stands above the plain's horizon

@@ -107,9 +107,16 @@ class DemProduct:
     units: str
 
     @classmethod
-    def open(cls, path: str | os.PathLike) -> DemProduct:
+    def open(cls, path: str | os.PathLike, key: str = "terrain.dem.file") -> DemProduct:
+        """The product at `path`, checked (a DemError naming `key` where it cannot place a site)."""
+        try:
+            return cls._open(str(path))
+        except DemError as exc:
+            raise DemError(str(exc), key) from None
+
+    @classmethod
+    def _open(cls, path: str) -> DemProduct:
         rasterio, pyproj = _modules()
-        path = str(path)
         if not Path(path).exists():
             raise DemError(f"{path} does not exist")
         try:
@@ -224,27 +231,37 @@ class DemTerrain:
     lon_deg: float
     radius_m: float
     detail: ProceduralTerrain | None = None
+    far: DemProduct | None = None  # the far field, where the site's product has no data
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
-        """Heights (m, up) above the site's sphere; a tile of `spacing_m` wider than the posts
-        reads their block means (DemProduct.heights' `step`)."""
+        """Heights (m, up) above the site's sphere: the site's product, else the far field's,
+        else the sphere; a tile of `spacing_m` wider than a product's posts reads their block
+        means (DemProduct.heights' `step`)."""
         lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg))
-        step = max(int(spacing_m // self.product.post_spacing_m), 1)
-        h_dem = self.product.heights(*self.product.post_indices(lat, lon), step)
-        h = np.where(np.isfinite(h_dem), (self.product.reference_radius_m + h_dem) - self.radius_m, 0.0)
+        rho = self._radii(self.product, lat, lon, spacing_m)  # from the Moon's centre, m
+        if self.far is not None and not (found := np.isfinite(rho)).all():
+            rho[~found] = self._radii(self.far, lat[~found], lon[~found], spacing_m)
+        h = np.where(np.isfinite(rho), rho - self.radius_m, 0.0)
         return h if self.detail is None else h + self.detail.height_m(x_m, y_m, spacing_m)
 
+    @staticmethod
+    def _radii(product: DemProduct, lat: np.ndarray, lon: np.ndarray, spacing_m: float) -> np.ndarray:
+        step = max(int(spacing_m // product.post_spacing_m), 1)
+        return product.reference_radius_m + product.heights(*product.post_indices(lat, lon), step)
+
     def identity(self) -> dict:
-        """What the heights depend on (the tile cache's key): the product's content, the site, the detail."""
+        """What the heights depend on (the tile cache's key): the products' content, the site, the detail."""
         detail = self.detail.identity() if self.detail is not None else None
+        far = self.far.sha256 if self.far is not None else None
         return {"dem_sha256": self.product.sha256, "site_deg": [self.lat_deg, self.lon_deg], "radius_m": self.radius_m,
-                "detail": detail}  # fmt: skip
+                "detail": detail, **({"far_sha256": far} if far else {})}  # fmt: skip
 
     def attrs(self) -> dict:
-        """What a file records of the DEM it was made from."""
+        """What a file records of the DEMs it was made from."""
+        far = {"dem_far_file": Path(self.far.path).name, "dem_far_sha256": self.far.sha256} if self.far else {}
         return {"dem_file": Path(self.product.path).name, "dem_sha256": self.product.sha256,
                 "dem_crs": self.product.crs_wkt, "dem_site_lat_deg": self.lat_deg, "dem_site_lon_deg": self.lon_deg,
-                "dem_reference_radius_m": self.product.reference_radius_m}  # fmt: skip
+                "dem_reference_radius_m": self.product.reference_radius_m, **far}  # fmt: skip
 
 
 # How far around the site the product must have data: the landing pad (terrain.site_radius_m
@@ -297,4 +314,5 @@ def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None)
                        f"reference {product.reference_radius_m:g} m plus the site's height): leave the key out, and "
                        "the config takes it from the DEM", "motion_field.moon_radius_m")  # fmt: skip
     below = ProceduralTerrain(detail_params(detail, product.post_spacing_m)) if detail is not None else None
-    return DemTerrain(product, lat, lon, radius_m, below)
+    far = DemProduct.open(dem["far"], "terrain.dem.far") if dem.get("far") else None
+    return DemTerrain(product, lat, lon, radius_m, below, far)
