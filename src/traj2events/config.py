@@ -99,6 +99,9 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"(scenario names may not be one of {list(RESERVED_SCENARIO_NAMES)})"
         )
     sun = [(f"sun.{k}", sc["sun"][k]) for k in ("azimuth_deg", "elevation_deg") if isinstance(sc["sun"][k], list)]
+    if sc["sun"].get("utc") and not (config["terrain"].get("dem") and sc["sun"].get("spice")):
+        missing = "terrain.dem (a real site)" if not config["terrain"].get("dem") else f"scenarios.{name}.sun.spice"
+        errors.append(f"config key 'scenarios.{name}.sun.utc': the Sun of a date needs {missing}")
     if sc.get("poses"):
         return errors + _external_errors(config, name, sc, sun)
     manoeuvres = [(f"{kind}.{k}", v) for kind in ("divert", "hover") for k, v in (sc.get(kind) or {}).items()]
@@ -228,6 +231,34 @@ def with_dem_radius(config: dict, overlay: dict) -> dict:
     except (DemError, KeyError, TypeError):  # the check names what is wrong
         return config
     return merge_config(config, {"motion_field": {"moon_radius_m": radius}})
+
+
+def with_dated_suns(config: dict) -> dict:
+    """Each scenario whose Sun has a date (scenarios.<name>.sun.utc), with that date's Sun at
+    terrain.dem's site (scene.ephemeris): a ConfigError naming the key where SPICE cannot
+    give it or it is below the horizon. Without a site the check says what is missing."""
+    scenarios = config.get("scenarios") if isinstance(config.get("scenarios"), dict) else {}
+    dated = {name: sc["sun"] for name, sc in scenarios.items() if isinstance(sc, dict)
+             and isinstance(sc.get("sun"), dict) and sc["sun"].get("utc")}  # fmt: skip
+    dem = config.get("terrain", {}).get("dem") if isinstance(config.get("terrain"), dict) else None
+    if not dated or not isinstance(dem, dict) or not models_importable():
+        return config
+    from .scene.ephemeris import EphemerisError, sun_at_site
+
+    site, radius, suns = dem["site"], float(config["motion_field"]["moon_radius_m"]), {}
+    for name, sun in dated.items():
+        if not sun.get("spice"):
+            continue  # the check names it
+        try:
+            at = (site["lat_deg"], site["lon_deg"], radius, sun.get("frame", "IAU_MOON"))
+            suns[name] = sun_at_site(sun["utc"], sun["spice"], *at)
+        except EphemerisError as exc:
+            raise ConfigError(f"config key 'scenarios.{name}.sun.spice': {exc}") from None
+        if suns[name]["elevation_deg"] <= 0:
+            raise ConfigError(f"config key 'scenarios.{name}.sun.utc': at {sun['utc']} the Sun is "
+                              f"{-suns[name]['elevation_deg']:.3g} deg below the site's horizon (the scene would be "
+                              "black): expected a date with the Sun up")  # fmt: skip
+    return merge_config(config, {"scenarios": {name: {"sun": sun} for name, sun in suns.items()}})
 
 
 def _semantic_errors(config: dict) -> list[str]:
@@ -365,7 +396,7 @@ def resolve_config(overlay: Any, refuse_large: bool = True) -> dict:
             config = with_preset(config, own if isinstance(own, dict) else {})
         except ValueError as exc:  # an unknown preset
             raise ConfigError(str(exc)) from None
-    config = with_dem_radius(config, overlay)
+    config = with_dated_suns(with_dem_radius(config, overlay))
     validate_config(config)
     reason = too_large_reason(config) if refuse_large else None
     if reason:

@@ -116,7 +116,10 @@ def add_settings(
     group = parser.add_argument_group(f"settings (each changes one config key; default: {where})")
     given_by = {}  # config key: its option
     for setting, path, flag in _leaves(keys):
-        node, default = _node(path), config_value(start, ".".join(setting))
+        try:
+            node, default = _node(path), config_value(start, ".".join(setting))
+        except KeyError:  # an optional key the job's settings leave out (scenarios.*.sun.utc): no option
+            continue
         option = dict(dest=_PREFIX + ".".join(setting), default=None, help=f"{node.get('description', '')} [{path}, "
                       f"default {default}]")  # fmt: skip
         if setting == ("preset",):

@@ -19,7 +19,7 @@ from traj2events.plan import dataset_plan, disk_shortfall, job_resources
 from traj2events.settings.events import EXPORT_SUFFIX
 from traj2events.settings.jobs import job_settings_json
 from traj2events.settings.poses import is_external, scenario_count, trajectory_source
-from traj2events.settings.render import terrain_files
+from traj2events.settings.site import terrain_files
 from traj2events.unlock import unlock_problem
 
 # A dataset too large to build is refused by the real run only (`refuse_too_large`, the

@@ -5,6 +5,7 @@ Read first (the model):
     terrain        procedural heights: craters, boulders, a DEM when given
     dem            a real site: a DEM product's heights placed on the site's frame
     sun            the Sun: direction and irradiance
+    ephemeris      the Sun of a date at a real site, from SPICE kernels
     illumination   horizon-march shadows under it
     reflectance    the Hapke law (the shaders evaluate the same law)
     stars          the star field seen in the sky

@@ -30,7 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..settings.render import TerrainParams, terrain_files
+from ..settings.render import TerrainParams
+from ..settings.site import terrain_files
 from .terrain import ProceduralTerrain, bilinear
 
 # A CRS is the Moon's when its body's semi-major axis is within these (IAU 2015: 1737.4 km;

@@ -15,6 +15,7 @@ settings reruns only that stage (a module's fingerprint covers what it imports):
     solve     base and sample solves of a scenario: the OCP, ranges, seed
     poses     the camera poses at the frame rate: fps, upsampling; diverts, hovers, pose files
     render    one scenario's frames: terrain, reflectance, detail, light, Sun, timing
+    site      a real site: its DEM products and landing site (terrain.dem), the files read
     events    the emulation: pixel model, sensor, readout, space; its picture's window
     camera    the camera and the Moon's sphere (motion field, its picture)
     imu       the IMU's rate and errors

@@ -6,56 +6,19 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 from ..geometry.horizon import horizon_distance_m
 from . import trajectory_rng
 from .camera import CameraSection
 from .declare import non_finite, section, setting
 from .poses import external_extents, is_external, scenario_divert
+from .site import DemSection
 
 HAPKE = "representative lunar values after Helfenstein & Veverka (1987) and Sato et al. (2014), LROC WAC"
 PIKE = "Pike (1977)"
 REFLECTANCE_MODELS = ("hapke", "lunar-lambert")
 TEXTURE_FILTERS = ("box", "trilinear", "point")
 TIMING_MODES = ("fixed", "adaptive")
-
-
-@section("terrain.dem.site", "the landing site on the product (planetocentric, as the IAU 2015 Moon CRSs)")
-class DemSite:
-    lat_deg: float = setting(unit="deg", doc="latitude", ge=-90, le=90)
-    lon_deg: float = setting(unit="deg", doc="east longitude", ge=-360, le=360)
-
-
-@section("terrain.dem", 'a real site: a DEM product users download and the landing site on it (docs/rendering.md "Real '
-         'sites"; pip install traj2events[dem])')  # fmt: skip
-class DemSection:
-    file: str = setting(doc="the product: GeoTIFF or cloud-optimised GeoTIFF, PDS3 .IMG (with its .LBL), PDS4 .xml, "
-                        "ISIS3 .cub; read through GDAL with its map projection, nodata, scale and offset")  # fmt: skip
-    site: DemSite = setting(DemSite, "", "where the trajectories land (x north, y east of it)")
-    far: str | None = setting(None, "", "a coarser product around it for the far field (LOLA's polar 20-240 m, or a "
-                              "global one): where the site's has no data, the horizon and the shadows it casts; "
-                              "beyond both, the sphere", optional=True)  # fmt: skip
-    detail: bool = setting(True, "", "add the procedural surface's craters, boulders, rocks and roughness (terrain's "
-                           "other keys) below the posts' resolution, so that the last seconds have texture; the "
-                           "posts' means are kept (docs/rendering.md \"Real sites\")", optional=True)  # fmt: skip
-
-
-def terrain_files(terrain: dict) -> list[str]:
-    """The files the surface is read from (the render rule's inputs): terrain.elevation_grid,
-    or terrain.dem's products (the site's, the far field's), each with a PDS3 image's
-    detached label or a label's image beside it."""
-    if terrain.get("elevation_grid"):
-        return [terrain["elevation_grid"]]
-    if not terrain.get("dem"):
-        return []
-    files = []
-    for name in (terrain["dem"]["file"], terrain["dem"].get("far")):
-        if name:
-            path = Path(name)
-            siblings = [path.with_suffix(s) for s in (".LBL", ".lbl", ".IMG", ".img")]
-            files += [str(path), *sorted(str(p) for p in siblings if p != path and p.exists())]
-    return files
 
 
 @section("terrain", "the procedural surface (sources in docs/rendering.md), or a DEM in its place")
@@ -232,6 +195,16 @@ class SunSection:
     elevation_deg: float | list[float] = setting(unit="deg", doc="above the horizon at the site (at or below it the "
                                                  "scene is black), or [low, high]: drawn per trajectory", gt=0, le=90,
                                                  length=2)  # fmt: skip
+    utc: str | None = setting(None, "", "a date (UTC, ISO 8601, e.g. 2027-03-01T12:00:00): the three keys above are "
+                              "then the Sun's at terrain.dem's site, from the kernels of `spice` "
+                              '(docs/rendering.md "The Sun of a date")', optional=True)  # fmt: skip
+    spice: str | None = setting(None, "", "with utc: a SPICE meta-kernel loading leap seconds, the Sun's and the "
+                                "Moon's ephemeris and the Moon's frame", optional=True)  # fmt: skip
+    frame: str = setting("IAU_MOON", "", "with utc: the Moon's body-fixed frame of the DEM's latitudes and "
+                         "longitudes (LOLA's products: MOON_ME)", optional=True)  # fmt: skip
+
+
+SUN_KEYS = ("range_m", "azimuth_deg", "elevation_deg")  # what the scene takes of scenarios.<name>.sun
 
 
 @section(
@@ -278,7 +251,7 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
     elevation given as [low, high] is drawn uniformly for each trajectory from the dataset's
     seed, the scenario and `trajectory_id` (the same config, the same Suns); without an id,
     the range's middle."""
-    sun = dict(config["scenarios"][name]["sun"])
+    sun = {k: config["scenarios"][name]["sun"][k] for k in SUN_KEYS}  # (a date's: computed at resolve_config)
     ranges = [k for k in ("azimuth_deg", "elevation_deg") if isinstance(sun[k], list)]
     if ranges and trajectory_id is None:
         return {**sun, **{k: 0.5 * (sun[k][0] + sun[k][1]) for k in ranges}}

@@ -1,0 +1,60 @@
+"""The Sun of a date at a real site, from SPICE kernels (spiceypy, the `spice` extra).
+
+At the UTC time of `scenarios.<name>.sun.utc`, the apparent position of the Sun seen from
+the Moon's centre (light time and stellar aberration corrected, SPICE's "LT+S"), in the
+Moon's body-fixed frame of the site's DEM (IAU_MOON, or LOLA's MOON_ME), less the site's
+own position R up gives the vector s from the site to the Sun. With the site's north, east
+and up (`scene.dem.site_axes`):
+
+    azimuth   = atan2(s . east, s . north)      (from +x = north toward +y = east)
+    elevation = asin(s . up / |s|)
+    range     = |s|
+
+The accuracy rests on the kernels the user loads: the planetary ephemeris (JPL's DE440:
+metres) and the Moon's orientation (DE440's lunar libration PCK with the MOON_ME frame
+kernel: well under 1 km on the surface; IAU_MOON's rotation model: ~150 m).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+from .dem import site_axes
+
+
+class EphemerisError(ValueError):
+    """Kernels or a date SPICE cannot use, naming the file and what was expected."""
+
+
+def sun_at_site(
+    utc: str, metakernel: str | os.PathLike, lat_deg: float, lon_deg: float, radius_m: float, frame: str
+) -> dict:
+    """{range_m, azimuth_deg, elevation_deg} of the Sun at the site at `utc` (ISO 8601)."""
+    try:
+        import spiceypy as sp
+        from spiceypy.utils.exceptions import SpiceyError
+    except ImportError:
+        raise EphemerisError("the Sun of a date needs spiceypy: pip install 'traj2events[spice]'") from None
+    if not os.path.exists(metakernel):
+        raise EphemerisError(f"{metakernel} does not exist (a SPICE meta-kernel: leap seconds, the ephemeris, "
+                             "the Moon's frame)")  # fmt: skip
+    sp.kclear()
+    try:
+        sp.furnsh(str(metakernel))
+        et = sp.str2et(utc)
+        sun_km, _ = sp.spkpos("SUN", et, frame, "LT+S", "MOON")
+    except SpiceyError as exc:
+        raise EphemerisError(f"{metakernel} at {utc}: SPICE: {exc.short or exc}: {exc.explain or ''}".strip()) from None
+    finally:
+        sp.kclear()
+    north, east, up = site_axes(lat_deg, lon_deg)
+    s = np.asarray(sun_km, float) * 1e3 - radius_m * up
+    distance = float(np.linalg.norm(s))
+    return {
+        "range_m": distance,
+        "azimuth_deg": math.degrees(math.atan2(float(s @ east), float(s @ north))),
+        "elevation_deg": math.degrees(math.asin(float(s @ up) / distance)),
+    }

@@ -1,0 +1,46 @@
+"""A real site's settings (`terrain.dem`, docs/rendering.md "Real sites"): the DEM products
+and the landing site on them, and the files the render rule reads them from. The standard
+library only: the workflow's DAG reads them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from .declare import section, setting
+
+
+@section("terrain.dem.site", "the landing site on the product (planetocentric, as the IAU 2015 Moon CRSs)")
+class DemSite:
+    lat_deg: float = setting(unit="deg", doc="latitude", ge=-90, le=90)
+    lon_deg: float = setting(unit="deg", doc="east longitude", ge=-360, le=360)
+
+
+@section("terrain.dem", 'a real site: a DEM product users download and the landing site on it (docs/rendering.md "Real '
+         'sites"; pip install traj2events[dem])')  # fmt: skip
+class DemSection:
+    file: str = setting(doc="the product: GeoTIFF or cloud-optimised GeoTIFF, PDS3 .IMG (with its .LBL), PDS4 .xml, "
+                        "ISIS3 .cub; read through GDAL with its map projection, nodata, scale and offset")  # fmt: skip
+    site: DemSite = setting(DemSite, "", "where the trajectories land (x north, y east of it)")
+    far: str | None = setting(None, "", "a coarser product around it for the far field (LOLA's polar 20-240 m, or a "
+                              "global one): where the site's has no data, the horizon and the shadows it casts; "
+                              "beyond both, the sphere", optional=True)  # fmt: skip
+    detail: bool = setting(True, "", "add the procedural surface's craters, boulders, rocks and roughness (terrain's "
+                           "other keys) below the posts' resolution, so that the last seconds have texture; the "
+                           "posts' means are kept (docs/rendering.md \"Real sites\")", optional=True)  # fmt: skip
+
+
+def terrain_files(terrain: dict) -> list[str]:
+    """The files the surface is read from (the render rule's inputs): terrain.elevation_grid,
+    or terrain.dem's products (the site's, the far field's), each with a PDS3 image's
+    detached label or a label's image beside it."""
+    if terrain.get("elevation_grid"):
+        return [terrain["elevation_grid"]]
+    if not terrain.get("dem"):
+        return []
+    files = []
+    for name in (terrain["dem"]["file"], terrain["dem"].get("far")):
+        if name:
+            path = Path(name)
+            siblings = [path.with_suffix(s) for s in (".LBL", ".lbl", ".IMG", ".img")]
+            files += [str(path), *sorted(str(p) for p in siblings if p != path and p.exists())]
+    return files
