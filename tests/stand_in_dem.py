@@ -35,18 +35,18 @@ def relief(x, y):
     return -1500.0 + 200.0 * np.sin(2 * np.pi * x / 4000.0) * np.cos(2 * np.pi * y / 5000.0) + 0.01 * x
 
 
-def site_posts(n=600, post_m=POST_M):
+def site_posts(n=600, post_m=POST_M, site=SITE):
     """A 12 km square of 20 m posts around SITE, as LOLA's polar products lay them out: the
     upper-left corner (x_min, y_max) and the heights, rows southwards in the map's y."""
-    x0, y0 = stereographic(*SITE)
+    x0, y0 = stereographic(*site)
     x_min, y_max = x0 - n * post_m / 2, y0 + n * post_m / 2
     cols, rows = np.meshgrid(np.arange(n), np.arange(n))
     return x_min, y_max, relief(x_min + (cols + 0.5) * post_m, y_max - (rows + 0.5) * post_m)
 
 
-def write_site_dem(path, n=600, crs="IAU_2015:30135", scale=1.0, hole=False, units=None, post_m=POST_M):
+def write_site_dem(path, n=600, crs="IAU_2015:30135", scale=1.0, hole=False, units=None, post_m=POST_M, site=SITE):
     """The posts as a tiled GeoTIFF with its IAU CRS."""
-    x_min, y_max, heights = site_posts(n, post_m)
+    x_min, y_max, heights = site_posts(n, post_m, site)
     heights = heights / scale
     if hole:
         heights[n // 2 - 1 : n // 2 + 2, n // 2 - 1 : n // 2 + 2] = NODATA  # under the site
@@ -111,10 +111,10 @@ WRITERS = {"geotiff": lambda folder: write_site_dem(folder / "site.tif"),
 MASSIF = (60_000.0, 0.0, 3000.0, 8000.0)
 
 
-def far_posts(n=1200, post_m=250.0, massif=MASSIF):
-    """A 300 km square of 250 m posts around SITE (LOLA's large-area products' layout): a
+def far_posts(n=1200, post_m=250.0, massif=MASSIF, site=SITE):
+    """A 300 km square of 250 m posts around `site` (LOLA's large-area products' layout): a
     level -1500 m plain and the massif."""
-    x0, y0 = stereographic(*SITE)
+    x0, y0 = stereographic(*site)
     x_min, y_max = x0 - n * post_m / 2, y0 + n * post_m / 2
     cols, rows = np.meshgrid(np.arange(n), np.arange(n))
     x, y = x_min + (cols + 0.5) * post_m, y_max - (rows + 0.5) * post_m
@@ -123,8 +123,8 @@ def far_posts(n=1200, post_m=250.0, massif=MASSIF):
     return x_min, y_max, -1500.0 + height * np.exp(-d2 / (2 * sigma**2))
 
 
-def write_far_dem(path, n=1200, post_m=250.0):
-    x_min, y_max, heights = far_posts(n, post_m)
+def write_far_dem(path, n=1200, post_m=250.0, site=SITE):
+    x_min, y_max, heights = far_posts(n, post_m, site=site)
     transform = rasterio.transform.Affine(post_m, 0.0, x_min, 0.0, -post_m, y_max)
     profile = {"driver": "GTiff", "width": n, "height": n, "count": 1, "dtype": "float32", "nodata": NODATA,
                "transform": transform, "tiled": True, "blockxsize": 256, "blockysize": 256,

@@ -30,6 +30,26 @@ def test_shipped_configs_are_valid(name):
     load_config(ROOT / "config" / name)
 
 
+def test_the_site_config_flies_the_paper_scenarios_over_its_products(tmp_path, monkeypatch):
+    """config/site.yaml with its two LOLA products written as stand-ins where it expects them
+    (tests/stand_in_dem.py) resolves, the sphere through its site taken from them; without
+    them, the check names the missing file."""
+    pytest.importorskip("rasterio")
+    from stand_in_dem import R, relief, stereographic, write_far_dem, write_site_dem
+
+    overlay = load_yaml(ROOT / "config" / "site.yaml")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ConfigError, match=r"'terrain.dem.file': dem/LDEM_80S_20MPP_ADJ.TIF does not exist"):
+        resolve_config(overlay)
+    site = tuple(overlay["terrain"]["dem"]["site"].values())
+    (tmp_path / "dem").mkdir()
+    write_site_dem(tmp_path / overlay["terrain"]["dem"]["file"], site=site)
+    write_far_dem(tmp_path / overlay["terrain"]["dem"]["far"], site=site)
+    config = resolve_config(overlay)
+    assert list(config["scenarios"]) == ["braking", "approach", "descent"]
+    assert config["motion_field"]["moon_radius_m"] == pytest.approx(R + relief(*stereographic(*site)), abs=0.05)
+
+
 def test_paper_config_has_500_trajectories():
     config = load_config(ROOT / "config" / "paper.yaml")
     assert sum(s["n_trajectories"] for s in config["scenarios"].values()) == 500
