@@ -49,7 +49,7 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
                           "divert_acceleration_added_max_m_s2": [0.75, np.nan], "hover": "none"})  # fmt: skip
     index.to_csv(tmp_path / "index.csv", index=False)
     pd.DataFrame({"scenario": ["descent"], "wanted": [2], "solved": [2]}).to_csv(tmp_path / "summary.csv", index=False)
-    config = {"camera": {"width": 4, "height": 2}, "seed": 7}
+    config = {"camera": {"width": 4, "height": 2}, "seed": 7, "terrain": {"seed": 3, "dem": None}}
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), tmp_path / "o.html")
     page = (tmp_path / "o.html").read_text()
     assert "2 trajectories, 22 frames of 4 x 2 px, 2,050 events" in page  # numbers as people read them
@@ -62,6 +62,7 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
     # The diverts' table: one flown, none failed, its offset and added acceleration.
     assert "<td>divert</td>\n      <td>1</td>\n      <td>0</td>\n      <td>42</td>\n      <td>42</td>" in page
     assert "<td>0.75</td>" in page and "<td>file</td>" in page and "<td>OCP</td>" in page
+    assert "Surface: procedural (terrain.seed 3" in page
     assert page.count("alt='frame and events'") == 1 and f"{EVENTS_PER_PIXEL_SHOWN:g} events per pixel" in page
     again = tmp_path / "again.html"
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), again)
@@ -73,3 +74,12 @@ def test_numbers_read_as_people_write_them():
 
     assert [readable(v) for v in (101362685, 2.431e5, 0.0421, 42.0, 1.5, float("nan"), "a<b")] == [
         "101,362,685", "243,100", "0.0421", "42", "1.5", "", "a&lt;b"]  # fmt: skip
+
+
+def test_the_surface_line_names_a_real_sites_products():
+    from traj2events.stages.overview import surface_line
+
+    dem = {"file": "dem/LDEM_80S_20MPP_ADJ.TIF", "far": "dem/far.tif", "site": {"lat_deg": -83.44, "lon_deg": 180.0}}
+    line = surface_line({"seed": 1, "dem": dem})
+    assert "<code>dem/LDEM_80S_20MPP_ADJ.TIF</code> at -83.44 deg, 180 deg E" in line and "dem/far.tif" in line
+    assert "procedural detail" in line and "procedural detail" not in surface_line({"dem": {**dem, "detail": False}})

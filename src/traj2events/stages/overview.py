@@ -84,6 +84,21 @@ def scene_panel(folder: Path, title: str) -> bytes:
     ), dpi=100)  # fmt: skip
 
 
+def surface_line(terrain: dict) -> str:
+    """What the surface is made of, in a sentence: a real site's products, a user grid, or
+    the procedural surface and its seed."""
+    dem = terrain.get("dem")
+    if dem:
+        far = f", the far field from <code>{html.escape(dem['far'])}</code>" if dem.get("far") else ""
+        detail = ", with the procedural detail below its posts" if dem.get("detail", True) else ""
+        return (f"Surface: a real site, <code>{html.escape(dem['file'])}</code> at {dem['site']['lat_deg']:g} deg, "
+                f"{dem['site']['lon_deg']:g} deg E{far}{detail} (frames.h5 records each product's name, SHA-256 "
+                "and CRS).")  # fmt: skip
+    if terrain.get("elevation_grid"):
+        return f"Surface: the elevation grid <code>{html.escape(terrain['elevation_grid'])}</code>."
+    return f'Surface: procedural (terrain.seed {terrain["seed"]}; docs/rendering.md "Terrain").'
+
+
 def readable(value) -> str:
     """A number as a person reads it: integers with thousands separators (101,362,685),
     others to 3 significant digits, those of 1,000 and more whole (243,100); blank: NaN."""
@@ -143,6 +158,7 @@ def overview_html(
         f"{readable(int(trajectories['frames'].sum()))} frames of {html.escape(str(config['camera']['width']))} x "
         f"{html.escape(str(config['camera']['height']))} px, {readable(int(trajectories['events'].sum()))} events, "
         f"{trajectories['MB'].sum():.1f} MB on disk (docs/dataset.md describes every file).</p>",
+        f"<p>{surface_line(config['terrain'])}</p>",
         "<h2>Per scenario</h2>", _table(per_scenario),
         *(["<h2>What the camera sees</h2><p>Per scenario, its first trajectory at mid-flight: the display frame "
            "(video.mkv: linear radiance through the display white and gamma) and the events around that instant, a "
