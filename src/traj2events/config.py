@@ -244,21 +244,40 @@ def with_dated_suns(config: dict) -> dict:
     if not dated or not isinstance(dem, dict) or not models_importable():
         return config
     from .scene.ephemeris import EphemerisError, sun_at_site
+    from .settings.render import date_between
 
     site, radius, suns = dem["site"], float(config["motion_field"]["moon_radius_m"]), {}
     for name, sun in dated.items():
         if not sun.get("spice"):
             continue  # the check names it
-        try:
-            at = (site["lat_deg"], site["lon_deg"], radius, sun.get("frame", "IAU_MOON"))
-            suns[name] = sun_at_site(sun["utc"], sun["spice"], *at)
-        except EphemerisError as exc:
-            raise ConfigError(f"config key 'scenarios.{name}.sun.spice': {exc}") from None
-        if suns[name]["elevation_deg"] <= 0:
-            raise ConfigError(f"config key 'scenarios.{name}.sun.utc': at {sun['utc']} the Sun is "
-                              f"{-suns[name]['elevation_deg']:.3g} deg below the site's horizon (the scene would be "
-                              "black): expected a date with the Sun up")  # fmt: skip
+        dates = [sun["utc"]]
+        if isinstance(sun["utc"], list):  # a date per trajectory: the Sun up over the whole range
+            try:
+                dates = [date_between(*sun["utc"], k / (DATE_RANGE_SAMPLES - 1)) for k in range(DATE_RANGE_SAMPLES)]
+            except (TypeError, ValueError):
+                raise ConfigError(f"config key 'scenarios.{name}.sun.utc': expected [first, last] ISO 8601 dates "
+                                  f"(e.g. 2027-03-01T12:00:00), got {sun['utc']}") from None  # fmt: skip
+            if dates[0] > dates[-1]:
+                raise ConfigError(f"config key 'scenarios.{name}.sun.utc': expected [first, last] with first <= "
+                                  f"last, got {sun['utc']}")  # fmt: skip
+        at = (site["lat_deg"], site["lon_deg"], radius, sun.get("frame", "IAU_MOON"))
+        for date in dates:
+            try:
+                found = sun_at_site(date, sun["spice"], *at)
+            except EphemerisError as exc:
+                raise ConfigError(f"config key 'scenarios.{name}.sun.spice': {exc}") from None
+            if found["elevation_deg"] <= 0:
+                raise ConfigError(f"config key 'scenarios.{name}.sun.utc': at {date} the Sun is "
+                                  f"{-found['elevation_deg']:.3g} deg below the site's horizon (the scene would be "
+                                  "black): expected dates with the Sun up")  # fmt: skip
+        if not isinstance(sun["utc"], list):
+            suns[name] = found
+    if not suns:  # (an empty `scenarios` would name no scenario to build)
+        return config
     return merge_config(config, {"scenarios": {name: {"sun": sun} for name, sun in suns.items()}})
+
+
+DATE_RANGE_SAMPLES = 97  # dates a range of scenarios.<name>.sun.utc is checked at (both ends included)
 
 
 def _semantic_errors(config: dict) -> list[str]:

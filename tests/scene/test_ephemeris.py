@@ -50,7 +50,7 @@ BODY301_PM = ( {W0} {W_DOT} 0.0 )
     sp.furnsh(str(folder / "leap.tls"))
     et = sp.str2et(UTC)
     sp.kclear()
-    epochs = et + np.array([-86400.0, 0.0, 86400.0, 172800.0])
+    epochs = et + np.linspace(-40.0, 40.0, 9) * 86400.0  # 40 days either side
     sun_j2000 = to_fixed(et).T @ SUN_FIXED_KM
     handle = sp.spkopn(str(folder / "sun.bsp"), "test", 0)
     for body, position in ((10, np.zeros(3)), (301, -sun_j2000)):
@@ -120,3 +120,40 @@ def test_a_dated_sun_fills_the_scenarios_sun_and_bad_kernels_or_dates_are_named(
         resolve_config({"terrain": site, "scenarios": {"descent": {"sun": {**sun, "utc": "1990-01-01T00:00:00"}}}})
     with pytest.raises(EphemerisError, match="SPICE"):
         sun_at_site("not a date", metakernel, *SITE, 1_736_000.0, "IAU_MOON")
+
+
+def test_a_range_of_dates_draws_one_per_trajectory_and_its_render_job_lights_it(tmp_path):
+    """sun.utc: [first, last]: each trajectory's render settings carry a date of its own in the
+    range (seeded, as a drawn azimuth), and the scene's Sun is that date's; a range in which
+    the Sun sets at a mid-latitude site is refused naming the date."""
+    from traj2events.settings.render import RenderSettings, dated_sun, render_settings
+
+    metakernel, et, sun_j2000 = write_kernels(tmp_path)
+    dem = write_site_dem(tmp_path / "site.tif")
+    site = {"dem": {"file": str(dem), "site": {"lat_deg": SITE[0], "lon_deg": SITE[1]}}}
+    dates = ["2027-02-20T00:00:00", "2027-03-10T00:00:00"]
+    sun = {"utc": dates, "spice": metakernel, "range_m": 1.5e11, "azimuth_deg": 0.0, "elevation_deg": 5.0}
+    config = resolve_config({"terrain": site, "scenarios": {"descent": {"sun": sun, "n_trajectories": 3}}})
+    drawn = [RenderSettings(**render_settings(config, "descent", f"{i:04d}")).sun for i in range(3)]
+    assert all(dates[0] <= d["utc"] <= dates[1] for d in drawn) and len({d["utc"] for d in drawn}) == 3
+    assert drawn == [RenderSettings(**render_settings(config, "descent", f"{i:04d}")).sun for i in range(3)]  # seeded
+    radius = config["motion_field"]["moon_radius_m"]
+    for d in drawn:
+        got = dated_sun(d, config["terrain"], radius)
+        expected = expected_sun(sp_et(tmp_path, d["utc"]), sun_j2000, *SITE, radius)
+        assert got["azimuth_deg"] == pytest.approx(expected[1], abs=1e-6)
+        assert got["elevation_deg"] == pytest.approx(expected[2], abs=1e-6)
+    mid = write_site_dem(tmp_path / "mid.tif", site=(-60.0, 30.0))
+    sets = {"dem": {"file": str(mid), "site": {"lat_deg": -60.0, "lon_deg": 30.0}}}
+    with pytest.raises(ConfigError, match=r"'scenarios.descent.sun.utc': at 2027-0.* below the site's horizon"):
+        resolve_config({"terrain": sets, "scenarios": {"descent": {"sun": sun}}})
+
+
+def sp_et(folder, utc: str) -> float:
+    """TDB seconds past J2000 of a UTC date, through the leap seconds written in `folder`."""
+    sp.kclear()
+    sp.furnsh(str(folder / "leap.tls"))
+    try:
+        return sp.str2et(utc)
+    finally:
+        sp.kclear()

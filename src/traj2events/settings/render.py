@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from datetime import datetime
 
 from ..geometry.horizon import horizon_distance_m
 from . import trajectory_rng
@@ -195,9 +196,11 @@ class SunSection:
     elevation_deg: float | list[float] = setting(unit="deg", doc="above the horizon at the site (at or below it the "
                                                  "scene is black), or [low, high]: drawn per trajectory", gt=0, le=90,
                                                  length=2)  # fmt: skip
-    utc: str | None = setting(None, "", "a date (UTC, ISO 8601, e.g. 2027-03-01T12:00:00): the three keys above are "
-                              "then the Sun's at terrain.dem's site, from the kernels of `spice` "
-                              '(docs/rendering.md "The Sun of a date")', optional=True)  # fmt: skip
+    utc: str | list[str] | None = setting(None, "", "a date (UTC, ISO 8601, e.g. 2027-03-01T12:00:00): the three "
+                                          "keys above are then the Sun's at terrain.dem's site, from the kernels of "
+                                          "`spice`; or [first, last]: a date drawn per trajectory, its Sun computed "
+                                          'by its render job (docs/rendering.md "The Sun of a date")', optional=True,
+                                          length=2)  # fmt: skip
     spice: str | None = setting(None, "", "with utc: a SPICE meta-kernel loading leap seconds, the Sun's and the "
                                 "Moon's ephemeris and the Moon's frame", optional=True)  # fmt: skip
     frame: str = setting("IAU_MOON", "", "with utc: the Moon's body-fixed frame of the DEM's latitudes and "
@@ -251,7 +254,12 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
     elevation given as [low, high] is drawn uniformly for each trajectory from the dataset's
     seed, the scenario and `trajectory_id` (the same config, the same Suns); without an id,
     the range's middle."""
-    sun = {k: config["scenarios"][name]["sun"][k] for k in SUN_KEYS}  # (a date's: computed at resolve_config)
+    own = config["scenarios"][name]["sun"]
+    sun = {k: own[k] for k in SUN_KEYS}  # (one date's: computed at resolve_config)
+    if isinstance(own.get("utc"), list):  # a date per trajectory, its Sun the render job's (`dated_sun`)
+        fraction = 0.5 if trajectory_id is None else trajectory_rng(config, name, trajectory_id, "sun").random()
+        return {**sun, "utc": date_between(*own["utc"], fraction), "spice": own["spice"],
+                "frame": own.get("frame", "IAU_MOON")}  # fmt: skip
     ranges = [k for k in ("azimuth_deg", "elevation_deg") if isinstance(sun[k], list)]
     if ranges and trajectory_id is None:
         return {**sun, **{k: 0.5 * (sun[k][0] + sun[k][1]) for k in ranges}}
@@ -259,6 +267,23 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
         rng = trajectory_rng(config, name, trajectory_id, "sun")
         sun.update({k: rng.uniform(*sun[k]) for k in ranges})
     return sun
+
+
+def date_between(first: str, last: str, fraction: float) -> str:
+    """The UTC date `fraction` of the way from `first` to `last` (ISO 8601), to the second."""
+    start, end = (datetime.fromisoformat(d) for d in (first, last))
+    return (start + (end - start) * fraction).replace(microsecond=0).isoformat()
+
+
+def dated_sun(sun: dict, terrain: dict, radius_m: float) -> dict:
+    """The Sun's {range_m, azimuth_deg, elevation_deg}: a drawn date's at terrain.dem's site
+    (scene.ephemeris, imported here only then), else as given."""
+    if "utc" not in sun:
+        return {k: sun[k] for k in SUN_KEYS}
+    from ..scene.ephemeris import sun_at_site
+
+    site = terrain["dem"]["site"]
+    return sun_at_site(sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"])
 
 
 # The render command's options: each key of render_settings that is a config key's (the
@@ -433,7 +458,7 @@ class RenderSettings:
             terrain = dem_terrain(dem, self.moon_radius_m, TerrainParams(**t) if dem.get("detail", True) else None)
         else:
             terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
-        sun = Sun(**self.sun)
+        sun = Sun(**dated_sun(self.sun, self.terrain, self.moon_radius_m))
         lod = LodSettings(**self.lod)
         azimuths = int(self.scattered_light["azimuths"])
         tiles = TileSet(

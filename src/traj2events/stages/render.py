@@ -72,7 +72,8 @@ class TrajectoryRender:
             **provenance(__name__),
         }
         dem = getattr(self.tiles.terrain, "attrs", None)  # a real site's product (scene.dem), named and hashed
-        self.attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER} | (dem() if dem else {})
+        dated = {"sun_utc": settings.sun["utc"]} if "utc" in settings.sun else {}  # a date drawn per trajectory
+        self.attrs = {k: attrs[k] for k in FRAME_ATTR_ORDER} | (dem() if dem else {}) | dated
 
     def frames(
         self,
