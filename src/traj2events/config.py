@@ -243,10 +243,10 @@ def with_dated_suns(config: dict) -> dict:
     dem = config.get("terrain", {}).get("dem") if isinstance(config.get("terrain"), dict) else None
     if not dated or not isinstance(dem, dict) or not models_importable():
         return config
-    from .scene.ephemeris import EphemerisError, sun_at_site
-    from .settings.render import date_between
+    from .scene.ephemeris import EphemerisError, body_at_site, sun_at_site
+    from .settings.site import date_between
 
-    site, radius, suns = dem["site"], float(config["motion_field"]["moon_radius_m"]), {}
+    site, radius, suns, earths = dem["site"], float(config["motion_field"]["moon_radius_m"]), {}, {}
     for name, sun in dated.items():
         if not sun.get("spice"):
             continue  # the check names it
@@ -272,9 +272,18 @@ def with_dated_suns(config: dict) -> dict:
                                   "black): expected dates with the Sun up")  # fmt: skip
         if not isinstance(sun["utc"], list):
             suns[name] = found
+            earth = scenarios[name].get("earth")
+            if isinstance(earth, dict) and earth.get("dated"):  # the Earth of the same date
+                seen = body_at_site("EARTH", sun["utc"], sun["spice"], *at)
+                earths[name] = {**earth, **{k: seen[k] for k in ("azimuth_deg", "elevation_deg")}}
+                if seen["elevation_deg"] <= 0:
+                    earths[name] = None  # below the horizon: no earthshine
     if not suns:  # (an empty `scenarios` would name no scenario to build)
         return config
-    return merge_config(config, {"scenarios": {name: {"sun": sun} for name, sun in suns.items()}})
+    config = merge_config(config, {"scenarios": {name: {"sun": sun} for name, sun in suns.items()}})
+    for name, earth in earths.items():
+        config["scenarios"][name]["earth"] = earth
+    return config
 
 
 DATE_RANGE_SAMPLES = 97  # dates a range of scenarios.<name>.sun.utc is checked at (both ends included)

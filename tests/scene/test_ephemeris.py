@@ -12,10 +12,16 @@ from stand_in_dem import SITE, write_site_dem  # noqa: E402
 from traj2events.config import ConfigError, resolve_config  # noqa: E402
 from traj2events.scene.ephemeris import EphemerisError, sun_at_site  # noqa: E402
 
+
 # Where the written ephemeris puts the Sun at UTC: 1.48e8 km from the Moon, at body-fixed
 # latitude -3 deg and longitude 30 deg, so that it stands ~2.5 deg above the polar site's horizon.
-SUN_FIXED_KM = 1.48e8 * np.array([np.cos(np.radians(-3)) * np.cos(np.radians(30)),
-                                  np.cos(np.radians(-3)) * np.sin(np.radians(30)), np.sin(np.radians(-3))])  # fmt: skip
+def fixed_vector(distance_km, lat_deg, lon_deg):
+    lat, lon = np.radians([lat_deg, lon_deg])
+    return distance_km * np.array([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)])
+
+
+SUN_FIXED_KM = fixed_vector(1.48e8, -3.0, 30.0)
+EARTH_FIXED_KM = fixed_vector(384_400.0, -2.0, 80.0)  # ~1.5 deg up at the polar site, 50 deg from the Sun
 ALPHA0, DELTA0, W0, W_DOT = 269.9949, 66.5392, 38.3213, 13.17635815  # deg, deg/day (the Moon's, without terms)
 UTC = "2027-03-01T12:00:00"
 LSK = r"""\begindata
@@ -52,8 +58,9 @@ BODY301_PM = ( {W0} {W_DOT} 0.0 )
     sp.kclear()
     epochs = et + np.linspace(-40.0, 40.0, 9) * 86400.0  # 40 days either side
     sun_j2000 = to_fixed(et).T @ SUN_FIXED_KM
+    earth_j2000 = to_fixed(et).T @ EARTH_FIXED_KM
     handle = sp.spkopn(str(folder / "sun.bsp"), "test", 0)
-    for body, position in ((10, np.zeros(3)), (301, -sun_j2000)):
+    for body, position in ((10, np.zeros(3)), (301, -sun_j2000), (399, earth_j2000 - sun_j2000)):
         states = np.tile(np.concatenate([position, np.zeros(3)]), (len(epochs), 1))
         sp.spkw09(handle, body, 0, "J2000", epochs[0], epochs[-1], "still", 3, len(epochs), states, epochs)
     sp.spkcls(handle)
@@ -126,7 +133,8 @@ def test_a_range_of_dates_draws_one_per_trajectory_and_its_render_job_lights_it(
     """sun.utc: [first, last]: each trajectory's render settings carry a date of its own in the
     range (seeded, as a drawn azimuth), and the scene's Sun is that date's; a range in which
     the Sun sets at a mid-latitude site is refused naming the date."""
-    from traj2events.settings.render import RenderSettings, dated_sun, render_settings
+    from traj2events.settings.render import RenderSettings, render_settings
+    from traj2events.settings.site import dated_sun
 
     metakernel, et, sun_j2000 = write_kernels(tmp_path)
     dem = write_site_dem(tmp_path / "site.tif")
@@ -157,3 +165,31 @@ def sp_et(folder, utc: str) -> float:
         return sp.str2et(utc)
     finally:
         sp.kclear()
+
+
+def test_the_earth_of_the_suns_date_lights_earthshine_and_below_the_horizon_none(tmp_path):
+    """earth.dated: the Earth of the Sun's date, from the same kernels (written at a known
+    vector here): its azimuth and elevation at one date (the config), at a drawn date (the
+    render job), and no earthshine where it is below the site's horizon."""
+    from traj2events.settings.render import RenderSettings, render_settings
+
+    metakernel, et, _ = write_kernels(tmp_path)
+    earth_j2000 = to_fixed(et).T @ EARTH_FIXED_KM
+    dem = write_site_dem(tmp_path / "site.tif")
+    site = {"dem": {"file": str(dem), "site": {"lat_deg": SITE[0], "lon_deg": SITE[1]}}}
+    sun = {"utc": UTC, "spice": metakernel, "range_m": 1.5e11, "azimuth_deg": 0.0, "elevation_deg": 5.0}
+    earth = {"azimuth_deg": 0.0, "elevation_deg": 10.0, "dated": True}
+    config = resolve_config({"terrain": site, "scenarios": {"descent": {"sun": sun, "earth": earth}}})
+    radius = config["motion_field"]["moon_radius_m"]
+    _, azimuth, elevation = expected_sun(et, earth_j2000, *SITE, radius)  # the same law, another body
+    got = config["scenarios"]["descent"]["earth"]
+    assert 0 < elevation < 5 and got["azimuth_deg"] == pytest.approx(azimuth, abs=1e-6)
+    assert got["elevation_deg"] == pytest.approx(elevation, abs=1e-6)
+    ranged = {**sun, "utc": [UTC, UTC]}
+    config = resolve_config({"terrain": site, "scenarios": {"descent": {"sun": ranged, "earth": earth}}})
+    light = RenderSettings(**render_settings(config, "descent", "0000")).earth_light()
+    assert light.elevation_deg == pytest.approx(elevation, abs=1e-6)
+    north = write_site_dem(tmp_path / "set.tif", site=(-80.0, -30.0))  # the Sun 8 deg up, the Earth 1.4 down
+    away = {"dem": {"file": str(north), "site": {"lat_deg": -80.0, "lon_deg": -30.0}}}
+    config = resolve_config({"terrain": away, "scenarios": {"descent": {"sun": {**sun}, "earth": earth}}})
+    assert config["scenarios"]["descent"]["earth"] is None

@@ -1,4 +1,4 @@
-"""The Sun of a date at a real site, from SPICE kernels (spiceypy, the `spice` extra).
+"""The Sun (and the Earth) of a date at a real site, from SPICE kernels (spiceypy, the `spice` extra).
 
 At the UTC time of `scenarios.<name>.sun.utc`, the apparent position of the Sun seen from
 the Moon's centre (light time and stellar aberration corrected, SPICE's "LT+S"), in the
@@ -10,6 +10,7 @@ and up (`scene.dem.site_axes`):
     elevation = asin(s . up / |s|)
     range     = |s|
 
+The Earth's direction, earthshine's source, is found the same way (`body_at_site`).
 The accuracy rests on the kernels the user loads: the planetary ephemeris (JPL's DE440:
 metres) and the Moon's orientation (DE440's lunar libration PCK with the MOON_ME frame
 kernel: well under 1 km on the surface; IAU_MOON's rotation model: ~150 m).
@@ -33,6 +34,13 @@ def sun_at_site(
     utc: str, metakernel: str | os.PathLike, lat_deg: float, lon_deg: float, radius_m: float, frame: str
 ) -> dict:
     """{range_m, azimuth_deg, elevation_deg} of the Sun at the site at `utc` (ISO 8601)."""
+    return body_at_site("SUN", utc, metakernel, lat_deg, lon_deg, radius_m, frame)
+
+
+def body_at_site(
+    body: str, utc: str, metakernel: str | os.PathLike, lat_deg: float, lon_deg: float, radius_m: float, frame: str
+) -> dict:
+    """{range_m, azimuth_deg, elevation_deg} of `body` (SPICE's name: SUN, EARTH) at the site."""
     try:
         import spiceypy as sp
         from spiceypy.utils.exceptions import SpiceyError
@@ -45,7 +53,7 @@ def sun_at_site(
     try:
         sp.furnsh(str(metakernel))
         et = sp.str2et(utc)
-        sun_km, _ = sp.spkpos("SUN", et, frame, "LT+S", "MOON")
+        sun_km, _ = sp.spkpos(body, et, frame, "LT+S", "MOON")
     except SpiceyError as exc:
         raise EphemerisError(f"{metakernel} at {utc}: SPICE: {exc.short or exc}: {exc.explain or ''}".strip()) from None
     finally:

@@ -6,14 +6,13 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
-from datetime import datetime
 
 from ..geometry.horizon import horizon_distance_m
 from . import trajectory_rng
 from .camera import CameraSection
 from .declare import non_finite, section, setting
 from .poses import external_extents, is_external, scenario_divert
-from .site import DemSection
+from .site import SUN_KEYS, DemSection, date_between, dated_earth, dated_sun
 
 HAPKE = "representative lunar values after Helfenstein & Veverka (1987) and Sato et al. (2014), LROC WAC"
 PIKE = "Pike (1977)"
@@ -207,9 +206,6 @@ class SunSection:
                          "longitudes (LOLA's products: MOON_ME)", optional=True)  # fmt: skip
 
 
-SUN_KEYS = ("range_m", "azimuth_deg", "elevation_deg")  # what the scene takes of scenarios.<name>.sun
-
-
 @section(
     "scenarios.<name>.earth",
     "the Earth in the site's sky (the Sun's convention), the source of earthshine "
@@ -218,6 +214,8 @@ SUN_KEYS = ("range_m", "azimuth_deg", "elevation_deg")  # what the scene takes o
 class EarthSection:
     azimuth_deg: float = setting(unit="deg", doc="azimuth from +x toward +y", ge=-360, le=360)
     elevation_deg: float = setting(unit="deg", doc="above the horizon at the site", gt=0, le=90)
+    dated: bool = setting(False, "", "with the Sun's utc: the Earth of the same date, the two keys above then "
+                          "computed (at or below the horizon: no earthshine)", optional=True)  # fmt: skip
 
 
 @section("render", "the scene's rendering, its videos and where it runs")
@@ -267,23 +265,6 @@ def scenario_sun(config: dict, name: str, trajectory_id: str | None = None) -> d
         rng = trajectory_rng(config, name, trajectory_id, "sun")
         sun.update({k: rng.uniform(*sun[k]) for k in ranges})
     return sun
-
-
-def date_between(first: str, last: str, fraction: float) -> str:
-    """The UTC date `fraction` of the way from `first` to `last` (ISO 8601), to the second."""
-    start, end = (datetime.fromisoformat(d) for d in (first, last))
-    return (start + (end - start) * fraction).replace(microsecond=0).isoformat()
-
-
-def dated_sun(sun: dict, terrain: dict, radius_m: float) -> dict:
-    """The Sun's {range_m, azimuth_deg, elevation_deg}: a drawn date's at terrain.dem's site
-    (scene.ephemeris, imported here only then), else as given."""
-    if "utc" not in sun:
-        return {k: sun[k] for k in SUN_KEYS}
-    from ..scene.ephemeris import sun_at_site
-
-    site = terrain["dem"]["site"]
-    return sun_at_site(sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"])
 
 
 # The render command's options: each key of render_settings that is a config key's (the
@@ -473,10 +454,14 @@ class RenderSettings:
         )
 
     def earth_light(self):
-        """Earthshine's source (scenarios.<name>.earth: scene.earthshine.Earth), or None."""
+        """Earthshine's source (scenarios.<name>.earth: scene.earthshine.Earth), or None: none,
+        or the Earth of the Sun's drawn date below the site's horizon."""
         from ..scene.earthshine import Earth
 
-        return Earth(**self.earth) if self.earth else None
+        if not self.earth:
+            return None
+        earth = dated_earth(self.earth, self.sun, self.terrain, self.moon_radius_m)
+        return Earth(**earth) if earth else None
 
     def star_field(self):
         """The sky's stars (render.stars: scene.stars.StarField), or None where they are off."""

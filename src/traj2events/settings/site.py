@@ -1,9 +1,11 @@
 """A real site's settings (`terrain.dem`, docs/rendering.md "Real sites"): the DEM products
-and the landing site on them, and the files the render rule reads them from. The standard
-library only: the workflow's DAG reads them."""
+and the landing site on them, the files the render rule reads them from, and the Sun and
+the Earth of a date there. The standard library only: the workflow's DAG reads them (the
+ephemeris is imported by the render job, where a date asks for it)."""
 
 from __future__ import annotations
 
+from datetime import datetime
 from pathlib import Path
 
 from .declare import section, setting
@@ -44,3 +46,35 @@ def terrain_files(terrain: dict) -> list[str]:
             siblings = [path.with_suffix(s) for s in (".LBL", ".lbl", ".IMG", ".img")]
             files += [str(path), *sorted(str(p) for p in siblings if p != path and p.exists())]
     return files
+
+
+SUN_KEYS = ("range_m", "azimuth_deg", "elevation_deg")  # what the scene takes of scenarios.<name>.sun
+
+
+def date_between(first: str, last: str, fraction: float) -> str:
+    """The UTC date `fraction` of the way from `first` to `last` (ISO 8601), to the second."""
+    start, end = (datetime.fromisoformat(d) for d in (first, last))
+    return (start + (end - start) * fraction).replace(microsecond=0).isoformat()
+
+
+def dated_sun(sun: dict, terrain: dict, radius_m: float) -> dict:
+    """The Sun's {range_m, azimuth_deg, elevation_deg}: a drawn date's at terrain.dem's site
+    (scene.ephemeris, imported here only then), else as given."""
+    if "utc" not in sun:
+        return {k: sun[k] for k in SUN_KEYS}
+    from ..scene.ephemeris import sun_at_site
+
+    site = terrain["dem"]["site"]
+    return sun_at_site(sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"])
+
+
+def dated_earth(earth: dict, sun: dict, terrain: dict, radius_m: float) -> dict | None:
+    """Earthshine's source {azimuth_deg, elevation_deg}: with `dated`, the Earth of the Sun's
+    drawn date (None below the site's horizon), else as given."""
+    if not (earth.get("dated") and "utc" in sun):
+        return {k: earth[k] for k in ("azimuth_deg", "elevation_deg")}
+    from ..scene.ephemeris import body_at_site
+
+    site = terrain["dem"]["site"]
+    found = body_at_site("EARTH", sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"])
+    return {k: found[k] for k in ("azimuth_deg", "elevation_deg")} if found["elevation_deg"] > 0 else None
