@@ -260,7 +260,7 @@ def with_dated_suns(config: dict) -> dict:
             if dates[0] > dates[-1]:
                 raise ConfigError(f"config key 'scenarios.{name}.sun.utc': expected [first, last] with first <= "
                                   f"last, got {sun['utc']}")  # fmt: skip
-        at = (site["lat_deg"], site["lon_deg"], radius, sun.get("frame", "IAU_MOON"))
+        at = (site["lat_deg"], site["lon_deg"], radius, sun.get("frame", "IAU_MOON"), site.get("heading_deg", 0.0))
         for date in dates:
             try:
                 found = sun_at_site(date, sun["spice"], *at)

@@ -18,17 +18,23 @@ from stand_in_dem import (  # noqa: E402
     write_site_dem,
 )
 from traj2events.config import ConfigError, resolve_config  # noqa: E402
-from traj2events.scene.dem import DemError, DemProduct, dem_terrain, site_axes, site_radius_m  # noqa: E402
+from traj2events.scene.dem import DemError, DemProduct, dem_terrain, site_radius_m  # noqa: E402
 
 
 def site_config(path, **site):
     return {"terrain": {"dem": {"file": str(path), "site": {"lat_deg": SITE[0], "lon_deg": SITE[1], **site}}}}
 
 
-def test_site_axes_are_north_east_up_and_right_handed():
-    north, east, up = site_axes(*SITE)
-    assert np.allclose(np.cross(north, east), -up)  # x north, y east, z down: right-handed
-    assert up[2] == pytest.approx(np.sin(np.radians(SITE[0]))) and north[2] > 0 and east[2] == 0
+def test_a_heading_turns_the_site_frame_and_the_surface_with_it(tmp_path):
+    """heading 90 deg: +x is east, +y south, so the point (x, y) is heading 0's (-y, x)."""
+    path = write_site_dem(tmp_path / "site.tif")
+    dem = site_config(path)["terrain"]["dem"]
+    radius = site_radius_m(dem)
+    north = dem_terrain(dem, radius)
+    east = dem_terrain({**dem, "site": {**dem["site"], "heading_deg": 90.0}}, radius)
+    x, y = np.meshgrid(np.linspace(-3000, 3000, 13), np.linspace(-2000, 2000, 9), indexing="ij")
+    np.testing.assert_allclose(east.height_m(x, y), north.height_m(-y, x), atol=1e-6)
+    assert np.abs(east.height_m(x, y) - north.height_m(x, y)).max() > 10  # and it did turn
 
 
 @pytest.mark.parametrize("kind", WRITERS)

@@ -193,3 +193,11 @@ def test_the_earth_of_the_suns_date_lights_earthshine_and_below_the_horizon_none
     away = {"dem": {"file": str(north), "site": {"lat_deg": -80.0, "lon_deg": -30.0}}}
     config = resolve_config({"terrain": away, "scenarios": {"descent": {"sun": {**sun}, "earth": earth}}})
     assert config["scenarios"]["descent"]["earth"] is None
+
+
+def test_a_heading_turns_the_suns_azimuth_with_the_site_frame(tmp_path):
+    metakernel, _, _ = write_kernels(tmp_path)
+    north = sun_at_site(UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON")
+    turned = sun_at_site(UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON", heading_deg=30.0)
+    assert (turned["azimuth_deg"] - north["azimuth_deg"] + 30.0 + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=1e-9)
+    assert turned["elevation_deg"] == pytest.approx(north["elevation_deg"], abs=1e-12)

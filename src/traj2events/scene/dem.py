@@ -5,13 +5,14 @@ IMG+LBL, PDS4, ISIS3 cubes) is read through rasterio (GDAL: every format with it
 projection; PROJ knows the IAU 2015 Moon CRSs), honouring its CRS, nodata, scale and
 offset, a window at a time: a large product is never loaded whole.
 
-The site frame (docs/geometry.md) has x north, y east, z down at the site, the Moon's centre
-at (0, 0, R) with R the radius of the sphere through the site: R = R_ref + h_site, the
+The site frame (docs/geometry.md) has z down at the site, x horizontal toward
+`terrain.dem.site.heading_deg` from north (0: north), y to its right (east for a northward
+x), the Moon's centre at (0, 0, R) with R the radius of the sphere through the site: R = R_ref + h_site, the
 product's reference radius plus the DEM's height at the site. A terrain point at horizontal
 coordinates (x, y) of the site's tangent plane (the gnomonic grid of `scene.terrain`) lies
 on the ray from the centre along
 
-    d = R up + x north + y east            (Moon-fixed; up, north, east at the site)
+    d = R up + x X + y Y                   (Moon-fixed; up, X, Y at the site)
 
 whose planetocentric latitude and longitude the product's CRS maps to its own (x, y); the
 DEM's height there (bilinear between posts) puts the point at R_ref + h_dem from the
@@ -32,6 +33,7 @@ import numpy as np
 
 from ..settings.render import TerrainParams
 from ..settings.site import terrain_files
+from ..trajectory.external import site_axes
 from .terrain import ProceduralTerrain, bilinear
 
 # A CRS is the Moon's when its body's semi-major axis is within these (IAU 2015: 1737.4 km;
@@ -76,21 +78,12 @@ def file_sha256(path: str, size: int, mtime_ns: int) -> str:
     return digest.hexdigest()
 
 
-def site_axes(lat_deg: float, lon_deg: float) -> np.ndarray:
-    """(3, 3) rows: north, east, up at a planetocentric latitude and east longitude, in the
-    Moon-fixed frame (x to longitude 0 on the equator, z to the north pole)."""
-    lat, lon = math.radians(lat_deg), math.radians(lon_deg)
-    north = [-math.sin(lat) * math.cos(lon), -math.sin(lat) * math.sin(lon), math.cos(lat)]
-    east = [-math.sin(lon), math.cos(lon), 0.0]
-    up = [math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)]
-    return np.array([north, east, up])
-
-
 def grid_directions(x_m: np.ndarray, y_m: np.ndarray, radius_m: float, axes: np.ndarray):
-    """Planetocentric (latitude, east longitude) in degrees of the rays d = R up + x north +
-    y east through the gnomonic grid points (x, y)."""
+    """Planetocentric (latitude, east longitude) in degrees of the rays d = x X + y Y - R Z
+    through the gnomonic grid points (x, y), for the site frame's axes X, Y, Z (z down) in
+    the Moon-fixed frame (`trajectory.external.site_axes`)."""
     x_m, y_m = np.broadcast_arrays(np.asarray(x_m, float), np.asarray(y_m, float))
-    d = x_m[..., None] * axes[0] + y_m[..., None] * axes[1] + radius_m * axes[2]
+    d = x_m[..., None] * axes[0] + y_m[..., None] * axes[1] - radius_m * axes[2]
     lat = np.degrees(np.arctan2(d[..., 2], np.hypot(d[..., 0], d[..., 1])))
     return lat, np.degrees(np.arctan2(d[..., 1], d[..., 0]))
 
@@ -233,12 +226,13 @@ class DemTerrain:
     radius_m: float
     detail: ProceduralTerrain | None = None
     far: DemProduct | None = None  # the far field, where the site's product has no data
+    heading_deg: float = 0.0  # the site frame's +x (the flights' approach), from north through east
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
         """Heights (m, up) above the site's sphere: the site's product, else the far field's,
         else the sphere; a tile of `spacing_m` wider than a product's posts reads their block
         means (DemProduct.heights' `step`)."""
-        lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg))
+        lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg, self.heading_deg))
         rho = self._radii(self.product, lat, lon, spacing_m)  # from the Moon's centre, m
         if self.far is not None and not (found := np.isfinite(rho)).all():
             rho[~found] = self._radii(self.far, lat[~found], lon[~found], spacing_m)
@@ -254,15 +248,17 @@ class DemTerrain:
         """What the heights depend on (the tile cache's key): the products' content, the site, the detail."""
         detail = self.detail.identity() if self.detail is not None else None
         far = self.far.sha256 if self.far is not None else None
+        heading = {"heading_deg": self.heading_deg} if self.heading_deg else {}
         return {"dem_sha256": self.product.sha256, "site_deg": [self.lat_deg, self.lon_deg], "radius_m": self.radius_m,
-                "detail": detail, **({"far_sha256": far} if far else {})}  # fmt: skip
+                "detail": detail, **({"far_sha256": far} if far else {}), **heading}  # fmt: skip
 
     def attrs(self) -> dict:
         """What a file records of the DEMs it was made from."""
         far = {"dem_far_file": Path(self.far.path).name, "dem_far_sha256": self.far.sha256} if self.far else {}
         return {"dem_file": Path(self.product.path).name, "dem_sha256": self.product.sha256,
                 "dem_crs": self.product.crs_wkt, "dem_site_lat_deg": self.lat_deg, "dem_site_lon_deg": self.lon_deg,
-                "dem_reference_radius_m": self.product.reference_radius_m, **far}  # fmt: skip
+                "dem_site_heading_deg": self.heading_deg, "dem_reference_radius_m": self.product.reference_radius_m,
+                **far}  # fmt: skip
 
 
 # How far around the site the product must have data: the landing pad (terrain.site_radius_m
@@ -278,7 +274,7 @@ def site_height_m(product: DemProduct, lat_deg: float, lon_deg: float) -> float:
     ring = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
     x = np.concatenate([[0.0], SITE_CHECK_RADIUS_M * np.cos(ring)])
     y = np.concatenate([[0.0], SITE_CHECK_RADIUS_M * np.sin(ring)])
-    lat, lon = grid_directions(x, y, radius, site_axes(lat_deg, lon_deg))
+    lat, lon = grid_directions(x, y, radius, site_axes(lat_deg, lon_deg, 0.0))
     rows, cols = product.post_indices(lat, lon)
     n_rows, n_cols = product.shape
     if not (0 <= rows[0] <= n_rows - 1 and 0 <= cols[0] <= n_cols - 1):
@@ -308,7 +304,7 @@ def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None)
     DemError naming motion_field.moon_radius_m where it is not that sphere's), with the
     procedural surface of `detail` below its posts (`detail_params`; None: none)."""
     product = DemProduct.open(dem["file"])
-    lat, lon = float(dem["site"]["lat_deg"]), float(dem["site"]["lon_deg"])
+    lat, lon, heading = (float(dem["site"].get(k, 0.0)) for k in ("lat_deg", "lon_deg", "heading_deg"))
     expected = product.reference_radius_m + site_height_m(product, lat, lon)
     if abs(radius_m - expected) > 0.01:
         raise DemError(f"{radius_m} m, but the sphere through the site of {dem['file']} is {expected:.3f} m (its "
@@ -316,4 +312,4 @@ def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None)
                        "the config takes it from the DEM", "motion_field.moon_radius_m")  # fmt: skip
     below = ProceduralTerrain(detail_params(detail, product.post_spacing_m)) if detail is not None else None
     far = DemProduct.open(dem["far"], "terrain.dem.far") if dem.get("far") else None
-    return DemTerrain(product, lat, lon, radius_m, below, far)
+    return DemTerrain(product, lat, lon, radius_m, below, far, heading)

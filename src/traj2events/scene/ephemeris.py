@@ -3,11 +3,11 @@
 At the UTC time of `scenarios.<name>.sun.utc`, the apparent position of the Sun seen from
 the Moon's centre (light time and stellar aberration corrected, SPICE's "LT+S"), in the
 Moon's body-fixed frame of the site's DEM (IAU_MOON, or LOLA's MOON_ME), less the site's
-own position R up gives the vector s from the site to the Sun. With the site's north, east
-and up (`scene.dem.site_axes`):
+own position R up gives the vector s from the site to the Sun. With the site frame's axes
+X, Y, Z (z down; X toward the heading, north by default: `trajectory.external.site_axes`):
 
-    azimuth   = atan2(s . east, s . north)      (from +x = north toward +y = east)
-    elevation = asin(s . up / |s|)
+    azimuth   = atan2(s . Y, s . X)             (from +x toward +y: north toward east)
+    elevation = asin(-s . Z / |s|)
     range     = |s|
 
 The Earth's direction, earthshine's source, is found the same way (`body_at_site`).
@@ -23,7 +23,7 @@ import os
 
 import numpy as np
 
-from .dem import site_axes
+from ..trajectory.external import site_axes
 
 
 class EphemerisError(ValueError):
@@ -31,14 +31,28 @@ class EphemerisError(ValueError):
 
 
 def sun_at_site(
-    utc: str, metakernel: str | os.PathLike, lat_deg: float, lon_deg: float, radius_m: float, frame: str
+    utc: str,
+    metakernel: str | os.PathLike,
+    lat_deg: float,
+    lon_deg: float,
+    radius_m: float,
+    frame: str,
+    heading_deg: float = 0.0,
 ) -> dict:
-    """{range_m, azimuth_deg, elevation_deg} of the Sun at the site at `utc` (ISO 8601)."""
-    return body_at_site("SUN", utc, metakernel, lat_deg, lon_deg, radius_m, frame)
+    """{range_m, azimuth_deg, elevation_deg} of the Sun at the site at `utc` (ISO 8601), the
+    azimuth from the site frame's +x (`heading_deg` from north) toward +y."""
+    return body_at_site("SUN", utc, metakernel, lat_deg, lon_deg, radius_m, frame, heading_deg)
 
 
 def body_at_site(
-    body: str, utc: str, metakernel: str | os.PathLike, lat_deg: float, lon_deg: float, radius_m: float, frame: str
+    body: str,
+    utc: str,
+    metakernel: str | os.PathLike,
+    lat_deg: float,
+    lon_deg: float,
+    radius_m: float,
+    frame: str,
+    heading_deg: float = 0.0,
 ) -> dict:
     """{range_m, azimuth_deg, elevation_deg} of `body` (SPICE's name: SUN, EARTH) at the site."""
     try:
@@ -58,11 +72,11 @@ def body_at_site(
         raise EphemerisError(f"{metakernel} at {utc}: SPICE: {exc.short or exc}: {exc.explain or ''}".strip()) from None
     finally:
         sp.kclear()
-    north, east, up = site_axes(lat_deg, lon_deg)
-    s = np.asarray(sun_km, float) * 1e3 - radius_m * up
+    x, y, down = site_axes(lat_deg, lon_deg, heading_deg)
+    s = np.asarray(sun_km, float) * 1e3 + radius_m * down  # from the site
     distance = float(np.linalg.norm(s))
     return {
         "range_m": distance,
-        "azimuth_deg": math.degrees(math.atan2(float(s @ east), float(s @ north))),
-        "elevation_deg": math.degrees(math.asin(float(s @ up) / distance)),
+        "azimuth_deg": math.degrees(math.atan2(float(s @ y), float(s @ x))),
+        "elevation_deg": math.degrees(math.asin(-float(s @ down) / distance)),
     }

@@ -11,10 +11,14 @@ from pathlib import Path
 from .declare import section, setting
 
 
-@section("terrain.dem.site", "the landing site on the product (planetocentric, as the IAU 2015 Moon CRSs)")
+@section("terrain.dem.site", "the landing site on the product (planetocentric, as the IAU 2015 Moon CRSs) and the "
+         "flights' approach")  # fmt: skip
 class DemSite:
     lat_deg: float = setting(unit="deg", doc="latitude", ge=-90, le=90)
     lon_deg: float = setting(unit="deg", doc="east longitude", ge=-360, le=360)
+    heading_deg: float = setting(0.0, "deg", "the site frame's +x, the flights' approach (they fly toward +x), from "
+                                 "north through east; the Sun's azimuth is from it too", ge=-360, le=360,
+                                 optional=True)  # fmt: skip
 
 
 @section("terrain.dem", 'a real site: a DEM product users download and the landing site on it (docs/rendering.md "Real '
@@ -65,7 +69,8 @@ def dated_sun(sun: dict, terrain: dict, radius_m: float) -> dict:
     from ..scene.ephemeris import sun_at_site
 
     site = terrain["dem"]["site"]
-    return sun_at_site(sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"])
+    return sun_at_site(sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"],
+                       site.get("heading_deg", 0.0))  # fmt: skip
 
 
 def dated_earth(earth: dict, sun: dict, terrain: dict, radius_m: float) -> dict | None:
@@ -76,5 +81,6 @@ def dated_earth(earth: dict, sun: dict, terrain: dict, radius_m: float) -> dict 
     from ..scene.ephemeris import body_at_site
 
     site = terrain["dem"]["site"]
-    found = body_at_site("EARTH", sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"])
+    found = body_at_site("EARTH", sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"],
+                         site.get("heading_deg", 0.0))  # fmt: skip
     return {k: found[k] for k in ("azimuth_deg", "elevation_deg")} if found["elevation_deg"] > 0 else None
