@@ -243,7 +243,7 @@ def with_dated_suns(config: dict) -> dict:
     dem = config.get("terrain", {}).get("dem") if isinstance(config.get("terrain"), dict) else None
     if not dated or not isinstance(dem, dict) or not models_importable():
         return config
-    from .scene.ephemeris import EphemerisError, body_at_site, sun_at_site
+    from .scene.ephemeris import EphemerisError, body_at_site
     from .settings.site import date_between
 
     site, radius, suns, earths = dem["site"], float(config["motion_field"]["moon_radius_m"]), {}, {}
@@ -263,7 +263,7 @@ def with_dated_suns(config: dict) -> dict:
         at = (site["lat_deg"], site["lon_deg"], radius, sun.get("frame", "IAU_MOON"), site.get("heading_deg", 0.0))
         for date in dates:
             try:
-                found = sun_at_site(date, sun["spice"], *at)
+                found = body_at_site("SUN", date, sun["spice"], *at)
             except EphemerisError as exc:
                 raise ConfigError(f"config key 'scenarios.{name}.sun.spice': {exc}") from None
             if found["elevation_deg"] <= 0:

@@ -10,7 +10,7 @@ sp = pytest.importorskip("spiceypy")
 
 from stand_in_dem import SITE, write_site_dem  # noqa: E402
 from traj2events.config import ConfigError, resolve_config  # noqa: E402
-from traj2events.scene.ephemeris import EphemerisError, sun_at_site  # noqa: E402
+from traj2events.scene.ephemeris import EphemerisError, body_at_site  # noqa: E402
 
 
 # Where the written ephemeris puts the Sun at UTC: 1.48e8 km from the Moon, at body-fixed
@@ -100,7 +100,7 @@ def expected_sun(et, sun_j2000_km, lat_deg, lon_deg, radius_m) -> tuple[float, f
 @pytest.mark.parametrize("site", [(-89.45, 30.0), (-85.0, 200.0), (10.0, -40.0)])
 def test_the_sun_of_a_date_is_the_one_the_rotation_formula_gives(tmp_path, site):
     metakernel, et, sun_j2000 = write_kernels(tmp_path)
-    got = sun_at_site(UTC, metakernel, *site, 1_736_000.0, "IAU_MOON")
+    got = body_at_site("SUN", UTC, metakernel, *site, 1_736_000.0, "IAU_MOON")
     distance, azimuth, elevation = expected_sun(et, sun_j2000, *site, 1_736_000.0)
     assert got["range_m"] == pytest.approx(distance, rel=1e-12)
     assert got["azimuth_deg"] == pytest.approx(azimuth, abs=1e-6) and got["elevation_deg"] == pytest.approx(
@@ -126,7 +126,7 @@ def test_a_dated_sun_fills_the_scenarios_sun_and_bad_kernels_or_dates_are_named(
     with pytest.raises(ConfigError, match=r"'scenarios.descent.sun.spice': .*at 1990-01-01T00:00:00: SPICE"):
         resolve_config({"terrain": site, "scenarios": {"descent": {"sun": {**sun, "utc": "1990-01-01T00:00:00"}}}})
     with pytest.raises(EphemerisError, match="SPICE"):
-        sun_at_site("not a date", metakernel, *SITE, 1_736_000.0, "IAU_MOON")
+        body_at_site("SUN", "not a date", metakernel, *SITE, 1_736_000.0, "IAU_MOON")
 
 
 def test_a_range_of_dates_draws_one_per_trajectory_and_its_render_job_lights_it(tmp_path):
@@ -197,7 +197,7 @@ def test_the_earth_of_the_suns_date_lights_earthshine_and_below_the_horizon_none
 
 def test_a_heading_turns_the_suns_azimuth_with_the_site_frame(tmp_path):
     metakernel, _, _ = write_kernels(tmp_path)
-    north = sun_at_site(UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON")
-    turned = sun_at_site(UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON", heading_deg=30.0)
+    north = body_at_site("SUN", UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON")
+    turned = body_at_site("SUN", UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON", heading_deg=30.0)
     assert (turned["azimuth_deg"] - north["azimuth_deg"] + 30.0 + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=1e-9)
     assert turned["elevation_deg"] == pytest.approx(north["elevation_deg"], abs=1e-12)

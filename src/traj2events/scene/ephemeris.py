@@ -30,20 +30,6 @@ class EphemerisError(ValueError):
     """Kernels or a date SPICE cannot use, naming the file and what was expected."""
 
 
-def sun_at_site(
-    utc: str,
-    metakernel: str | os.PathLike,
-    lat_deg: float,
-    lon_deg: float,
-    radius_m: float,
-    frame: str,
-    heading_deg: float = 0.0,
-) -> dict:
-    """{range_m, azimuth_deg, elevation_deg} of the Sun at the site at `utc` (ISO 8601), the
-    azimuth from the site frame's +x (`heading_deg` from north) toward +y."""
-    return body_at_site("SUN", utc, metakernel, lat_deg, lon_deg, radius_m, frame, heading_deg)
-
-
 def body_at_site(
     body: str,
     utc: str,
@@ -54,7 +40,9 @@ def body_at_site(
     frame: str,
     heading_deg: float = 0.0,
 ) -> dict:
-    """{range_m, azimuth_deg, elevation_deg} of `body` (SPICE's name: SUN, EARTH) at the site."""
+    """{range_m, azimuth_deg, elevation_deg} of `body` (SPICE's name: SUN, EARTH) at the site
+    at `utc` (ISO 8601), the azimuth from the site frame's +x (`heading_deg` from north)
+    toward +y."""
     try:
         import spiceypy as sp
         from spiceypy.utils.exceptions import SpiceyError

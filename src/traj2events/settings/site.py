@@ -66,10 +66,10 @@ def dated_sun(sun: dict, terrain: dict, radius_m: float) -> dict:
     (scene.ephemeris, imported here only then), else as given."""
     if "utc" not in sun:
         return {k: sun[k] for k in SUN_KEYS}
-    from ..scene.ephemeris import sun_at_site
+    from ..scene.ephemeris import body_at_site
 
     site = terrain["dem"]["site"]
-    return sun_at_site(sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"],
+    return body_at_site("SUN", sun["utc"], sun["spice"], site["lat_deg"], site["lon_deg"], radius_m, sun["frame"],
                        site.get("heading_deg", 0.0))  # fmt: skip
 
 
