@@ -296,3 +296,36 @@ def test_the_far_field_dem_shapes_the_horizon(tmp_path):
     cast_ground = np.isfinite(cast).reshape(a.shape).sum(axis=1)
     assert np.abs(ground["both"] - cast_ground).max() <= 1, (ground["both"], cast_ground)
     assert (ground["both"] - ground["site only"]).max() >= 5  # the massif stands above the plain's horizon
+
+
+def test_a_mask_adds_craters_where_the_product_is_interpolated_and_not_where_measured(tmp_path):
+    """A LOLA-style count raster (LDEC: laser spots per post) on the product's grid: 0 in its
+    western half (interpolated), 3 in its eastern: craters up to half the effective resolution
+    join the detail there only; where measured, the surface is the detail's alone."""
+    from traj2events.scene.terrain import TerrainParams
+
+    post = 5.0
+    path = write_site_dem(tmp_path / "site5.tif", n=400, post_m=post)
+    counts = tmp_path / "ldec.tif"
+    with rasterio.open(path) as src:
+        profile = {**src.profile, "nodata": None}
+    with rasterio.open(counts, "w", **profile) as dst:
+        dst.write(np.where(np.arange(400) < 200, 0.0, 3.0)[None, :].repeat(400, 0).astype(np.float32), 1)
+    dem = site_config(path)["terrain"]["dem"]
+    radius = site_radius_m(dem)
+    mask = {"file": str(counts), "measured_min": 1.0, "interpolated_resolution_m": 60.0}
+    plain, masked = (
+        dem_terrain(dem, radius, TerrainParams()),
+        dem_terrain({**dem, "mask": mask}, radius, TerrainParams()),
+    )
+    x0, y0 = stereographic(*SITE)
+    band = {}
+    for name, cols in (("interpolated", np.arange(20, 160)), ("measured", np.arange(240, 380))):
+        c, r = np.meshgrid(cols, np.arange(140, 260))
+        x, y = x0 + (c - 200 + 0.5) * post, y0 - (r - 200 + 0.5) * post  # post centres, 200 m+ from the site
+        north, east = gnomonic(*inverse_stereographic(x, y), radius, *SITE)
+        band[name] = masked.height_m(north, east, 0.5) - plain.height_m(north, east, 0.5)
+    assert np.abs(band["measured"]).max() < 1e-9
+    assert band["interpolated"].std() > 0.05 and band["interpolated"].min() < -1.0  # craters of metres
+    with pytest.raises(DemError, match="terrain.dem.detail: true"):
+        dem_terrain({**dem, "mask": mask}, radius, None)

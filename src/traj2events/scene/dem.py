@@ -214,6 +214,32 @@ def detail_params(params: TerrainParams, post_m: float) -> TerrainParams:
 DETAIL_POST_SHIFT_M = 0.1  # the most one boulder may move its post's mean (issue 70's bound)
 
 
+def band_params(params: TerrainParams, post_m: float, resolution_m: float) -> TerrainParams:
+    """Where the product is interpolated (its mask): the craters it cannot hold there, from
+    half a post to half its effective resolution there, their own seed; no boulders, rocks
+    or roughness (the detail below the posts has them)."""
+    return replace(params, seed=params.seed + 1, crater_diameter_min_m=post_m / 2,
+                   crater_diameter_max_m=max(resolution_m / 2, post_m / 2), boulder_density_k=0.0,
+                   roughness_m_at_1m=0.0)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class DemMask:
+    """Which posts of a product are measured: a raster in any CRS GDAL reads (LOLA's LDEC
+    counts of laser spots per post, a NAC DTM's confidence map), values at or above
+    `measured_min` measured; `band`: the detail where it is not (`band_params`)."""
+
+    product: DemProduct
+    measured_min: float
+    band: ProceduralTerrain
+
+    def interpolated(self, lat: np.ndarray, lon: np.ndarray, spacing_m: float) -> np.ndarray:
+        """0 where measured, 1 where interpolated (bilinear between posts; outside the mask: 1)."""
+        step = max(int(spacing_m // self.product.post_spacing_m), 1)
+        value = self.product.heights(*self.product.post_indices(lat, lon), step)
+        return np.where(np.isfinite(value), np.clip(1.0 - value / self.measured_min, 0.0, 1.0), 1.0)
+
+
 @dataclass(frozen=True)
 class DemTerrain:
     """`scene.terrain.Terrain` from a product: heights above the sphere through the site
@@ -227,6 +253,7 @@ class DemTerrain:
     detail: ProceduralTerrain | None = None
     far: DemProduct | None = None  # the far field, where the site's product has no data
     heading_deg: float = 0.0  # the site frame's +x (the flights' approach), from north through east
+    mask: DemMask | None = None  # where the site's product is interpolated, and the detail there
 
     def height_m(self, x_m: np.ndarray, y_m: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
         """Heights (m, up) above the site's sphere: the site's product, else the far field's,
@@ -237,6 +264,8 @@ class DemTerrain:
         if self.far is not None and not (found := np.isfinite(rho)).all():
             rho[~found] = self._radii(self.far, lat[~found], lon[~found], spacing_m)
         h = np.where(np.isfinite(rho), rho - self.radius_m, 0.0)
+        if self.mask is not None:
+            h = h + self.mask.interpolated(lat, lon, spacing_m) * self.mask.band.height_m(x_m, y_m, spacing_m)
         return h if self.detail is None else h + self.detail.height_m(x_m, y_m, spacing_m)
 
     @staticmethod
@@ -249,12 +278,18 @@ class DemTerrain:
         detail = self.detail.identity() if self.detail is not None else None
         far = self.far.sha256 if self.far is not None else None
         heading = {"heading_deg": self.heading_deg} if self.heading_deg else {}
+        mask = {}
+        if self.mask is not None:
+            mask = {"mask_sha256": self.mask.product.sha256, "measured_min": self.mask.measured_min,
+                    "band": self.mask.band.identity()}  # fmt: skip
         return {"dem_sha256": self.product.sha256, "site_deg": [self.lat_deg, self.lon_deg], "radius_m": self.radius_m,
-                "detail": detail, **({"far_sha256": far} if far else {}), **heading}  # fmt: skip
+                "detail": detail, **({"far_sha256": far} if far else {}), **heading, **mask}  # fmt: skip
 
     def attrs(self) -> dict:
         """What a file records of the DEMs it was made from."""
         far = {"dem_far_file": Path(self.far.path).name, "dem_far_sha256": self.far.sha256} if self.far else {}
+        if self.mask is not None:
+            far |= {"dem_mask_file": Path(self.mask.product.path).name, "dem_mask_sha256": self.mask.product.sha256}
         return {"dem_file": Path(self.product.path).name, "dem_sha256": self.product.sha256,
                 "dem_crs": self.product.crs_wkt, "dem_site_lat_deg": self.lat_deg, "dem_site_lon_deg": self.lon_deg,
                 "dem_site_heading_deg": self.heading_deg, "dem_reference_radius_m": self.product.reference_radius_m,
@@ -312,4 +347,13 @@ def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None)
                        "the config takes it from the DEM", "motion_field.moon_radius_m")  # fmt: skip
     below = ProceduralTerrain(detail_params(detail, product.post_spacing_m)) if detail is not None else None
     far = DemProduct.open(dem["far"], "terrain.dem.far") if dem.get("far") else None
-    return DemTerrain(product, lat, lon, radius_m, below, far, heading)
+    mask = None
+    if dem.get("mask"):  # the band where the product is interpolated: with the detail only
+        m = dem["mask"]
+        band = band_params(detail or TerrainParams(), product.post_spacing_m, float(m["interpolated_resolution_m"]))
+        mask = DemMask(DemProduct.open(m["file"], "terrain.dem.mask.file"), float(m["measured_min"]),
+                       ProceduralTerrain(band))  # fmt: skip
+        if detail is None:
+            raise DemError("a mask adds the detail the product lacks where it is interpolated: expected "
+                           "terrain.dem.detail: true", "terrain.dem.mask")  # fmt: skip
+    return DemTerrain(product, lat, lon, radius_m, below, far, heading, mask)

@@ -21,6 +21,17 @@ class DemSite:
                                  optional=True)  # fmt: skip
 
 
+@section("terrain.dem.mask", "which of the site product's posts are measured, and the detail where they are not "
+         '(docs/rendering.md "Real sites")')  # fmt: skip
+class DemMaskSection:
+    file: str = setting(doc="a raster GDAL reads with its CRS: LOLA's LDEC_ (laser spots per post, beside the "
+                        "LDEM_), a NAC DTM's confidence map")  # fmt: skip
+    measured_min: float = setting(unit="", doc="the value from which a post is measured (LDEC: 1 spot)", gt=0)
+    interpolated_resolution_m: float = setting(unit="m", doc="the product's effective resolution where it is "
+                                               "interpolated (LOLA's _EFFRES products give it per post, e.g. 60): "
+                                               "craters up to half of it are added there", gt=0)  # fmt: skip
+
+
 @section("terrain.dem", 'a real site: a DEM product users download and the landing site on it (docs/rendering.md "Real '
          'sites"; pip install traj2events[dem])')  # fmt: skip
 class DemSection:
@@ -30,6 +41,9 @@ class DemSection:
     far: str | None = setting(None, "", "a coarser product around it for the far field (LOLA's polar 20-240 m, or a "
                               "global one): where the site's has no data, the horizon and the shadows it casts; "
                               "beyond both, the sphere", optional=True)  # fmt: skip
+    mask: DemMaskSection | None = setting(None, "", "which posts are measured (null: all): where they are not, "
+                                          "craters up to the effective resolution join the detail",
+                                          optional=True)  # fmt: skip
     detail: bool = setting(True, "", "add the procedural surface's craters, boulders, rocks and roughness (terrain's "
                            "other keys) below the posts' resolution, so that the last seconds have texture; the "
                            "posts' means are kept (docs/rendering.md \"Real sites\")", optional=True)  # fmt: skip
@@ -44,7 +58,8 @@ def terrain_files(terrain: dict) -> list[str]:
     if not terrain.get("dem"):
         return []
     files = []
-    for name in (terrain["dem"]["file"], terrain["dem"].get("far")):
+    mask = terrain["dem"].get("mask") or {}
+    for name in (terrain["dem"]["file"], terrain["dem"].get("far"), mask.get("file")):
         if name:
             path = Path(name)
             siblings = [path.with_suffix(s) for s in (".LBL", ".lbl", ".IMG", ".img")]
