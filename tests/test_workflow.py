@@ -564,6 +564,17 @@ def test_exports_added_to_a_built_dataset_emulate_nothing_again(built, tmp_path)
     assert video_info(events.with_suffix(".mp4"))[3] == len(poses) - 1  # a frame per pose interval
 
 
+def test_a_split_setting_reruns_the_index_only_and_the_loader_reads_the_splits(built, tmp_path):
+    from traj2events.data import open_dataset
+
+    dataset = open_dataset(built / "results")
+    assert {landing.split for landing in dataset} <= {"train", "validation", "test"}
+    assert sum(len(dataset.split(name)) for name in ("train", "validation", "test")) == len(dataset)
+    shutil.copytree(built, tmp_path / "wf")
+    jobs = edit_config(tmp_path / "wf", lambda c: c.update(splits={"train": 0.5, "validation": 0.25, "test": 0.25}))
+    assert jobs == {"dataset_index": 2, "dataset_overview": 1}
+
+
 def test_an_imu_setting_or_a_readout_setting_reruns_its_stage_only(built, tmp_path):
     shutil.copytree(built, tmp_path / "wf")
     jobs = edit_config(tmp_path / "wf", lambda c: c.update(imu={"rate_hz": 500.0}))

@@ -19,6 +19,7 @@ from .options import add_declared_option, add_settings, json_or_null, settings_f
 from .settings.camera import CAMERA, MOTION_FIELD
 from .settings.events import EVENTS, EVENTS_FLAGS, EVENTS_PICTURE
 from .settings.imu import IMU
+from .settings.index import INDEX
 from .settings.poses import EXTERNAL_POSES, POSES, external_pose_defaults
 from .settings.render import RENDER, RENDER_FLAGS, RenderSection, render_job_settings
 from .settings.solve import SOLVE, solve_settings
@@ -258,7 +259,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("trajectories", nargs="*", help="trajectory.h5 files (other files are ignored)")
     p.add_argument("--output", "-o", required=True, help="index.csv")
     p.add_argument("--samples", help="the scenario's samples.csv: a scenario with no solved sample is then an error")
-    p.set_defaults(func=_calls("index", "dataset_index", "trajectories", "output", "samples"))
+    add_settings(p, INDEX, "the seed and the split shares")
+    p.set_defaults(func=_calls("index", "dataset_index", "trajectories", "output", "samples",
+                               lambda a: settings_from(a, INDEX)))  # fmt: skip
 
     p = sub.add_parser("summary", help="one CSV row per scenario: counts, failures, final mass, t_f, errors")
     p.add_argument("--solutions", nargs="*", required=True, help="solutions.h5 of each solved scenario")

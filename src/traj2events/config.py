@@ -336,6 +336,7 @@ def _section_errors(config: dict) -> list[str]:
     """Each section that is a class built from the config: its own checks, written once in
     its declaration (bounds, and what one section's keys must satisfy together)."""
     from .settings.events import EmulatorParams, SensorParams
+    from .settings.index import SplitsSection
     from .settings.render import FrameTiming, TerrainParams
     from .settings.solve import OcpSettings
     from .settings.vehicle import Vehicle
@@ -343,7 +344,7 @@ def _section_errors(config: dict) -> list[str]:
     events = config["events"]
     for cls, values in ((Vehicle, config["vehicle"]), (OcpSettings, config["ocp"]), (TerrainParams, config["terrain"]),
                         (EmulatorParams, events["pixel"]), (SensorParams, events["sensor"]),
-                        (FrameTiming, config["render"]["timing"])):  # fmt: skip
+                        (FrameTiming, config["render"]["timing"]), (SplitsSection, config["splits"])):  # fmt: skip
         try:
             cls(**values)
         except ValueError as error:  # "section.key: problem"

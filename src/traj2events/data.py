@@ -99,11 +99,13 @@ def held_open(path: Path, reader: Callable[[Path], Reader]) -> Reader:
 
 @dataclass(frozen=True)
 class Landing:
-    """One trajectory's files: `folder` is results/{scenario}/{id}/."""
+    """One trajectory's files: `folder` is results/{scenario}/{id}/; `split`: train,
+    validation or test (index.csv's; "" in an index written before splits)."""
 
     scenario: str
     id: int
     folder: Path
+    split: str = ""
 
     def poses(self) -> tuple[np.ndarray, np.ndarray]:
         """Camera pose times (K,) s and states (K, 13) at the frame rate."""
@@ -213,13 +215,19 @@ class Dataset:
             with open(index, newline="") as fh:
                 for row in csv.DictReader(fh):
                     folder = self.results / row["scenario"] / f"{int(row['id']):04d}"
-                    self.landings.append(Landing(row["scenario"], int(row["id"]), folder))
+                    self.landings.append(Landing(row["scenario"], int(row["id"]), folder, row.get("split", "")))
 
     def __len__(self) -> int:
         return len(self.landings)
 
     def __getitem__(self, i: int) -> Landing:
         return self.landings[i]
+
+    def split(self, name: str) -> list[Landing]:
+        """The landings of split `name` (train, validation, test: index.csv's `split`)."""
+        if name not in ("train", "validation", "test"):
+            raise ValueError(f"split: expected train, validation or test, got {name!r}")
+        return [landing for landing in self.landings if landing.split == name]
 
     def find(self, scenario: str, id: int) -> Landing:
         for landing in self.landings:

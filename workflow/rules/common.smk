@@ -17,7 +17,7 @@ from traj2events.fingerprint import code_fingerprint
 from traj2events.formats.tile_cache import unusable as tile_cache_unusable
 from traj2events.plan import dataset_plan, disk_shortfall, job_resources
 from traj2events.settings.events import EXPORT_SUFFIX
-from traj2events.settings.jobs import job_settings_json
+from traj2events.settings.jobs import job_settings, job_settings_json
 from traj2events.settings.poses import is_external, scenario_count, trajectory_source
 from traj2events.settings.site import terrain_files
 from traj2events.unlock import unlock_problem
@@ -255,7 +255,8 @@ def index_what_was_built():
         ids = trajectory_ids(scenario)
         built = [i for i in ids if all(Path(f"results/{scenario}/{i}/{name}").exists() for name in PER_TRAJECTORY)]
         if built and len(built) < len(ids):
-            dataset_index([f"results/{scenario}/{i}/trajectory.h5" for i in built], f"results/{scenario}/index.csv")
+            paths = [f"results/{scenario}/{i}/trajectory.h5" for i in built]
+            dataset_index(paths, f"results/{scenario}/index.csv", settings=job_settings(config, "index"))
             print(f"traj2events: results/{scenario}/index.csv lists the {len(built)} of {len(ids)} trajectories "
                   "whose files were all built (the others failed: see above)", file=sys.stderr)  # fmt: skip
 

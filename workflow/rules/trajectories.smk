@@ -119,9 +119,10 @@ rule dataset_index:
         ENV
     params:
         samples=lambda wildcards, input: f"--samples {input.samples}" if input.samples else "",
+        settings=settings("index"),
         code=code("index"),
     shell:
-        "traj2events index {input.trajectories} {params.samples} --output {output} 2> {log}"
+        "traj2events index {input.trajectories} {params.samples} --settings {params.settings:q} --output {output} 2> {log}"
 
 
 rule trajectory_summary:

@@ -19,6 +19,7 @@ settings reruns only that stage (a module's fingerprint covers what it imports):
     events    the emulation: pixel model, sensor, readout, space; its picture's window
     camera    the camera and the Moon's sphere (motion field, its picture)
     imu       the IMU's rate and errors
+    index     the dataset index's train, validation and test splits
 
 The simple ones are a map from each setting to its config key (`pick`), which the commands
 also read to offer one option per key (traj2events.options). Each stage turns its settings

@@ -13,6 +13,7 @@ import json
 from .camera import camera_settings, motion_field_settings
 from .events import events_picture_settings, events_settings
 from .imu import imu_settings
+from .index import index_settings
 from .poses import external_pose_settings, pose_settings, scenario_manoeuvre
 from .render import render_settings
 from .solve import solve_settings
@@ -29,6 +30,7 @@ JOBS = {
     "camera": lambda config, _, __: camera_settings(config),  # the motion-field picture
     "events": lambda config, _, __: events_settings(config),
     "events_picture": lambda config, _, __: events_picture_settings(config),
+    "index": lambda config, _, __: index_settings(config),  # the splits
 }
 
 

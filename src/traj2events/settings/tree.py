@@ -11,6 +11,7 @@ from .camera import CameraSection, MotionFieldSection
 from .declare import declared_fields, defaults_of, schema_of, section, setting
 from .events import EventsSection
 from .imu import ImuSection
+from .index import SplitsSection
 from .poses import Upsampling
 from .render import EarthSection, RenderSection, SunSection, TerrainParams
 from .solve import OcpSettings
@@ -173,6 +174,7 @@ class Config:
     render: RenderSection = setting(RenderSection, "", "the rendering")
     imu: ImuSection = setting(ImuSection, "", "the IMU")
     events: EventsSection = setting(EventsSection, "", "the event emulation")
+    splits: SplitsSection = setting(SplitsSection, "", "the landings' train, validation and test splits")
     scenarios: dict[str, ScenarioSection] = setting(
         SCENARIOS,
         "",

@@ -11,6 +11,7 @@ import pandas as pd
 from ..formats.atomic import atomic_output
 from ..formats.trajectory import read_trajectory
 from ..progress import log
+from ..settings.index import split_of
 from ..trajectory.state import MASS
 from .summary import read_sample_table
 
@@ -54,12 +55,18 @@ def failure_summary(samples: pd.DataFrame) -> str:
 
 
 def dataset_index(
-    paths: list[str | os.PathLike], output: str | os.PathLike, samples: str | os.PathLike | None = None
+    paths: list[str | os.PathLike],
+    output: str | os.PathLike,
+    samples: str | os.PathLike | None = None,
+    settings: dict | None = None,
 ) -> pd.DataFrame:
-    """index.csv from the trajectory.h5 files among `paths` (other files are ignored).
-    Given the scenario's samples.csv, a scenario with no solved sample is an error that
-    says why its samples failed (not an empty index)."""
+    """index.csv from the trajectory.h5 files among `paths` (other files are ignored), each
+    row with its split where `settings` (the seed and the shares: settings.index) are given
+    (settings.index.split_of). Given the scenario's samples.csv, a scenario with no solved
+    sample is an error that says why its samples failed (not an empty index)."""
     rows = [index_row(p) for p in paths if Path(p).name == "trajectory.h5"]
+    for row in rows if settings is not None else []:
+        row["split"] = split_of(settings, row["scenario"], row["id"])
     if not rows and samples is not None:
         table = read_sample_table(samples)
         raise NoSolvedSampleError(
