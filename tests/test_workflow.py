@@ -688,6 +688,10 @@ def test_a_real_site_flies_over_its_dem_product_and_an_edit_of_it_reruns_the_ren
         assert f.attrs["dem_file"] == "site.tif" and len(f.attrs["dem_sha256"]) == 64
         assert f.attrs["moon_radius_m"] == pytest.approx(R + relief(*stereographic(*SITE)), abs=0.05)
         assert "South Polar" in f.attrs["dem_crs"] and 0 < f["depth_m"][0].min()
+        named = f.attrs["dem_sha256"]
+    for kept in ("events.h5", "motion_field.h5"):  # the files kept without frames.h5 name it too
+        with h5py.File(tmp_path / "results" / "descent" / "0000" / kept) as f:
+            assert f.attrs["dem_sha256"] == named and f.attrs["dem_file"] == "site.tif", kept
     write_site_dem(tmp_path / "site.tif", scale=1.01)  # heights 1 % lower: another site radius, another surface
     jobs = {k: v for k, v in jobs_in_dry_run(tmp_path).items() if k != "all"}
     assert jobs.get("render") == jobs.get("motion_field") == jobs.get("imu") == 1, jobs  # the sphere moved too

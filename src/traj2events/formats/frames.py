@@ -37,6 +37,12 @@ from .hdf5 import (
 )
 from .units import UNITS, label_datasets
 
+# A real site's products, as frames.h5 records them (scene.dem.DemTerrain.attrs), and a
+# drawn date's Sun: every file made from the frames repeats them, so that each names its DEM.
+SITE_ATTRS = ("dem_file", "dem_sha256", "dem_crs", "dem_site_lat_deg", "dem_site_lon_deg", "dem_site_heading_deg",
+              "dem_reference_radius_m", "dem_far_file", "dem_far_sha256", "dem_mask_file", "dem_mask_sha256",
+              "sun_utc")  # fmt: skip
+
 
 def central_ray(height: int, width: int, focal_px: float, attrs=None) -> tuple[int, int, float]:
     """The range meter's pixel (row H/2, column W/2: half a pixel off the boresight for even

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..formats.events import MAX_T_US
-from ..formats.frames import FramesFile
+from ..formats.frames import SITE_ATTRS, FramesFile
 from ..geometry.distortion import Distortion
 from ..read_ahead import read_ahead
 from ..video import iter_video, video_info
@@ -65,7 +65,7 @@ VIDEO_DECODER_CPUS = 1
 SCENE_ATTRS = ("fov_deg", "focal_px", "camera_matrix_px", "distortion", "distortion_coefficients", "image_convention",
                "camera_mount_height_m", "camera_position", "fps", "timing", "stars", "sun_range_m",
                "sun_azimuth_deg", "sun_elevation_deg", "sun_irradiance_w_m2", "earth", "reflectance", "terrain",
-               "scattered_light", "moon_radius_m", "scenario", "id")  # fmt: skip
+               "scattered_light", "moon_radius_m", "scenario", "id", *SITE_ATTRS)  # fmt: skip
 
 
 def check_recording_length(path: Path, last_time_s: float | None) -> None:

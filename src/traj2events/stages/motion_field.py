@@ -12,7 +12,7 @@ import numpy as np
 
 from ..formats.atomic import atomic_directory
 from ..formats.flow import motion_field_file, write_flo
-from ..formats.frames import FramesFile
+from ..formats.frames import SITE_ATTRS, FramesFile
 from ..formats.hdf5 import set_attrs, write_dataset
 from ..formats.trajectory import read_trajectory
 from ..geometry.camera import Camera
@@ -91,6 +91,8 @@ def motion_field(
             **provenance(__name__),
             "status_codes": ", ".join(f"{code} {name}" for code, name in enumerate(STATUS_NAMES)),
             **camera.intrinsics_attrs(),
+            # The terrain-true field is the rendered surface's: a real site's products, named.
+            **({k: rendered.attrs[k] for k in SITE_ATTRS if k in rendered.attrs} if rendered is not None else {}),
         }
         log(
             f"{trajectory}: {n} fields of {w} x {h} (every {every_n_frames} of {len(tr.t)} poses)"
