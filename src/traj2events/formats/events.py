@@ -241,12 +241,7 @@ class EventsReader(HeldFile):
         recording has fewer): a constant-count slice, as event-based methods cut windows."""
         m = min(max((centre_us - self.t_offset_us) // 1000, 0), len(self.ms_to_idx) - 1)
         lo = max(min(int(self.ms_to_idx[m]) - count // 2, self.n_events - count), 0)
-        hi = min(lo + count, self.n_events)
-        g, out = self._columns, np.empty(hi - lo, EVENT_DTYPE)
-        with read_errors_named(self.path, EXPECTED):
-            out["x"], out["y"], out["p"], out["t"] = g["x"][lo:hi], g["y"][lo:hi], g["p"][lo:hi], g["t"][lo:hi]
-        out["t"] += self.t_offset_us
-        return out
+        return self._slice(lo, min(lo + count, self.n_events), labels=False)[0]
 
     def _read(self, t_start_us: int, t_end_us: int, labels: bool) -> tuple[np.ndarray, np.ndarray | None]:
         if labels and "label" not in self._columns:
@@ -257,6 +252,12 @@ class EventsReader(HeldFile):
         hi_ms = (t_end_us - self.t_offset_us) // 1000 + 1
         lo = int(self.ms_to_idx[lo_ms])
         hi = int(self.ms_to_idx[hi_ms]) if hi_ms < n_ms else self.n_events
+        out, label = self._slice(lo, hi, labels)
+        inside = (out["t"] >= t_start_us) & (out["t"] < t_end_us)
+        return out[inside], (label[inside] if labels else None)
+
+    def _slice(self, lo: int, hi: int, labels: bool) -> tuple[np.ndarray, np.ndarray | None]:
+        """Events lo..hi (their order in the file), t absolute; their labels if asked."""
         g = self._columns
         out = np.empty(max(hi - lo, 0), EVENT_DTYPE)
         with read_errors_named(self.path, EXPECTED):
@@ -264,8 +265,7 @@ class EventsReader(HeldFile):
             out["t"] = g["t"][lo:hi]
             label = g["label"][lo:hi] if labels else None
         out["t"] += self.t_offset_us
-        inside = (out["t"] >= t_start_us) & (out["t"] < t_end_us)
-        return out[inside], (label[inside] if labels else None)
+        return out, label
 
 
 def merge_events(events: dict, labels: np.ndarray | None, due: dict) -> tuple[dict, np.ndarray | None]:

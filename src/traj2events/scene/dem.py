@@ -98,7 +98,6 @@ class DemProduct:
     reference_radius_m: float
     shape: tuple[int, int]  # rows, columns
     transform: tuple[float, ...]  # GDAL's affine (a, b, c, d, e, f): x = a col + b row + c
-    units: str
 
     @classmethod
     def open(cls, path: str | os.PathLike, key: str = "terrain.dem.file") -> DemProduct:
@@ -131,7 +130,7 @@ class DemProduct:
             raise DemError(f"{path}: heights in {units}: expected metres (rescale it, e.g. gdal_translate -scale)")
         files = terrain_files({"dem": {"file": path}})  # a PDS3 label's image too
         digest = hashlib.sha256("".join(file_sha256(f, *_version(f)) for f in files).encode()).hexdigest()
-        return cls(path, digest, crs.to_wkt(), float(radius), shape, tuple(transform)[:6], units)
+        return cls(path, digest, crs.to_wkt(), float(radius), shape, tuple(transform)[:6])
 
     @functools.cached_property
     def _to_product(self):
@@ -160,6 +159,12 @@ class DemProduct:
         if crs.is_geographic:
             return spacing * self.reference_radius_m * math.pi / 180
         return spacing * crs.axis_info[0].unit_conversion_factor
+
+    def sample(self, lat_deg: np.ndarray, lon_deg: np.ndarray, spacing_m: float = 0.0) -> np.ndarray:
+        """The product's values at points (heights, or a mask's counts), for a tile of
+        `spacing_m`: block means where it is wider than the posts (`heights`' step)."""
+        step = max(int(spacing_m // self.post_spacing_m), 1)
+        return self.heights(*self.post_indices(lat_deg, lon_deg), step)
 
     def heights(self, rows: np.ndarray, cols: np.ndarray, step: int = 1) -> np.ndarray:
         """Heights about the reference sphere, m, bilinear between posts at continuous
@@ -235,8 +240,7 @@ class DemMask:
 
     def interpolated(self, lat: np.ndarray, lon: np.ndarray, spacing_m: float) -> np.ndarray:
         """0 where measured, 1 where interpolated (bilinear between posts; outside the mask: 1)."""
-        step = max(int(spacing_m // self.product.post_spacing_m), 1)
-        value = self.product.heights(*self.product.post_indices(lat, lon), step)
+        value = self.product.sample(lat, lon, spacing_m)
         return np.where(np.isfinite(value), np.clip(1.0 - value / self.measured_min, 0.0, 1.0), 1.0)
 
 
@@ -260,18 +264,13 @@ class DemTerrain:
         else the sphere; a tile of `spacing_m` wider than a product's posts reads their block
         means (DemProduct.heights' `step`)."""
         lat, lon = grid_directions(x_m, y_m, self.radius_m, site_axes(self.lat_deg, self.lon_deg, self.heading_deg))
-        rho = self._radii(self.product, lat, lon, spacing_m)  # from the Moon's centre, m
+        rho = self.product.reference_radius_m + self.product.sample(lat, lon, spacing_m)  # from the centre, m
         if self.far is not None and not (found := np.isfinite(rho)).all():
-            rho[~found] = self._radii(self.far, lat[~found], lon[~found], spacing_m)
+            rho[~found] = self.far.reference_radius_m + self.far.sample(lat[~found], lon[~found], spacing_m)
         h = np.where(np.isfinite(rho), rho - self.radius_m, 0.0)
         if self.mask is not None:
             h = h + self.mask.interpolated(lat, lon, spacing_m) * self.mask.band.height_m(x_m, y_m, spacing_m)
         return h if self.detail is None else h + self.detail.height_m(x_m, y_m, spacing_m)
-
-    @staticmethod
-    def _radii(product: DemProduct, lat: np.ndarray, lon: np.ndarray, spacing_m: float) -> np.ndarray:
-        step = max(int(spacing_m // product.post_spacing_m), 1)
-        return product.reference_radius_m + product.heights(*product.post_indices(lat, lon), step)
 
     def identity(self) -> dict:
         """What the heights depend on (the tile cache's key): the products' content, the site, the detail."""
@@ -349,11 +348,11 @@ def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None)
     far = DemProduct.open(dem["far"], "terrain.dem.far") if dem.get("far") else None
     mask = None
     if dem.get("mask"):  # the band where the product is interpolated: with the detail only
-        m = dem["mask"]
-        band = band_params(detail or TerrainParams(), product.post_spacing_m, float(m["interpolated_resolution_m"]))
-        mask = DemMask(DemProduct.open(m["file"], "terrain.dem.mask.file"), float(m["measured_min"]),
-                       ProceduralTerrain(band))  # fmt: skip
         if detail is None:
             raise DemError("a mask adds the detail the product lacks where it is interpolated: expected "
                            "terrain.dem.detail: true", "terrain.dem.mask")  # fmt: skip
+        m = dem["mask"]
+        band = band_params(detail, product.post_spacing_m, float(m["interpolated_resolution_m"]))
+        mask = DemMask(DemProduct.open(m["file"], "terrain.dem.mask.file"), float(m["measured_min"]),
+                       ProceduralTerrain(band))  # fmt: skip
     return DemTerrain(product, lat, lon, radius_m, below, far, heading, mask)
