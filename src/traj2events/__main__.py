@@ -7,7 +7,7 @@ import sys
 
 # cli.build_parser's subcommands (tests/test_cli.py checks they agree), for the reader's --help.
 COMMANDS = ("check-config", "base", "sample", "upsample", "poses", "imu", "render", "motion-field", "events",
-            "export", "picture", "index", "summary", "overview")  # fmt: skip
+            "export", "picture", "index", "summary", "overview", "score", "baseline")  # fmt: skip
 
 
 def main() -> None:

@@ -23,6 +23,7 @@ from .settings.index import INDEX
 from .settings.poses import EXTERNAL_POSES, POSES, external_pose_defaults
 from .settings.render import RENDER, RENDER_FLAGS, RenderSection, render_job_settings
 from .settings.solve import SOLVE, solve_settings
+from .tasks.commands import add_task_commands
 
 
 def _job(kind, args, keys: dict[str, str]):
@@ -275,7 +276,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--config", required=True, help="the resolved config as JSON (the workflow passes its own)")
     p.add_argument("--output", "-o", required=True, help="overview.html")
     p.set_defaults(func=_calls("overview", "dataset_overview", "indexes", "summary", "config", "output"))
-
+    add_task_commands(sub)  # score, baseline
     return parser
 
 

@@ -67,6 +67,16 @@ def test_the_page_holds_each_trajectorys_numbers(tmp_path):
     again = tmp_path / "again.html"
     dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), again)
     assert again.read_bytes() == (tmp_path / "o.html").read_bytes()
+    # Score tables beside summary.csv: their whole's rows shown, one table per task.
+    (tmp_path / "scores").mkdir()
+    (tmp_path / "scores" / "divergence-cmax.csv").write_text(
+        "task,predictions,method,landings,scenario,id,n,median_relative_error\n"
+        "divergence,cmax,cmax,all,descent,0,5,0.5\ndivergence,cmax,cmax,all,all,,9,0.0312\n"
+    )
+    dataset_overview([tmp_path / "index.csv"], tmp_path / "summary.csv", json.dumps(config), again)
+    scored = again.read_text()
+    assert "<h2>Task scores</h2>" in scored and scored.count("<table") == 6
+    assert "<td>0.0312</td>" in scored and "<td>0.5</td>" not in scored  # the whole's row, not a landing's
 
 
 def test_numbers_read_as_people_write_them():

@@ -101,6 +101,8 @@ rule dataset_overview:
     input:
         indexes=expand("results/{scenario}/index.csv", scenario=SCENARIOS),
         summary="results/summary.csv",
+        # The score tables `traj2events score` wrote (the page shows them): a new one reruns it.
+        scores=lambda wildcards: sorted(str(p) for p in Path("results/scores").glob("*.csv")),
     output:
         report(
             "results/overview.html",

@@ -131,10 +131,11 @@ def overview_html(
     manoeuvres: pd.DataFrame | None = None,
     panels: list[bytes] = (),
     summary_href: str = "summary.csv",
+    scores: pd.DataFrame | None = None,
 ) -> str:
     """The page: per-scenario and per-trajectory tables, a scene panel per scenario, the
     rate figure, the diverts and hovers flown (where any was tried), bytes per kind of file,
-    summary.csv, the version, commit and the config."""
+    summary.csv, the task scores (where any), the version, commit and the config."""
     made = provenance(__name__)
     per_scenario = trajectories.groupby("scenario", sort=False).agg(
         trajectories=("id", "size"), frames=("frames", "sum"), flight_s=("t_f_s", "sum"), events=("events", "sum"),
@@ -177,11 +178,22 @@ def overview_html(
            _table(manoeuvres)] if manoeuvres is not None and len(manoeuvres) else []),
         "<h2>Bytes on disk per kind of file</h2>", _table(sizes),
         f"<h2>Solves (<a href='{html.escape(summary_href)}'>summary.csv</a>)</h2>", _table(summary),
+        *(["<h2>Task scores</h2><p>Each score table in scores/ (`traj2events score`, docs/tasks.md): its row over "
+           "all the landings it scored, one table per task.</p>"]
+          + [_table(rows.dropna(axis=1, how="all")) for _, rows in scores.groupby("task", sort=False)]
+          if scores is not None and len(scores) else []),
         "<h2>Configuration</h2><details><summary>The resolved config (defaults.yaml with the overlays), as the "
         "jobs got it</summary>",
         f"<pre>{html.escape(json.dumps(config, indent=1, sort_keys=True))}</pre></details>",
         "</body></html>", "",
     ])  # fmt: skip
+
+
+def task_scores(folder: Path) -> pd.DataFrame:
+    """The whole's row (`scenario` "all") of every score table `traj2events score` wrote in folder."""
+    tables = [pd.read_csv(path, dtype={"id": str}) for path in sorted(folder.glob("*.csv"))]
+    found = [t[t["scenario"] == "all"] for t in tables if "scenario" in t]
+    return pd.concat(found, ignore_index=True).drop(columns=["scenario", "id"]) if found else pd.DataFrame()
 
 
 def dataset_overview(
@@ -222,7 +234,8 @@ def dataset_overview(
     kinds = pd.DataFrame({"file": by_kind.index, "MB": by_kind.values / 1e6, "MB_per_trajectory": by_kind.values / 1e6
                           / len(rows), "share": by_kind.values / max(by_kind.sum(), 1)})  # fmt: skip
     figure = png_bytes(event_rate_figure(curves, RATE_BIN_MS), dpi=100)
+    scores = task_scores(Path(summary).parent / "scores")  # beside summary.csv: results/scores/
     page = overview_html(table, pd.read_csv(summary), kinds, figure, json.loads(config_json), pd.DataFrame(manoeuvres),
-                         panels, Path(os.path.relpath(summary, Path(output).parent)).as_posix())  # fmt: skip
+                         panels, Path(os.path.relpath(summary, Path(output).parent)).as_posix(), scores)  # fmt: skip
     with atomic_output(output) as tmp:
         Path(tmp).write_text(page)

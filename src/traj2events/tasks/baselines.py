@@ -1,0 +1,121 @@
+"""The baselines (`traj2events baseline TASK METHOD`): a prediction file for a task, made
+by one method over a dataset's landings, with its run time in the file's notes
+(`method`, `run_time_s`, `events_s`: the seconds of events it was given).
+
+    truth               the ground truth itself: scores zero error (a check of the scorer)
+    zero                zero flow, zero divergence, zero velocity
+    constant-velocity   egomotion: the first pose's velocity, held
+    centre              landing site: the image centre
+    cmax                flow, divergence: contrast maximisation of the events (contrast_max)
+    dis                 flow, divergence: OpenCV's DIS on video.mkv's frames (frame_flow)
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..trajectory.state import VELOCITY
+from . import contrast_max, egomotion, flow, frame_flow
+from .affine_flow import displacement_field
+from .poses import flight_of
+from .predictions import PredictionError, write_table
+from .score import TABLE_TASKS, landings_of, truth_of
+
+METHODS = {
+    "flow": ("truth", "zero", "cmax", "dis"),
+    "divergence": ("truth", "zero", "cmax", "dis"),
+    "egomotion": ("truth", "zero", "constant-velocity"),
+    "landing-site": ("truth", "centre"),
+}
+
+
+def _cmax_motion(landing, flight, t_s: float) -> tuple[float, float, float]:
+    """(D, c_x, c_y) of the events of [t - h, t + h), h = contrast_max.HALF_WINDOW_S."""
+    h = contrast_max.HALF_WINDOW_S
+    events = landing.events(max(t_s - h, 0.0), t_s + h)
+    if len(events) < 100:
+        return 0.0, 0.0, 0.0
+    return contrast_max.fit(events, t_s * 1e6, flight.camera.width, flight.camera.height)
+
+
+def _frames_around(flight, t_s: float) -> tuple[int, int]:
+    """The poses HALF_WINDOW_S before and after t_s, inside the flight."""
+    k, m = round(t_s * flight.fps), round(contrast_max.HALF_WINDOW_S * flight.fps)
+    return max(k - m, 0), min(k + m, len(flight.t) - 1)
+
+
+def table_predictions(task: str, method: str, landing, flight) -> np.ndarray:
+    """(n, c) predicted values at the task's scored times of one landing."""
+    t, expected = truth_of(task, landing, flight)
+    if method == "truth":
+        return expected
+    if method == "zero":
+        return np.zeros((len(t), len(TABLE_TASKS[task].COLUMNS)))
+    if method == "constant-velocity":
+        return np.tile(flight.state[0, VELOCITY], (len(t), 1))
+    if method == "centre":
+        return np.tile([(flight.camera.width - 1) / 2, (flight.camera.height - 1) / 2], (len(t), 1))
+    if method == "cmax":
+        return np.array([[_cmax_motion(landing, flight, float(s))[0]] for s in t])
+    from ..video import read_video
+
+    video = read_video(landing.folder / "video.mkv")
+    out = []
+    for s in t:
+        a, b = _frames_around(flight, float(s))
+        out.append([frame_flow.frame_divergence(video[a], video[b], (b - a) / flight.fps)])
+    return np.nan_to_num(np.array(out))  # too little lit ground: 0
+
+
+def flow_predictions(method: str, landing, flight, dt_frames: int) -> tuple[np.ndarray, np.ndarray]:
+    """(frame_index (K,), displacement (K, H, W, 2) px) of one landing."""
+    frames = flow.field_frames(landing, flight, dt_frames)
+    width, height = flight.camera.width, flight.camera.height
+    dt_s = dt_frames / flight.fps
+    if method == "dis":
+        from ..video import read_video
+
+        video = read_video(landing.folder / "video.mkv")
+    fields = []
+    for k in frames:
+        if method == "truth":
+            fields.append(flow.truth_at(landing, flight, int(k), dt_frames)[0])
+        elif method == "zero":
+            fields.append(np.zeros((height, width, 2), np.float32))
+        elif method == "cmax":
+            d, cx, cy = _cmax_motion(landing, flight, float(flight.t[k]) + dt_s / 2)
+            fields.append(displacement_field(width, height, d, (cx, cy), dt_s))
+        else:
+            fields.append(frame_flow.dis_displacement(video[k], video[k + dt_frames]))
+    return frames, np.array(fields, np.float32).reshape(len(frames), height, width, 2)
+
+
+def run_baseline(task: str, method: str, output, results="results", split: str | None = None,
+                 dt_frames: int = 1, progress=print, scenario: str | None = None) -> dict:  # fmt: skip
+    """Write `method`'s predictions for `task` over the dataset (or one split) to output;
+    returns the notes written (method, run_time_s, events_s)."""
+    if task not in METHODS:
+        raise PredictionError(f"task: expected one of {', '.join(METHODS)}, got {task!r}")
+    if method not in METHODS[task]:
+        raise PredictionError(f"method: {task} has the baselines {', '.join(METHODS[task])}, not {method!r}")
+    landings = landings_of(results, split, scenario)
+    start, events_s, rows, fields = time.perf_counter(), 0.0, [], {}
+    for i, landing in enumerate(landings):
+        flight = flight_of(landing)
+        events_s += float(flight.t[-1])
+        if task == "flow":
+            fields[landing.scenario, landing.id] = flow_predictions(method, landing, flight, dt_frames)
+        else:
+            t, _ = truth_of(task, landing, flight)
+            values = table_predictions(task, method, landing, flight)
+            rows += [(landing.scenario, landing.id, s, *v) for s, v in zip(t, values)]
+        progress(f"{task} {method}: {i + 1} of {len(landings)} landings ({landing.scenario} {landing.id:04d})")
+    notes = {"method": method, "run_time_s": f"{time.perf_counter() - start:.3f}", "events_s": f"{events_s:.3f}"}
+    if task == "flow":
+        flow.write_predictions(output, dt_frames, fields, notes)
+    else:
+        rates = egomotion.OPTIONAL if task == "egomotion" and method == "truth" else ()
+        write_table(output, TABLE_TASKS[task].COLUMNS + rates, rows, notes)
+    return notes
