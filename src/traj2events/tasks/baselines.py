@@ -46,7 +46,13 @@ def _frames_around(flight, t_s: float) -> tuple[int, int]:
     return max(k - m, 0), min(k + m, len(flight.t) - 1)
 
 
-def table_predictions(task: str, method: str, landing, flight) -> np.ndarray:
+def _every_tenth(progress, what: str, n: int):
+    """A callback for item i of n that reports every tenth of them."""
+    step = max(1, n // 10)
+    return lambda i: progress(f"  {what}: {i + 1} of {n}") if (i + 1) % step == 0 else None
+
+
+def table_predictions(task: str, method: str, landing, flight, progress=lambda line: None) -> np.ndarray:
     """(n, c) predicted values at the task's scored times of one landing."""
     t, expected = truth_of(task, landing, flight)
     if method == "truth":
@@ -57,19 +63,22 @@ def table_predictions(task: str, method: str, landing, flight) -> np.ndarray:
         return np.tile(flight.state[0, VELOCITY], (len(t), 1))
     if method == "centre":
         return np.tile([(flight.camera.width - 1) / 2, (flight.camera.height - 1) / 2], (len(t), 1))
-    if method == "cmax":
-        return np.array([[_cmax_motion(landing, flight, float(s))[0]] for s in t])
-    from ..video import read_video
+    done, out = _every_tenth(progress, "windows", len(t)), []
+    if method == "dis":
+        from ..video import read_video
 
-    video = read_video(landing.folder / "video.mkv")
-    out = []
-    for s in t:
-        a, b = _frames_around(flight, float(s))
-        out.append([frame_flow.frame_divergence(video[a], video[b], (b - a) / flight.fps)])
+        video = read_video(landing.folder / "video.mkv")
+    for i, s in enumerate(t):
+        if method == "cmax":
+            out.append([_cmax_motion(landing, flight, float(s))[0]])
+        else:
+            a, b = _frames_around(flight, float(s))
+            out.append([frame_flow.frame_divergence(video[a], video[b], (b - a) / flight.fps)])
+        done(i)
     return np.nan_to_num(np.array(out))  # too little lit ground: 0
 
 
-def flow_predictions(method: str, landing, flight, dt_frames: int) -> tuple[np.ndarray, np.ndarray]:
+def flow_predictions(method: str, landing, flight, dt_frames: int, progress=lambda line: None) -> tuple:
     """(frame_index (K,), displacement (K, H, W, 2) px) of one landing."""
     frames = flow.field_frames(landing, flight, dt_frames)
     width, height = flight.camera.width, flight.camera.height
@@ -78,8 +87,8 @@ def flow_predictions(method: str, landing, flight, dt_frames: int) -> tuple[np.n
         from ..video import read_video
 
         video = read_video(landing.folder / "video.mkv")
-    fields = []
-    for k in frames:
+    fields, done = [], _every_tenth(progress, "fields", len(frames))
+    for i, k in enumerate(frames):
         if method == "truth":
             fields.append(flow.truth_at(landing, flight, int(k), dt_frames)[0])
         elif method == "zero":
@@ -89,6 +98,7 @@ def flow_predictions(method: str, landing, flight, dt_frames: int) -> tuple[np.n
             fields.append(displacement_field(width, height, d, (cx, cy), dt_s))
         else:
             fields.append(frame_flow.dis_displacement(video[k], video[k + dt_frames]))
+        done(i)
     return frames, np.array(fields, np.float32).reshape(len(frames), height, width, 2)
 
 
@@ -106,10 +116,10 @@ def run_baseline(task: str, method: str, output, results="results", split: str |
         flight = flight_of(landing)
         events_s += float(flight.t[-1])
         if task == "flow":
-            fields[landing.scenario, landing.id] = flow_predictions(method, landing, flight, dt_frames)
+            fields[landing.scenario, landing.id] = flow_predictions(method, landing, flight, dt_frames, progress)
         else:
             t, _ = truth_of(task, landing, flight)
-            values = table_predictions(task, method, landing, flight)
+            values = table_predictions(task, method, landing, flight, progress)
             rows += [(landing.scenario, landing.id, s, *v) for s, v in zip(t, values)]
         progress(f"{task} {method}: {i + 1} of {len(landings)} landings ({landing.scenario} {landing.id:04d})")
     notes = {"method": method, "run_time_s": f"{time.perf_counter() - start:.3f}", "events_s": f"{events_s:.3f}"}
