@@ -133,3 +133,18 @@ def test_hg1700_units_and_the_noise_laws():
         starts.append(b[0])
         walks.append(b[-1] - b[0])
     assert np.std(starts) == pytest.approx(2.0, rel=0.08) and np.std(walks) == pytest.approx(2.0, rel=0.08)
+
+
+def test_the_altitude_keeps_its_digits_at_touchdown():
+    # The counterexample of the stability search (docs/accuracy.md): |p - c| - R at 1 mm
+    # up kept no digit (R's ulp is 2.3e-10 m: 1e-7 relative); the stable form keeps 4 eps.
+    import mpmath as mp
+
+    states = np.zeros((3, 13))
+    states[:, 0], states[:, 2] = (0.0, 150.0, -2.0e5), (-1e-3, -0.37, -1.0)
+    got = altitude_above_sphere(states, 1737400.0)
+    with mp.workdps(50):
+        for s, h in zip(states, got):
+            x, z = mp.mpf(float(s[0])), mp.mpf(float(s[2]))
+            reference = mp.sqrt(x**2 + (1737400 - z) ** 2) - 1737400
+            assert float(abs(h - reference) / reference) <= 4 * np.finfo(float).eps

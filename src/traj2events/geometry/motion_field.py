@@ -41,10 +41,18 @@ def local_vertical(position: np.ndarray, rotation: np.ndarray, radius_m: float) 
     """
     x, y, z = (float(c) for c in position)
     down = np.array([-x, -y, radius_m - z])
-    distance = float(np.linalg.norm(down))
-    # |p - c|^2 - R^2 = x^2 + y^2 + z^2 - 2 R z, divided by |p - c| + R: no cancellation at 1 m.
-    height = (x * x + y * y + z * z - 2.0 * radius_m * z) / (distance + radius_m)
-    return rotation.T @ (down / distance), height
+    return rotation.T @ (down / float(np.linalg.norm(down))), float(height_above_sphere(position, radius_m))
+
+
+def height_above_sphere(points: np.ndarray, radius_m: float) -> np.ndarray:
+    """(...) m: the height of points (..., 3) (site frame, z down) above the sphere whose
+    centre is at (0, 0, R), within 4 eps relative from 1 mm to 200 km up, 200 km out
+    (docs/accuracy.md): |p - c|^2 - R^2 = x^2 + y^2 + z^2 - 2 R z, divided by |p - c| + R,
+    where |p - c| - R would cancel (at 1 mm up it keeps no digit)."""
+    p = np.asarray(points, dtype=float)
+    x, y, z = p[..., 0], p[..., 1], p[..., 2]
+    distance = np.sqrt(x * x + y * y + (radius_m - z) ** 2)
+    return (x * x + y * y + z * z - 2.0 * radius_m * z) / (distance + radius_m)
 
 
 def site_vertical(position: np.ndarray, rotation: np.ndarray) -> tuple[np.ndarray, float]:

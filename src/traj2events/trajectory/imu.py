@@ -47,8 +47,11 @@ def angular_rate_body(states: np.ndarray) -> np.ndarray:
 
 
 def altitude_above_sphere(states: np.ndarray, radius_m: float) -> np.ndarray:
-    """(n,) height above the sphere through the site (centre at (0, 0, R), z down), m."""
-    return np.linalg.norm(np.asarray(states)[:, POSITION] - np.array([0.0, 0.0, radius_m]), axis=1) - radius_m
+    """(n,) height above the sphere through the site (centre at (0, 0, R), z down), m,
+    without cancellation (`geometry.motion_field.height_above_sphere`)."""
+    from ..geometry.motion_field import height_above_sphere
+
+    return height_above_sphere(np.asarray(states)[:, POSITION], radius_m)
 
 
 @dataclass(frozen=True)
