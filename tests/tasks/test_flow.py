@@ -68,7 +68,12 @@ def predictions_file(path, results, dt=1, change=None):
 
 
 def read(path, dataset):
-    return flow.read_predictions(path, list(dataset), {(la.scenario, la.id): flight_of(la) for la in dataset})
+    """Read and score: the checks of the file, then of its unit (`check_lengths`)."""
+    flights = {(la.scenario, la.id): flight_of(la) for la in dataset}
+    predicted, dt, notes = flow.read_predictions(path, list(dataset), flights)
+    rows = [flow.score_landing(la, flights[la.scenario, la.id], predicted[la.scenario, la.id], dt) for la in dataset]
+    flow.check_lengths(path, rows, dt)
+    return predicted, dt, notes
 
 
 def test_a_written_file_reads_back_with_its_interval_and_notes(results, tmp_path):

@@ -80,15 +80,25 @@ def endpoint_errors(predicted: np.ndarray, expected: np.ndarray) -> np.ndarray:
 
 
 def score_landing(landing: Landing, flight: Flight, predicted: dict, dt_frames: int) -> dict:
-    """The landing's row; predicted: {k: (H, W, 2) px} at every field_frames k."""
-    sparse, dense = [], []
+    """The landing's row; predicted: {k: (H, W, 2) px} at every field_frames k. `_lengths`:
+    the predicted and true displacements' lengths on the visible pixels (every 7th), for
+    the file's unit check (`check_lengths`)."""
+    sparse, dense, lengths = [], [], ([], [])
     for k, displacement in predicted.items():
         expected, visible = truth_at(landing, flight, k, dt_frames)
         epe = endpoint_errors(displacement, expected)
         sparse.append(epe[visible & event_pixels(landing, flight, k, dt_frames)])
         dense.append(epe[visible])
+        for pooled, d in zip(lengths, (displacement, expected)):
+            pooled.append(np.linalg.norm(d[visible].astype(np.float64), axis=-1)[::7])
     return _row(np.concatenate(sparse), np.concatenate(dense)) | {"fields": len(predicted), "_sparse": sparse,
-                                                                   "_dense": dense}  # fmt: skip
+                                                                   "_dense": dense, "_lengths": lengths}  # fmt: skip
+
+
+def check_lengths(path, rows: list[dict], dt_frames: int) -> None:
+    """The whole file's displacements against the truth's typical length: px, not px/s."""
+    predicted, expected = (np.concatenate([a for r in rows for a in r["_lengths"][i]]) for i in (0, 1))
+    check_scale(path, "displacement_px", f"px over {dt_frames} frames", predicted, expected)
 
 
 def _row(sparse: np.ndarray, dense: np.ndarray) -> dict:
@@ -120,7 +130,7 @@ def write_predictions(path: str | os.PathLike, dt_frames: int, fields: dict, not
 
 def read_predictions(path: str | os.PathLike, landings: list[Landing], flights: dict) -> tuple:
     """({(scenario, id): {k: (H, W, 2)}}, dt_frames, notes), checked: the task, every landing
-    and field, the shapes, finite values, and px (not px/s: a scale check against the truth)."""
+    and field, the shapes and finite values (the unit: `check_lengths`, once scored)."""
     path = Path(path)
     if not path.is_file():
         raise PredictionError(f"{path}: no such prediction file")
@@ -158,10 +168,4 @@ def read_predictions(path: str | os.PathLike, landings: list[Landing], flights: 
                 raise PredictionError(f"{where}/displacement_px: NaN or infinite values (predict every pixel)")
             out[key] = dict(zip(frames.tolist(), values))
         notes = {k: str(v) for k, v in f.attrs.items() if k not in ("task", "dt_frames")}
-    first = landings[0]
-    k0 = next(iter(out[first.scenario, first.id]))
-    truth0, visible0 = truth_at(first, flights[first.scenario, first.id], k0, dt)
-    length = lambda d: np.linalg.norm(d.astype(np.float64), axis=-1)  # noqa: E731
-    check_scale(path, "displacement_px", f"px over {dt} frames", length(out[first.scenario, first.id][k0][visible0]),
-                length(truth0[visible0]))  # fmt: skip
     return out, dt, notes

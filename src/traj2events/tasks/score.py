@@ -97,6 +97,7 @@ def score_flow(predictions, landings: list) -> tuple[list[dict], dict, dict]:
             np.array([np.mean(a) if len(a) else np.nan for a in row["_dense"]]),
         )
         rows.append({"scenario": landing.scenario, "id": landing.id, "dt_frames": dt} | row)
+    flow.check_lengths(predictions, rows, dt)  # before anything is written
     return rows, {"dt_frames": dt} | flow.combine(rows), notes
 
 
