@@ -27,7 +27,7 @@ SHOWN = {  # the whole's columns the table shows, per task
 }
 RUNS = [("flow", m, dt) for dt in (1, 4, 5) for m in ("truth", "zero", "dis", "cmax")] + [
     ("divergence", m, 1) for m in ("truth", "zero", "dis", "cmax")] + [
-    ("egomotion", m, 1) for m in ("truth", "zero", "constant-velocity")] + [
+    ("egomotion", m, 1) for m in ("truth", "zero", "constant-velocity", "imu")] + [
     ("landing-site", m, 1) for m in ("truth", "centre")]  # fmt: skip
 
 

@@ -1,7 +1,7 @@
 """A results/ folder of stand-in landings for the task tests, made in a second: a camera
 looking straight down while the lander descends at constant velocity over flat ground
 (closed forms for every task's truth), its poses, a flat depth map per pose, the motion
-field written by the real stage, random events and index.csv."""
+field written by the real stage, random events, a noise-free IMU and index.csv."""
 
 from __future__ import annotations
 
@@ -11,6 +11,7 @@ import numpy as np
 
 from traj2events.formats.events import EVENT_DTYPE, EventsWriter
 from traj2events.formats.frames import FramesWriter
+from traj2events.formats.imu import write_imu
 from traj2events.formats.trajectory import write_trajectory
 from traj2events.geometry.camera import Camera
 from traj2events.geometry.motion_field import MOON_RADIUS_M
@@ -21,6 +22,7 @@ CAMERA = Camera(WIDTH, HEIGHT, FOV_DEG, MOUNT_M)
 START = np.array([-20.0, 3.0, -200.0])  # m, site frame (z down: 200 m up)
 VELOCITY = np.array([2.0, -0.5, 10.0])  # m/s: forward, sideways, down
 DURATION_S = 4.0
+G_M_S2 = 1.6242
 
 
 def states() -> tuple[np.ndarray, np.ndarray]:
@@ -58,6 +60,13 @@ def write_landing(folder, scenario: str, id_: int, seed: int = 0) -> None:
     writer = EventsWriter(folder / "events.h5", WIDTH, HEIGHT, scene)
     writer.append(events)
     writer.close(round(DURATION_S * 1e6))
+    n_imu = round(DURATION_S * 100) + 1  # 100 Hz, level and unaccelerated: it reads gravity up, no rates
+    t_imu = np.arange(n_imu) / 100.0
+    reading = {"specific_force_b": np.tile([0.0, 0.0, -G_M_S2], (n_imu, 1)), "angular_rate_b": np.zeros((n_imu, 3))}
+    streams = {"t": t_imu, **reading, **{f"{k}_measured": v for k, v in reading.items()},
+               "accel_bias_b": np.zeros((n_imu, 3)), "gyro_bias_b": np.zeros((n_imu, 3)),
+               "altitude_m": camera_height_m(t_imu) - MOUNT_M}  # fmt: skip
+    write_imu(folder / "imu.h5", streams, {"rate_hz": 100.0, "g_m_s2": G_M_S2})
 
 
 def write_results(root, landings=(("descent", 0, "train"), ("descent", 1, "test"))):

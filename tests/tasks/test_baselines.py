@@ -22,6 +22,8 @@ def test_trivial_predictors_score_their_closed_forms(results, tmp_path):
     t = np.arange(41) / 10.0
     baselines.run_baseline("egomotion", "constant-velocity", tmp_path / "cv.csv", results, **QUIET)
     assert score("egomotion", tmp_path / "cv.csv", results)[-1]["elope_error"] == 0.0  # the flight's is constant
+    baselines.run_baseline("egomotion", "imu", tmp_path / "i.csv", results, **QUIET)  # a noise-free IMU: exact
+    assert score("egomotion", tmp_path / "i.csv", results)[-1]["elope_error"] == pytest.approx(0.0, abs=1e-12)
     baselines.run_baseline("egomotion", "zero", tmp_path / "z.csv", results, **QUIET)
     altitude = camera_height_m(t) - CAMERA.mount_height_m
     expected = np.mean(np.linalg.norm(VELOCITY) / altitude)
@@ -49,7 +51,7 @@ def test_cmax_writes_a_field_per_scored_frame_of_its_affine_model(results, tmp_p
 @pytest.mark.parametrize(
     "task, method, message",
     [("pose", "zero", r"task: expected one of flow, divergence"), ("egomotion", "cmax", r"egomotion has the "
-     r"baselines truth, zero, constant-velocity, not 'cmax'")],
+     r"baselines truth, zero, constant-velocity, imu, not 'cmax'")],
 )  # fmt: skip
 def test_unknown_tasks_and_methods_are_refused(results, tmp_path, task, method, message):
     with pytest.raises(PredictionError, match=message):

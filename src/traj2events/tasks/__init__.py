@@ -11,6 +11,7 @@ the data is for, each scored against its ground truth by `traj2events score`.
     affine_flow    the affine radial flow model of the divergence baselines
     contrast_max   contrast maximisation of the events (Gallego et al. 2018)
     frame_flow     OpenCV's DIS flow on video.mkv, and its divergence
+    strapdown      the IMU dead-reckoned: the egomotion an IMU alone gives
     baselines      truth, trivial predictors, cmax and dis -> prediction files
     commands       the `score` and `baseline` subcommands
 """

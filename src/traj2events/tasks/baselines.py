@@ -5,6 +5,7 @@ by one method over a dataset's landings, with its run time in the file's notes
     truth               the ground truth itself: scores zero error (a check of the scorer)
     zero                zero flow, zero divergence, zero velocity
     constant-velocity   egomotion: the first pose's velocity, held
+    imu                 egomotion: the measured IMU (imu.h5) dead-reckoned from the first pose (strapdown)
     centre              landing site: the image centre
     cmax                flow, divergence: contrast maximisation of the events (contrast_max)
     dis                 flow, divergence: OpenCV's DIS on video.mkv's frames (frame_flow)
@@ -16,8 +17,9 @@ import time
 
 import numpy as np
 
-from ..trajectory.state import VELOCITY
-from . import contrast_max, egomotion, flow, frame_flow
+from ..formats.imu import read_imu
+from ..trajectory.state import ATTITUDE, VELOCITY, rotation_matrix
+from . import contrast_max, egomotion, flow, frame_flow, strapdown
 from .affine_flow import displacement_field
 from .poses import flight_of
 from .predictions import PredictionError, write_table
@@ -26,7 +28,7 @@ from .score import TABLE_TASKS, landings_of, truth_of
 METHODS = {
     "flow": ("truth", "zero", "cmax", "dis"),
     "divergence": ("truth", "zero", "cmax", "dis"),
-    "egomotion": ("truth", "zero", "constant-velocity"),
+    "egomotion": ("truth", "zero", "constant-velocity", "imu"),
     "landing-site": ("truth", "centre"),
 }
 
@@ -52,6 +54,16 @@ def _every_tenth(progress, what: str, n: int):
     return lambda i: progress(f"  {what}: {i + 1} of {n}") if (i + 1) % step == 0 else None
 
 
+def dead_reckoned(landing, flight, t: np.ndarray) -> np.ndarray:
+    """(n, 3) m/s at t: imu.h5's measured streams integrated from the first pose's velocity
+    and attitude."""
+    streams, attrs = read_imu(landing.folder / "imu.h5")
+    start = flight.state[0]
+    v = strapdown.velocities(streams["t"], streams["specific_force_b_measured"], streams["angular_rate_b_measured"],
+                             start[VELOCITY], rotation_matrix(*start[ATTITUDE]), float(attrs["g_m_s2"]))  # fmt: skip
+    return np.column_stack([np.interp(t, streams["t"], v[:, c]) for c in range(3)])
+
+
 def table_predictions(task: str, method: str, landing, flight, progress=lambda line: None) -> np.ndarray:
     """(n, c) predicted values at the task's scored times of one landing."""
     t, expected = truth_of(task, landing, flight)
@@ -61,6 +73,8 @@ def table_predictions(task: str, method: str, landing, flight, progress=lambda l
         return np.zeros((len(t), len(TABLE_TASKS[task].COLUMNS)))
     if method == "constant-velocity":
         return np.tile(flight.state[0, VELOCITY], (len(t), 1))
+    if method == "imu":
+        return dead_reckoned(landing, flight, t)
     if method == "centre":
         return np.tile([(flight.camera.width - 1) / 2, (flight.camera.height - 1) / 2], (len(t), 1))
     done, out = _every_tenth(progress, "windows", len(t)), []

@@ -52,9 +52,10 @@ def add_task_commands(sub: argparse._SubParsersAction) -> None:
     p = _task_parser(sub, "baseline", "a baseline's predictions for a task (truth, trivial, cmax, dis)",
                      "Write a baseline's predictions for a task over a built dataset, in the format `traj2events "
                      "score` reads, with its run time. Methods: truth, zero (flow, divergence, egomotion), "
-                     "constant-velocity (egomotion), centre (landing-site), cmax (contrast maximisation of the "
-                     "events: flow, divergence), dis (OpenCV's DIS on video.mkv: flow, divergence).",
-                     ("method", "truth, zero, constant-velocity, centre, cmax or dis"))  # fmt: skip
+                     "constant-velocity and imu (dead reckoning; egomotion), centre (landing-site), cmax "
+                     "(contrast maximisation of the events: flow, divergence), dis (OpenCV's DIS on video.mkv: "
+                     "flow, divergence).",
+                     ("method", "truth, zero, constant-velocity, imu, centre, cmax or dis"))  # fmt: skip
     p.add_argument("--dt-frames", type=int, default=1, help="flow: the interval, frames (MVSEC: 1, 4; default 1)")
     p.add_argument("--output", "-o", required=True, help="the prediction file (flow: .h5; the others: .csv)")
     p.set_defaults(func=cmd_baseline)
