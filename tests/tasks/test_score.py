@@ -63,3 +63,12 @@ def test_a_unit_slip_is_refused_before_scoring(results, tmp_path):
         score("egomotion", path, results, output_dir=tmp_path / "out")
     with open(path, newline="") as fh:
         assert len(list(csv.reader(fh))) > 10
+
+
+def test_body_rates_come_all_three_or_none(results, tmp_path):
+    path = tmp_path / "rates.csv"
+    baselines.run_baseline("egomotion", "truth", path, results, progress=lambda line: None)
+    lines = path.read_text().splitlines()
+    path.write_text("\n".join(",".join(line.split(",")[:7]) if not line.startswith("#") else line for line in lines))
+    with pytest.raises(PredictionError, match=r"p_rad_s without the rest: give p_rad_s, q_rad_s, r_rad_s together"):
+        score("egomotion", path, results, output_dir=tmp_path / "out")

@@ -56,7 +56,11 @@ def _curve(task: str, flight, t: np.ndarray, predicted: np.ndarray, expected: np
 def score_table_task(task: str, predictions, landings: list) -> tuple[list[dict], dict, dict]:
     """(a row per landing, the whole's row, notes) of a CSV task; curves under `_curve`."""
     module = TABLE_TASKS[task]
-    table, given, notes = read_table(predictions, module.COLUMNS, getattr(module, "OPTIONAL", ()))
+    optional = getattr(module, "OPTIONAL", ())
+    table, given, notes = read_table(predictions, module.COLUMNS, optional)
+    if given and given != optional:
+        raise PredictionError(f"{predictions}: {', '.join(given)} without the rest: give {', '.join(optional)} "
+                              "together, or none")  # fmt: skip
     check_landings(predictions, set(table), {(la.scenario, la.id) for la in landings})
     flights = {(la.scenario, la.id): flight_of(la) for la in landings}
     matched = []
