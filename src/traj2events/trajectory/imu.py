@@ -31,7 +31,8 @@ def rotations_body_to_inertial(states: np.ndarray) -> np.ndarray:
 
 def specific_force(states: np.ndarray, acceleration_m_s2: np.ndarray, g_m_s2: float) -> np.ndarray:
     """(n, 3) accelerometer reading, m/s^2, body axes: R_iv^T (a_i - g_i) of the states'
-    attitudes and their inertial accelerations (n, 3)."""
+    attitudes and their inertial accelerations (n, 3); each component within 4 eps
+    |a - g|_1 of the exact rotation (docs/accuracy.md)."""
     gravity = np.array([0.0, 0.0, g_m_s2])
     return np.einsum("nji,nj->ni", rotations_body_to_inertial(states), np.asarray(acceleration_m_s2) - gravity)
 
