@@ -22,6 +22,11 @@ python bench/trajectories.py motion [--config config/config.yaml] [--vehicle con
     by scenario, A and B alternated: solved share, t_f, whether the pitch keeps decreasing
     (its rise above the running minimum; "monotone" = at most 2 deg), how often it reaches
     the tilt limit, roll and yaw swings, horizontal travel per altitude lost, solve CPU time.
+python bench/trajectories.py reach [--config config/config.yaml] [--samples 12] [--widen 1,1.5,2,3]
+    The OCP over its sampling ranges and beyond (issue 71): each range widened about its
+    midpoint by each factor (altitude kept >= 20 m, pitch and roll inside the tilt limit),
+    --samples draws continued from the unwidened base: share solved, how, and every accepted
+    sample re-checked with DOP853 (an accepted wrong optimum would show there).
 """
 
 from __future__ import annotations
@@ -224,9 +229,48 @@ def motion(config: dict, overlay_path: str, n_samples: int, jobs: int) -> None:
             )
 
 
+def widened(ranges: dict, factor: float, tilt_deg: float) -> dict:
+    """Each [lo, hi] range widened about its midpoint by factor, kept physical."""
+    out = {}
+    for key, (lo, hi) in ranges.items():
+        mid, half = (lo + hi) / 2, (hi - lo) / 2 * factor
+        lo, hi = mid - half, mid + half
+        if key == "altitude_m":
+            lo = max(lo, 20.0)
+        if key in ("pitch_deg", "roll_deg"):
+            lo, hi = max(lo, 1.0 - tilt_deg), min(hi, tilt_deg - 1.0)
+        if key == "downrange_m":
+            lo = max(lo, 0.0)
+        out[key] = (lo, hi)
+    return out
+
+
+def reach(config: dict, samples: int, factors: list[float], jobs: int) -> None:
+    print(
+        "| scenario | widened | solved / draws | first attempt | retried | accepted over 0.1 m or 0.01 m/s "
+        "(DOP853) | worst DOP853 error (m, m/s) | CPU s |\n|---|---|---|---|---|---|---|---|"
+    )
+    for name in config["scenarios"]:
+        s = ScenarioSettings.from_config(merge_config(config, {"scenarios": {name: {"n_trajectories": samples}}}), name)
+        base, bc = solve_base(s)
+        for factor in factors:
+            scenario = replace(s.scenario, ranges=widened(s.scenario.ranges, factor, s.vehicle.tilt_max_deg))
+            results = solve_samples(s.vehicle, s.ocp, scenario, s.seed, bc, base, jobs)
+            ok = [r for r in results if r.success]
+            dyn = Dynamics(s.vehicle)
+            errors = [final_state_error(dyn, r.solution.t, r.solution.state, r.solution.control) for r in ok]
+            over = sum(e[0] > 0.1 or e[1] > 0.01 for e in errors)
+            worst = (max(e[0] for e in errors), max(e[1] for e in errors)) if errors else (np.nan, np.nan)
+            cpu = sum(r.total_time_s for r in results)
+            print(f"| {name} | {factor:g}x | {len(ok)} / {len(results)} | {sum(r.method == 'warm' for r in ok)} | "
+                  f"{sum(r.method != 'warm' for r in ok)} | {over} | {worst[0]:.2g}, {worst[1]:.2g} | {cpu:.0f} |",
+                  flush=True)  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("what", choices=("mesh", "batch", "compare", "motion"))
+    parser.add_argument("what", choices=("mesh", "batch", "compare", "motion", "reach"))
+    parser.add_argument("--widen", default="1,1.5,2,3", help="reach: the ranges' widening factors")
     parser.add_argument("--vehicle", default="config/vehicle-agile.yaml", help="motion: variant B's overlay")
     parser.add_argument("--a", default="{}", help="compare: variant A as JSON")
     parser.add_argument("--b", default="{}", help="compare: variant B as JSON")
@@ -240,7 +284,7 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--verify", action="store_true", help="batch: re-check every sample with DOP853 afterwards")
     args = parser.parse_args()
-    default = "config/config.yaml" if args.what in ("mesh", "motion") else "config/paper.yaml"
+    default = "config/config.yaml" if args.what in ("mesh", "motion", "reach") else "config/paper.yaml"
     config = load_config(ROOT / (args.config or default))
     print(f"# {args.what} on {machine()}, {time.strftime('%Y-%m-%d')}")
     if args.what == "mesh":
@@ -249,6 +293,8 @@ def main() -> None:
         batch(config, args.jobs, args.nodes, args.clustering, args.verify)
     elif args.what == "motion":
         motion(config, args.vehicle, args.samples, args.jobs)
+    elif args.what == "reach":
+        reach(config, args.samples, [float(f) for f in args.widen.split(",")], args.jobs)
     else:
         compare(config, json.loads(args.a), json.loads(args.b), args.samples)
 
