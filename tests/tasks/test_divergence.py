@@ -14,7 +14,7 @@ from traj2events.tasks.poses import Flight, flight_of
 
 def test_straight_down_the_divergence_is_the_descent_rate_over_the_height(tmp_path):
     flight = flight_of(open_dataset(write_results(tmp_path, (("descent", 0, "train"),)))[0])
-    t, d = divergence.truth(flight, MOON_RADIUS_M)
+    t, d = divergence.truth(flight)
     assert np.allclose(t, flight.t[:: round(flight.fps * divergence.PERIOD_S)])
     assert d[:, 0] == pytest.approx(VELOCITY[2] / camera_height_m(t), rel=1e-5)  # the sphere's curvature: ~1e-6
 
@@ -32,14 +32,14 @@ def test_a_tilted_camera_divergence_is_that_of_its_flow_field(pitch_deg, roll_de
     c = 200
     du_dx = (field[c, c + 1, 0] - field[c, c - 1, 0]) / 2.0
     dv_dy = (field[c + 1, c, 1] - field[c - 1, c, 1]) / 2.0
-    assert divergence.divergence_at(flight, 0, MOON_RADIUS_M) == pytest.approx((du_dx + dv_dy) / 2.0, rel=1e-6)
+    assert divergence.divergence_at(flight, 0) == pytest.approx((du_dx + dv_dy) / 2.0, rel=1e-6)
 
 
 def test_a_boresight_above_the_horizon_has_no_truth():
     camera = Camera(32, 32, 45.0, 0.0)
     state = np.zeros(13)
     state[2], state[7] = -100.0, np.radians(100.0)  # pitched past the horizontal: the boresight sees sky
-    assert np.isnan(divergence.divergence_at(Flight(np.zeros(1), state[None], camera, 10.0), 0, MOON_RADIUS_M))
+    assert np.isnan(divergence.divergence_at(Flight(np.zeros(1), state[None], camera, 10.0), 0))
 
 
 def test_the_scores_are_relative_errors_and_mid_flight_is_its_middle_half():

@@ -26,11 +26,11 @@ def test_the_truth_is_every_scored_pose_and_zero_velocity_scores_its_closed_form
     t, expected = egomotion.truth(f)
     assert len(t) == len(f.t) - 2 and (f.altitude_m[f.scored] >= MIN_ALTITUDE_M).all()
     assert np.allclose(expected[:, :3], VELOCITY) and not expected[:, 3:].any()
-    row = egomotion.score_landing(f, np.zeros((len(t), 3)), expected)
+    row = egomotion.score_landing(f, np.zeros((len(t), 3)), expected, t)
     speed = np.linalg.norm(VELOCITY)
     assert row["elope_error"] == pytest.approx(np.mean(speed / f.altitude_m[f.scored]))
     assert row["velocity_error_m_s"] == pytest.approx(speed) and "rate_rms_error_rad_s" not in row
-    with_rates = egomotion.score_landing(f, np.hstack([expected[:, :3], np.full((len(t), 3), 0.01)]), expected)
+    with_rates = egomotion.score_landing(f, np.hstack([expected[:, :3], np.full((len(t), 3), 0.01)]), expected, t)
     assert with_rates["elope_error"] == 0 and with_rates["rate_rms_error_rad_s"] == pytest.approx(0.01 * np.sqrt(3))
 
 

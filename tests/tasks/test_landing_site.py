@@ -28,5 +28,5 @@ def test_the_site_projects_where_the_pinhole_puts_it():
 def test_the_scores_are_pixel_distances():
     expected = np.zeros((4, 2))
     predicted = np.array([[3.0, 4.0], [0.0, 1.0], [0.0, 2.0], [0.0, 0.0]])
-    row = landing_site.score_landing(None, predicted, expected)
+    row = landing_site.score_landing(None, predicted, expected, np.arange(4.0))
     assert row["median_px"] == 1.5 and row["mean_px"] == 2.0 and row["within_3px"] == 0.75

@@ -64,9 +64,9 @@ def dead_reckoned(landing, flight, t: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(t, streams["t"], v[:, c]) for c in range(3)])
 
 
-def table_predictions(task: str, method: str, landing, flight, progress=lambda line: None) -> np.ndarray:
-    """(n, c) predicted values at the task's scored times of one landing."""
-    t, expected = truth_of(task, landing, flight)
+def table_predictions(task: str, method: str, landing, flight, t: np.ndarray, expected: np.ndarray,
+                      progress=lambda line: None) -> np.ndarray:  # fmt: skip
+    """(n, c) predicted values at the task's scored times t of one landing (truth: expected)."""
     if method == "truth":
         return expected
     if method == "zero":
@@ -132,8 +132,8 @@ def run_baseline(task: str, method: str, output, results="results", split: str |
         if task == "flow":
             fields[landing.scenario, landing.id] = flow_predictions(method, landing, flight, dt_frames, progress)
         else:
-            t, _ = truth_of(task, landing, flight)
-            values = table_predictions(task, method, landing, flight, progress)
+            t, expected = truth_of(task, flight)
+            values = table_predictions(task, method, landing, flight, t, expected, progress)
             rows += [(landing.scenario, landing.id, s, *v) for s, v in zip(t, values)]
         progress(f"{task} {method}: {i + 1} of {len(landings)} landings ({landing.scenario} {landing.id:04d})")
     notes = {"method": method, "run_time_s": f"{time.perf_counter() - start:.3f}", "events_s": f"{events_s:.3f}"}

@@ -29,11 +29,12 @@ COLUMNS = ("divergence_1_s",)
 SCALES = ((COLUMNS, "1/s"),)  # the unit slip checked
 
 
-def divergence_at(flight: Flight, k: int, radius_m: float) -> float:
-    """D (1/s) at pose k over the sphere of radius_m through the site; NaN where the
+def divergence_at(flight: Flight, k: int) -> float:
+    """D (1/s) at pose k over the flight's sphere through the site; NaN where the
     boresight misses it."""
     pose = flight.camera.pose(flight.state[k])
     v, _ = flight.camera.motion(flight.state[k])
+    radius_m = flight.radius_m
     centre = pose.rotation.T @ (np.array([0.0, 0.0, radius_m]) - pose.position)  # camera frame
     _, height = local_vertical(pose.position, pose.rotation, radius_m)
     k_term = height * (2.0 * radius_m + height)  # |C|^2 - R^2, without cancellation
@@ -45,41 +46,35 @@ def divergence_at(flight: Flight, k: int, radius_m: float) -> float:
     return float(v[2] / z0 - (normal[0] * v[0] + normal[1] * v[1]) / (2.0 * normal[2] * z0))
 
 
-def truth(flight: Flight, radius_m: float) -> tuple[np.ndarray, np.ndarray]:
+def truth(flight: Flight) -> tuple[np.ndarray, np.ndarray]:
     """(t (n,) s, D (n, 1) 1/s) at the windows' poses where the boresight sees the sphere."""
     k = flight.every(PERIOD_S)
-    d = np.array([divergence_at(flight, int(i), radius_m) for i in k])
+    d = np.array([divergence_at(flight, int(i)) for i in k])
     seen = np.isfinite(d)
     return flight.t[k[seen]], d[seen, None]
 
 
-def _relative(predicted, expected) -> np.ndarray:
-    return np.abs(predicted[:, 0] - expected[:, 0]) / np.abs(expected[:, 0])
-
-
 def score_landing(flight: Flight, predicted: np.ndarray, expected: np.ndarray, t: np.ndarray) -> dict:
     """The landing's row: the median relative error and the share within 10 %, over every
-    window and mid-flight, and the mean absolute error (1/s)."""
-    rel = _relative(predicted, expected)
-    mid = (t >= MID_FLIGHT[0] * flight.t[-1]) & (t <= MID_FLIGHT[1] * flight.t[-1])
+    window and mid-flight, and the mean absolute error (1/s); `_per_time`: the relative
+    error at each window's time t."""
+    pooled = {"_rel": np.abs(predicted[:, 0] - expected[:, 0]) / np.abs(expected[:, 0]),
+              "_mid": (t >= MID_FLIGHT[0] * flight.t[-1]) & (t <= MID_FLIGHT[1] * flight.t[-1]),
+              "_abs": np.abs(predicted[:, 0] - expected[:, 0])}  # fmt: skip
+    return _row(*pooled.values()) | pooled | {"_per_time": pooled["_rel"]}
+
+
+def _row(rel: np.ndarray, mid: np.ndarray, absolute: np.ndarray) -> dict:
+    """The scores of relative errors `rel` (the windows `mid` mid-flight) and absolute ones (1/s)."""
     return {
         "n": len(rel), "median_relative_error": float(np.median(rel)), "within_10pct": float(np.mean(rel <= 0.1)),
         "mid_n": int(mid.sum()),
         "mid_median_relative_error": float(np.median(rel[mid])) if mid.any() else float("nan"),
         "mid_within_10pct": float(np.mean(rel[mid] <= 0.1)) if mid.any() else float("nan"),
-        "mean_absolute_error_1_s": float(np.mean(np.abs(predicted[:, 0] - expected[:, 0]))),
-        "_rel": rel, "_mid": mid,
+        "mean_absolute_error_1_s": float(np.mean(absolute)),
     }  # fmt: skip
 
 
 def combine(rows: list[dict]) -> dict:
     """Over every window of every landing (pooled)."""
-    rel, mid = np.concatenate([r["_rel"] for r in rows]), np.concatenate([r["_mid"] for r in rows])
-    n = np.array([r["n"] for r in rows])
-    return {
-        "n": int(n.sum()), "median_relative_error": float(np.median(rel)), "within_10pct": float(np.mean(rel <= 0.1)),
-        "mid_n": int(mid.sum()),
-        "mid_median_relative_error": float(np.median(rel[mid])) if mid.any() else float("nan"),
-        "mid_within_10pct": float(np.mean(rel[mid] <= 0.1)) if mid.any() else float("nan"),
-        "mean_absolute_error_1_s": float(np.average([r["mean_absolute_error_1_s"] for r in rows], weights=n)),
-    }  # fmt: skip
+    return _row(*(np.concatenate([r[key] for r in rows]) for key in ("_rel", "_mid", "_abs")))

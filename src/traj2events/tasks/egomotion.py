@@ -31,18 +31,24 @@ def truth(flight: Flight) -> tuple[np.ndarray, np.ndarray]:
     return flight.t[k], np.hstack([flight.state[k][:, VELOCITY], flight.state[k][:, BODY_RATES]])
 
 
+def elope_terms(v_est: np.ndarray, v_gt: np.ndarray, altitude_m: np.ndarray) -> np.ndarray:
+    """Each timestamp's |v_est - v_gt| / z_gt (1/s; v (n, 3) m/s, z (n,) m)."""
+    return np.linalg.norm(v_est - v_gt, axis=1) / altitude_m
+
+
 def elope_error(v_est: np.ndarray, v_gt: np.ndarray, altitude_m: np.ndarray) -> float:
-    """E(i): the mean over timestamps of |v_est - v_gt| / z_gt (v (n, 3) m/s, z (n,) m)."""
-    return float(np.mean(np.linalg.norm(v_est - v_gt, axis=1) / altitude_m))
+    """E(i): the mean over timestamps of |v_est - v_gt| / z_gt."""
+    return float(np.mean(elope_terms(v_est, v_gt, altitude_m)))
 
 
-def score_landing(flight: Flight, predicted: np.ndarray, expected: np.ndarray) -> dict:
+def score_landing(flight: Flight, predicted: np.ndarray, expected: np.ndarray, t: np.ndarray) -> dict:
     """The landing's row: ELOPE's E, the mean velocity error (m/s) and, with body rates
-    (predicted has 6 columns), their RMS error (rad/s)."""
-    altitude = flight.altitude_m[flight.scored]
+    (predicted has 6 columns), their RMS error (rad/s); `_per_time`: E's terms at t."""
+    terms = elope_terms(predicted[:, :3], expected[:, :3], flight.altitude_m[flight.scored])
     row = {
         "n": len(expected),
-        "elope_error": elope_error(predicted[:, :3], expected[:, :3], altitude),
+        "elope_error": float(np.mean(terms)),
+        "_per_time": terms,
         "velocity_error_m_s": float(np.mean(np.linalg.norm(predicted[:, :3] - expected[:, :3], axis=1))),
     }
     if predicted.shape[1] == 6:

@@ -41,9 +41,10 @@ def truth(flight: Flight) -> tuple[np.ndarray, np.ndarray]:
     return flight.t[k], pixels[k]
 
 
-def score_landing(flight: Flight, predicted: np.ndarray, expected: np.ndarray) -> dict:
+def score_landing(flight: Flight, predicted: np.ndarray, expected: np.ndarray, t: np.ndarray) -> dict:
+    """The landing's row; `_per_time`: the pixel distance at each time t."""
     error = np.linalg.norm(predicted - expected, axis=1)
-    return _row(error) | {"_error": error}
+    return _row(error) | {"_per_time": error}
 
 
 def _row(error: np.ndarray) -> dict:
@@ -52,4 +53,4 @@ def _row(error: np.ndarray) -> dict:
 
 
 def combine(rows: list[dict]) -> dict:
-    return _row(np.concatenate([r["_error"] for r in rows]))
+    return _row(np.concatenate([r["_per_time"] for r in rows]))

@@ -17,6 +17,7 @@ from ..data import Landing
 from ..formats.trajectory import read_trajectory
 from ..geometry.camera import Camera
 from ..geometry.distortion import COEFFICIENTS, Distortion
+from ..geometry.motion_field import MOON_RADIUS_M
 from ..trajectory.state import POSITION
 
 MIN_ALTITUDE_M = 10.0  # the trajectory point's height above the site (-z) below which no pose is scored
@@ -26,12 +27,13 @@ TIME_TOLERANCE_S = 1e-6  # a prediction's t_s matches a pose's time within this
 @dataclass(frozen=True)
 class Flight:
     """One landing's poses: t (K,) s, state (K, 13) (docs/dataset.md "trajectory.h5"), its
-    camera, and t_f (s)."""
+    camera, its frame rate (Hz) and the sphere through its site (radius, m)."""
 
     t: np.ndarray
     state: np.ndarray
     camera: Camera
     fps: float
+    radius_m: float = MOON_RADIUS_M
 
     @property
     def altitude_m(self) -> np.ndarray:
@@ -50,15 +52,16 @@ class Flight:
         return k[self.scored[k]]
 
 
-def camera_of(landing: Landing) -> Camera:
+def camera_of(landing: Landing, attrs: dict) -> Camera:
     """The landing's camera from its files' attributes (width, height, fov, mount, lens)."""
-    attrs = landing._scene_attrs()
     lens = Distortion(**dict(zip(COEFFICIENTS, (float(c) for c in landing.distortion_coefficients))))
     return Camera(int(attrs["width"]), int(attrs["height"]), float(attrs["fov_deg"]),
                   float(attrs["camera_mount_height_m"]), lens)  # fmt: skip
 
 
 def flight_of(landing: Landing) -> Flight:
-    """The landing's Flight: its poses, camera and frame rate (trajectory.h5's `fps`)."""
-    trajectory = read_trajectory(landing.folder / "trajectory.h5")
-    return Flight(trajectory.t, trajectory.state, camera_of(landing), float(trajectory.attrs["fps"]))
+    """The landing's Flight: its poses, frame rate (trajectory.h5's `fps`), camera and sphere
+    (events.h5's, or frames.h5's, attributes)."""
+    trajectory, attrs = read_trajectory(landing.folder / "trajectory.h5"), landing._scene_attrs()
+    return Flight(trajectory.t, trajectory.state, camera_of(landing, attrs), float(trajectory.attrs["fps"]),
+                  float(attrs["moon_radius_m"]))  # fmt: skip

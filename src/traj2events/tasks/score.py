@@ -36,21 +36,9 @@ def selection(split: str | None, scenario: str | None) -> str:
     return " ".join(filter(None, (split, scenario))) or "all"
 
 
-def truth_of(task: str, landing, flight) -> tuple[np.ndarray, np.ndarray]:
+def truth_of(task: str, flight) -> tuple[np.ndarray, np.ndarray]:
     """A table task's (t (n,) s, truth (n, c)) for one landing."""
-    if task == "divergence":
-        return divergence.truth(flight, float(landing._scene_attrs()["moon_radius_m"]))
     return TABLE_TASKS[task].truth(flight)
-
-
-def _curve(task: str, flight, t: np.ndarray, predicted: np.ndarray, expected: np.ndarray) -> np.ndarray:
-    """Each scored time's error, as the figure shows it."""
-    if task == "divergence":
-        return np.abs(predicted[:, 0] - expected[:, 0]) / np.abs(expected[:, 0])
-    if task == "egomotion":
-        altitude = np.interp(t, flight.t, flight.altitude_m)
-        return np.linalg.norm(predicted[:, :3] - expected[:, :3], axis=1) / altitude
-    return np.linalg.norm(predicted - expected, axis=1)
 
 
 def score_table_task(task: str, predictions, landings: list) -> tuple[list[dict], dict, dict]:
@@ -66,7 +54,7 @@ def score_table_task(task: str, predictions, landings: list) -> tuple[list[dict]
     matched = []
     for landing in landings:
         key = (landing.scenario, landing.id)
-        t_expected, expected = truth_of(task, landing, flights[key])
+        t_expected, expected = truth_of(task, flights[key])
         rows = match_times(predictions, key, *table[key][:1], t_expected)
         matched.append((landing, t_expected, table[key][1][rows], expected[:, : len(module.COLUMNS) + len(given)]))
     columns = module.COLUMNS + given
@@ -79,11 +67,8 @@ def score_table_task(task: str, predictions, landings: list) -> tuple[list[dict]
     rows = []
     for landing, t, predicted, expected in matched:
         flight = flights[landing.scenario, landing.id]
-        if task == "divergence":
-            row = module.score_landing(flight, predicted, expected, t)
-        else:
-            row = module.score_landing(flight, predicted, expected)
-        row["_curve"] = (t / flight.t[-1], _curve(task, flight, t, predicted, expected))
+        row = module.score_landing(flight, predicted, expected, t)
+        row["_curve"] = (t / flight.t[-1], row["_per_time"])
         rows.append({"scenario": landing.scenario, "id": landing.id} | row)
     return rows, module.combine(rows), notes
 
