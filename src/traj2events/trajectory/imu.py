@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry.motion_field import height_above_sphere
 from .dynamics import Dynamics
 from .state import ATTITUDE, BODY_RATES, POSITION, VELOCITY, rotation_body_to_inertial
 
@@ -50,8 +51,6 @@ def angular_rate_body(states: np.ndarray) -> np.ndarray:
 def altitude_above_sphere(states: np.ndarray, radius_m: float) -> np.ndarray:
     """(n,) height above the sphere through the site (centre at (0, 0, R), z down), m,
     without cancellation (`geometry.motion_field.height_above_sphere`)."""
-    from ..geometry.motion_field import height_above_sphere
-
     return height_above_sphere(np.asarray(states)[:, POSITION], radius_m)
 
 
