@@ -2,8 +2,11 @@
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
-from traj2events.geometry.camera import Camera, camera_motion, camera_pose, opengl_camera_to_world
+from traj2events.geometry.camera import Camera, CameraPose, camera_motion, camera_pose, opengl_camera_to_world
+from traj2events.trajectory.state import rotation_matrix
 
 
 def test_focal_length_and_pixel_centres():
@@ -106,3 +109,49 @@ def test_a_mounted_camera_stays_above_the_ground_at_touchdown_and_moves_with_the
     assert cam.intrinsics_attrs()["camera_mount_height_m"] == 3.0
     with pytest.raises(ValueError, match="mount_height_m"):
         Camera(32, 32, 45.0, mount_height_m=-1.0)
+
+
+EPS = np.finfo(float).eps
+COORDINATE = st.floats(-2e5, 2e5)  # m: 200 km out
+
+
+@given(st.integers(1, 8192), st.floats(0.5, 179.5), COORDINATE, COORDINATE, st.floats(1e-3, 2e5))
+def test_focal_length_projection_and_back_projection_are_within_their_bounds_of_50_digits(width, fov, x, y, z):
+    """Their stated bounds (docs/accuracy.md): the focal length within (3 + kappa_tan) eps
+    relative, kappa_tan = 2 u / sin(2 u) the tangent's condition at u = fov / 2 (fov -> 180
+    deg); a point's pixel (x_s = f X / Z) within 2 eps relative; a pixel's ray (x_s / f)
+    within 1 eps, for 1..8192 px, fov 0.5..179.5 deg, points to 200 km out and 1 mm..200 km deep."""
+    import mpmath as mp
+
+    cam = Camera(width, width, fov)
+    pixel = cam.project(np.array([x, y, z]))
+    ray = cam.back_project(pixel[0], pixel[1])
+    with mp.workdps(50):
+        half = mp.radians(mp.mpf(fov)) / 2
+        focal = width / (2 * mp.tan(half))
+        kappa = 2 * half / mp.sin(2 * half)
+        assert float(abs(cam.focal_px - focal) / focal) <= (3 + float(kappa)) * EPS
+        f = mp.mpf(cam.focal_px)  # the camera's own float focal length from here on
+        for got, coordinate in zip(pixel, (x, y)):
+            want = f * mp.mpf(coordinate) / mp.mpf(z)
+            assert float(abs(got - want)) <= 2 * EPS * float(abs(want))
+        for got, coordinate in zip(ray[:2], pixel):
+            want = mp.mpf(float(coordinate)) / f
+            assert float(abs(got - want)) <= EPS * float(abs(want))
+
+
+@given(*[st.floats(-np.pi, np.pi)] * 3, *[COORDINATE] * 3, COORDINATE, COORDINATE, st.floats(-1e5, 0.0))
+def test_a_points_camera_coordinates_are_within_4_eps_of_50_digits(phi, theta, psi, px, py, pz, cx, cy, cz):
+    """Its stated bound (docs/accuracy.md): R^T (p - c) within 4 eps sum_j |R_ji| |p_j - c_j|
+    of the same float R and points at 50 digits, for points 200 km out and cameras to 100 km up."""
+    import mpmath as mp
+
+    rotation = rotation_matrix(phi, theta, psi)
+    point, position = np.array([px, py, pz]), np.array([cx, cy, cz])
+    got = CameraPose(position, rotation).to_camera(point)
+    with mp.workdps(50):
+        d = [mp.mpf(p) - mp.mpf(c) for p, c in zip(point, position)]
+        for i in range(3):
+            want = sum(mp.mpf(rotation[j, i]) * d[j] for j in range(3))
+            scale = sum(abs(mp.mpf(rotation[j, i]) * d[j]) for j in range(3))
+            assert float(abs(got[i] - want)) <= 4 * EPS * float(scale)

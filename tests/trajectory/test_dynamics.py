@@ -1,8 +1,20 @@
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from traj2events.trajectory.dynamics import Dynamics, Vehicle, rotation_matrix, split_control_dynamics
+from traj2events.trajectory.dynamics import (
+    STATE_NAMES,
+    Dynamics,
+    Vehicle,
+    rotation_matrix,
+    split_control_dynamics,
+)
+from trajectory.test_state import exact_rotation
+
+DYNAMICS = Dynamics(Vehicle())
+EPS = np.finfo(float).eps
 
 
 def rest_state(mass=8000.0, angles=(0.0, 0.0, 0.0), rates=(0.0, 0.0, 0.0)):
@@ -92,3 +104,57 @@ def test_batch_evaluation_matches_single(dynamics):
 def test_vehicle_rejects_dry_mass_above_wet_mass():
     with pytest.raises(ValueError, match="dry_mass_kg"):
         Vehicle(mass_kg=5000.0, dry_mass_kg=6000.0)
+
+
+RATE = st.floats(-1.0, 1.0)  # rad/s
+COUPLE = st.floats(-1.0, 1.0)
+
+
+def exact_derivative(vehicle: Vehicle, x: np.ndarray, u: np.ndarray) -> tuple[list, list]:
+    """The lander's f(x, u) of the same float inputs at the caller's mpmath precision, and
+    each component's size: its terms' absolute values summed (the rounding bound's scale)."""
+    import mpmath as mp
+
+    phi, theta = mp.mpf(float(x[6])), mp.mpf(float(x[7]))
+    p, q, r = (mp.mpf(float(v)) for v in x[9:12])
+    m, g = mp.mpf(float(x[12])), mp.mpf(vehicle.g_m_s2)
+    push = mp.mpf(vehicle.thrust_main_N) * mp.mpf(float(u[0])) / m
+    column = [row[2] for row in exact_rotation(x[6], x[7], x[8])]  # body +z in the inertial frame
+    accel = [push * -c for c in column]
+    accel[2] += g
+    tilt = q * mp.sin(phi) + r * mp.cos(phi)
+    euler = [p + tilt * mp.tan(theta), q * mp.cos(phi) - r * mp.sin(phi), tilt / mp.cos(theta)]
+    inertia = [mp.mpf(v) for v in vehicle.inertia_kgm2]
+    w = [p, q, r]
+    couple = [2 * mp.mpf(vehicle.lever_arm_m) * mp.mpf(vehicle.thrust_rcs_N) * mp.mpf(float(c)) for c in u[1:4]]
+    j, k = (1, 2, 0), (2, 0, 1)  # the other two axes of each
+    gyro = [w[j[i]] * inertia[k[i]] * w[k[i]] - w[k[i]] * inertia[j[i]] * w[j[i]] for i in range(3)]
+    omega_dot = [(couple[i] - gyro[i]) / inertia[i] for i in range(3)]
+    exhaust = mp.mpf(vehicle.isp_s) * mp.mpf(vehicle.g0_m_s2)
+    burn = mp.mpf(vehicle.thrust_main_N) * mp.mpf(float(u[0])) + 2 * mp.mpf(vehicle.thrust_rcs_N) * sum(
+        abs(mp.mpf(float(c))) for c in u[1:4])  # fmt: skip
+    value = [mp.mpf(float(v)) for v in x[3:6]] + accel + euler + omega_dot + [-burn / exhaust]
+    turn = abs(p) + (abs(q) + abs(r)) / mp.cos(theta)
+    size = ([mp.mpf(0)] * 3 + [push + g * (i == 2) for i in range(3)] + [turn] * 3
+            + [(abs(couple[i]) + (inertia[j[i]] + inertia[k[i]]) * abs(w[j[i]] * w[k[i]])) / inertia[i]
+               for i in range(3)] + [burn / exhaust])  # fmt: skip
+    return value, size
+
+
+@given(st.floats(-1e4, 1e4), st.floats(-np.pi / 2 + 1e-3, np.pi / 2 - 1e-3), st.floats(-np.pi, np.pi),
+       st.floats(-np.pi, np.pi), RATE, RATE, RATE, st.floats(0.0, 1.0), COUPLE, COUPLE, COUPLE,
+       st.floats(6000.0, 9472.06))  # fmt: skip
+def test_the_landers_derivative_is_within_4_eps_of_50_digits(v, theta, phi, psi, p, q, r, throttle, u1, u2, u3, m):
+    """Its stated bound (docs/accuracy.md): every component of f(x, u) within 4 eps of its
+    terms' absolute values summed, against the same equations at 50 digits, over every
+    attitude with pitch inside +-90 deg, rates to 1 rad/s, any command and mass."""
+    import mpmath as mp
+
+    vehicle = DYNAMICS.vehicle
+    x = np.array([0.0, 0.0, -100.0, v, -0.5 * v, 0.25 * v, phi, theta, psi, p, q, r, m])
+    u = np.array([throttle, u1, u2, u3])
+    xdot = DYNAMICS(x, u)
+    with mp.workdps(50):
+        value, size = exact_derivative(vehicle, x, u)
+        for i in range(13):
+            assert float(abs(mp.mpf(float(xdot[i])) - value[i])) <= 4 * EPS * float(size[i]), STATE_NAMES[i]

@@ -68,6 +68,8 @@ class Camera:
 
     @property
     def focal_px(self) -> float:
+        """f = W / (2 tan(fov / 2)) px: within (3 + 2u / sin 2u) eps relative, u = fov / 2,
+        the tangent's condition toward 180 deg (docs/accuracy.md)."""
         return self.width / (2.0 * np.tan(np.radians(self.fov_deg) / 2.0))
 
     @property
@@ -98,7 +100,8 @@ class Camera:
 
     def project(self, points_cam: np.ndarray) -> np.ndarray:
         """Camera-frame points (..., 3) -> centred pixel coordinates (..., 2) (x_s, y_s),
-        through the lens's distortion."""
+        through the lens's distortion. The pinhole's x_s = f X / Z within 2 eps relative
+        (docs/accuracy.md; the lens's inverse has its own bound)."""
         p = np.asarray(points_cam, dtype=float)
         if self.distortion.is_pinhole:
             return self.focal_px * p[..., :2] / p[..., 2:3]
@@ -107,7 +110,7 @@ class Camera:
 
     def back_project(self, x_s: np.ndarray, y_s: np.ndarray) -> np.ndarray:
         """Centred pixel coordinates -> rays (..., 3) = (a, b, 1): a = x_s / f, b = y_s / f
-        undistorted (NaN where the lens's model does not reach)."""
+        undistorted (NaN where the lens's model does not reach); the pinhole's within 1 eps."""
         x_s, y_s = np.broadcast_arrays(np.asarray(x_s, dtype=float), np.asarray(y_s, dtype=float))
         a, b = x_s / self.focal_px, y_s / self.focal_px
         if not self.distortion.is_pinhole:
@@ -207,7 +210,8 @@ class CameraPose:
     rotation: np.ndarray
 
     def to_camera(self, points_inertial: np.ndarray) -> np.ndarray:
-        """Inertial points (..., 3) -> camera frame."""
+        """Inertial points (..., 3) -> camera frame: R^T (p - c), each component within
+        4 eps sum_j |R_ji| |p_j - c_j| (docs/accuracy.md)."""
         return (np.asarray(points_inertial) - self.position) @ self.rotation
 
 

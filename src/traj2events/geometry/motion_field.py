@@ -78,7 +78,8 @@ def _sphere_terms(a, b, normal, height_m, radius_m):
 
 def inverse_depth_plane(a: np.ndarray, b: np.ndarray, normal: np.ndarray, height_m: float) -> np.ndarray:
     """h = A / H on the plane H below the camera along `normal`; 0 where the ray misses it
-    (everywhere when H <= 0)."""
+    (everywhere when H <= 0). Bound (docs/accuracy.md): relative error at most 3 eps kappa,
+    kappa = (|alpha a| + |beta b| + |gamma|) / A the dot's condition, any H > 0."""
     dtype = np.result_type(a, b)
     if not height_m > 0:
         return np.zeros(np.broadcast_shapes(np.shape(a), np.shape(b)), dtype.type)
@@ -144,7 +145,11 @@ def flow_law(x_s, y_s, f, h, vx, vy, vz, p, q, r):
     """The field (u, v) px/s of the formula above at centred pixel (x_s, y_s), inverse depth
     h, camera velocity (vx, vy, vz) and body rates (p, q, r): numbers, or arrays that
     broadcast. Written once: `motion_field` calls it on arrays, the compiled pass
-    (`motion_pass`) per pixel, the same operations in the same order."""
+    (`motion_pass`) per pixel, the same operations in the same order.
+
+    Bound (docs/accuracy.md): each component within 4 eps of its terms' absolute values
+    summed (|h x_s vz| + |h f vx| + ... px/s): the translation and rotation parts cancel
+    where the field stops (the focus of expansion), so the error is absolute there."""
     xy_over_f = x_s * (y_s / f)
     u = h * (x_s * vz - f * vx) + (p * xy_over_f + ((-(f + x_s * x_s / f) * q) + y_s * r))
     v = h * (y_s * vz - f * vy) + ((-q) * xy_over_f + (((f + y_s * y_s / f) * p) - x_s * r))

@@ -114,7 +114,13 @@ class Dynamics:
         return self._f
 
     def __call__(self, state: np.ndarray, control: np.ndarray) -> np.ndarray:
-        """dx/dt for one state (13,) and control (4,), or batches (n, 13), (n, 4)."""
+        """dx/dt for one state (13,) and control (4,), or batches (n, 13), (n, 4).
+
+        Domain: pitch inside +-90 deg (the Euler rates grow as 1 / cos(theta)), any roll,
+        yaw, velocity, rates, command and mass. Bound: each component within 4 eps of its
+        terms' absolute values summed (g + T uT / m for the acceleration, the gyroscopic
+        products' for the rates: hovering cancels, so the error is absolute there),
+        docs/accuracy.md."""
         state = np.asarray(state, dtype=float)
         control = np.asarray(control, dtype=float)
         if state.ndim == 1:

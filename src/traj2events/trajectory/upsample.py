@@ -59,7 +59,8 @@ class ReintegratedStates:
     (controls linear within one, so no step crosses a kink), kept with its dense output,
     so a state at any time (a frame's pose, an adaptive frame's) comes from the same
     integration. `states(t)` for sorted or unsorted t within the node span: (len(t), 13);
-    `final_state` at the last node."""
+    `final_state` at the last node. Bound, checked for constant commands over 5..120 s
+    against the closed-form burn (docs/accuracy.md): every state within 4 ATOL of it."""
 
     def __init__(
         self,
