@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from numba import njit
 from scipy import stats
 
@@ -71,3 +73,37 @@ def _gaps(key, n, rate_hz):
 def test_gaps_are_exponential_with_the_rate():
     gaps = _gaps(unit_key(interval_key(1, 1, 1), 0), 20_000, 50.0)
     assert stats.kstest(gaps, "expon", args=(0, 1 / 50.0)).pvalue > 1e-3
+
+
+def first_uniform_key(k: int) -> np.uint64:
+    """A key whose first uniform is k 2^-53 (k = 1..2^53): `unit_open` of it."""
+    return np.uint64((k - 1) << 11)
+
+
+def zero_count_share(rate_hz: float, dt: float) -> float:
+    """The code's own P(N = 0), exactly: the share of the 2^53 first uniforms that give no
+    event (N = 0 for every uniform up to a threshold: smaller uniforms, longer gaps)."""
+    if poisson_arrivals(first_uniform_key(1), rate_hz, dt) != 0:
+        return 0.0
+    lo, hi = 1, 2**53  # N = 0 at lo; above hi none
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        lo, hi = (mid, hi) if poisson_arrivals(first_uniform_key(mid), rate_hz, dt) == 0 else (lo, mid - 1)
+    return lo / 2**53
+
+
+@given(st.floats(1e-6, 1e9), st.floats(1e-9, 10.0))
+def test_the_share_of_pixels_without_an_event_is_within_its_bound_of_exp_minus_rate_dt(rate_hz, dt):
+    """Its stated bound (docs/accuracy.md): the draws' P(N = 0) within 2^-52 + 4 eps
+    lambda exp(-lambda) of Poisson's exp(-lambda), lambda = rate dt (50 digits), for rates
+    1e-6..1e9 Hz and intervals 1 ns..10 s: the uniform's 53-bit grid, and the gap's rounding
+    at the threshold."""
+    import mpmath as mp
+    from hypothesis import assume
+
+    assume(rate_hz * dt <= 50.0)  # beyond, exp(-lambda) < 2e-22 and each draw walks ~lambda gaps
+    with mp.workdps(50):
+        lam = mp.mpf(rate_hz) * mp.mpf(dt)
+        exact = mp.exp(-lam)
+        bound = 2.0**-52 + 4 * np.finfo(float).eps * float(lam * exact)
+        assert float(abs(zero_count_share(rate_hz, dt) - exact)) <= bound

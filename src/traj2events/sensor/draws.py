@@ -69,7 +69,11 @@ def poisson_arrivals(key, rate_hz, dt):
     """How many events a Poisson process of rate_hz gives within dt (seconds), the gaps
     between them drawn from a unit's draws 0, 1, ... (`arrival_gap_s`); the emitter walks
     the same gaps to time them. The first gap reaches past dt whenever u <= 1 - rate dt
-    (as -ln u >= 1 - u): the common case then costs one draw and no log."""
+    (as -ln u >= 1 - u): the common case then costs one draw and no log.
+
+    Bound (docs/accuracy.md): P(N = 0) within 2^-52 + 4 eps lambda exp(-lambda) of
+    exp(-lambda), lambda = rate dt: the uniform's 53-bit grid, and the gap's rounding at
+    the threshold (its shortcut's, for lambda near 1e-8)."""
     if not rate_hz > 0.0:
         return 0
     if unit_open(key) <= 1.0 - rate_hz * dt:

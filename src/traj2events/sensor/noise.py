@@ -44,7 +44,8 @@ def kept(coin, majorant, intensity_dn, theta_on, theta_off, theta_nominal):
     """Is a candidate kept on its pixel, with probability g(I) w / majorant, w = theta_nom /
     theta(x) (theta(x) the mean of the pixel's two thresholds)? The block's candidates come
     at R_shot majorant per pixel, so the kept ones at `laws.shot_noise_rate_hz`. Written
-    without divisions."""
+    without divisions. Its probability is within 2^-26 + 4 eps of g(I) w / majorant (the
+    coin's 26 bits, docs/accuracy.md)."""
     return coin * majorant * (0.5 * (theta_on + theta_off)) < shot_noise_gain_scalar(intensity_dn) * theta_nominal
 
 
@@ -59,7 +60,9 @@ def candidate(block_key, j, s, mean_gap_s):
     """The block's j-th candidate after the one at time s (from the interval's start; 0
     before the first): (its time, its pixel's offset in the block, its coin in [0, 1),
     ON?), from one draw: the exponential gap (high 32 bits), the pixel (the next 5), the
-    coin (the next 26) and the polarity (bit 0)."""
+    coin (the next 26) and the polarity (bit 0). Bound (docs/accuracy.md): P(gap < dt)
+    within 2^-31 + 4 eps of 1 - exp(-dt / mean gap); no gap beyond 22.2 mean gaps (the
+    32-bit grid: a tail of 2^-32 is lost)."""
     bits = draw_bits(block_key, j)
     u = np.float64((bits >> _SHIFT32) + np.uint64(1)) * 2.3283064365386963e-10  # (0, 1], 2^-32 steps
     offset = np.int64((bits >> np.uint64(27)) & np.uint64(NOISE_BLOCK - 1))

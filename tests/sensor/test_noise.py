@@ -1,0 +1,71 @@
+"""Shot noise's draws (sensor/noise.py): the candidates' exponential gaps and the thinning
+coin, each on its bit grid, against the law's exact probabilities at 50 digits. The noise's
+rates, counts and order over whole frames are tested with the emulator
+(tests/sensor/test_emulator.py)."""
+
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+
+from traj2events.sensor.laws import shot_noise_gain_scalar
+from traj2events.sensor.noise import candidate, kept
+
+
+def first_gap_share(mean_gap_s: float, dt: float) -> float:
+    """The code's own P(first candidate's gap < dt), exactly: the share of the 2^32 values
+    of the gap's uniform (k 2^-32, the draw's high 32 bits k - 1) that land it within dt
+    (larger uniforms, shorter gaps)."""
+
+    def within(k: int) -> bool:
+        return candidate(np.uint64((k - 1) << 32), 0, 0.0, mean_gap_s)[0] < dt
+
+    if not within(2**32):
+        return 0.0
+    lo, hi = 1, 2**32  # the smallest k within dt lies in [lo, hi]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if within(mid) else (mid + 1, hi)
+    return (2**32 - lo + 1) / 2**32
+
+
+@given(st.floats(1e-9, 10.0), st.floats(1e-3, 100.0))
+def test_the_candidates_gap_is_within_its_bound_of_the_exponential(mean_gap_s, x):
+    """Its stated bound (docs/accuracy.md): P(gap < dt) within 2^-31 + 4 eps x exp(-x) of
+    1 - exp(-x), x = dt / mean gap (50 digits), for mean gaps 1 ns..10 s and x 1e-3..100:
+    the uniform's 32-bit grid (no gap beyond 22.2 mean gaps: a tail of 2^-32 lost)."""
+    import mpmath as mp
+
+    dt = x * mean_gap_s
+    with mp.workdps(50):
+        ratio = mp.mpf(dt) / mp.mpf(mean_gap_s)
+        exact = 1 - mp.exp(-ratio)
+        bound = 2.0**-31 + 4 * np.finfo(float).eps * float(ratio * mp.exp(-ratio))
+        assert float(abs(first_gap_share(mean_gap_s, dt) - exact)) <= bound
+
+
+def kept_share(majorant, intensity_dn, theta_on, theta_off, theta_nominal) -> float:
+    """The code's own P(kept), exactly: the share of the coin's 2^26 values (c 2^-26) that
+    keep a candidate (smaller coins keep)."""
+    lo, hi = 0, 2**26  # the first coin not kept lies in [lo, hi] (hi: every coin keeps)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if kept(mid * 2.0**-26, majorant, intensity_dn, theta_on, theta_off, theta_nominal):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo / 2**26
+
+
+@given(st.floats(0.0, 400.0), st.floats(0.05, 1.0), st.floats(0.05, 1.0), st.floats(0.05, 1.0), st.floats(1.0, 20.0))
+def test_the_thinning_keeps_with_its_probability_within_its_bound(intensity_dn, on, off, nominal, spread):
+    """Its stated bound (docs/accuracy.md): P(kept) within 2^-26 + 4 eps of g(I) w / majorant
+    (50 digits, g the code's gain), w = theta_nom / theta(x), for intensities 0..400 DN,
+    thresholds 0.05..1 and majorants 1..20 times the pixel's own g(0) w: the coin's 26 bits."""
+    import mpmath as mp
+
+    weight = mp.mpf(nominal) / ((mp.mpf(on) + mp.mpf(off)) / 2)
+    majorant = float(shot_noise_gain_scalar(0.0) * nominal / (0.5 * (on + off))) * spread
+    with mp.workdps(50):
+        exact = mp.mpf(shot_noise_gain_scalar(intensity_dn)) * weight / mp.mpf(majorant)
+        got = kept_share(majorant, intensity_dn, on, off, nominal)
+        assert float(abs(got - exact)) <= 2.0**-26 + 4 * np.finfo(float).eps
