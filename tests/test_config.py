@@ -407,9 +407,9 @@ POSES = (st.floats(0.5, 4), st.tuples(*[st.floats(-89, 89)] * 3), st.floats(-3, 
 def test_no_camera_the_check_accepts_gives_the_motion_field_a_nan(w, h, fov, mount, k, radius, log_alt, att, log_dt):
     """Issue 71: configs drawn across the camera's and the sphere's bounds; for each the
     config check accepts, the motion field's law at a pose 3 m to 10 km up gives a finite
-    flow and displacement at every pixel. A lens that folds over between the pixel centres
-    (coefficients near 1; the check tests the image's border) is refused by the stage,
-    with its key, instead (docs/accuracy.md)."""
+    flow and displacement at every pixel, and no lens the check accepts is refused by the
+    stage (a fold between the pixel centres, from tangential terms near 1, passed the
+    border's check before the check computed the centres' rays: docs/accuracy.md)."""
     from traj2events.geometry.camera import Camera
     from traj2events.geometry.motion_field import sphere_motion
 
@@ -430,9 +430,16 @@ def test_no_camera_the_check_accepts_gives_the_motion_field_a_nan(w, h, fov, mou
     later = state.copy()
     later[:3] += state[3:6] * 10**log_dt
     later[6:9] += state[9:12] * 10**log_dt
-    try:
-        flow, displacement, _ = sphere_motion(Camera.from_settings(config["camera"]), state, later, radius)
-    except ValueError as exc:
-        assert str(exc).startswith("camera.distortion:") and "folds over" in str(exc)
-        return
+    flow, displacement, _ = sphere_motion(Camera.from_settings(config["camera"]), state, later, radius)
     assert np.isfinite(flow).all() and np.isfinite(displacement).all()
+
+
+def test_a_lens_folding_between_the_pixel_centres_is_refused_before_any_job():
+    """The property search's counterexample (issue 71): a tangential lens whose border maps
+    one to one but whose middle pixel has no ray passed the check and failed the motion-field
+    stage; the check now computes the centres' rays and names the key and the pixel."""
+    lens = {"k1": 0.0, "k2": 0.0, "p1": 0.0, "p2": 1.0, "k3": 1.0}
+    camera = {"width": 3, "height": 1, "fov_deg": 108.0, "distortion": lens}
+    with pytest.raises(ConfigError, match=r"camera\.distortion.*folds over inside the 3 x 1 image: pixel \(\d, 0\)"):
+        resolve_config({"camera": camera, "scenarios": {"descent": {}}})
+    resolve_config({"camera": {**camera, "distortion": {**lens, "p2": 0.01, "k3": 0.0}}, "scenarios": {"descent": {}}})

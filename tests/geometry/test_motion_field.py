@@ -622,7 +622,7 @@ RAY = st.floats(-2, 2, allow_subnormal=False)  # a pixel's ray: a = x_s / f, nev
 def test_the_planes_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h, nx, ny, nz, a, b, dtype):
     """Its stated bound (docs/accuracy.md): relative error <= 3 eps kappa, kappa the dot's
     condition (|alpha a| + |beta b| + |gamma|) / A, from 1 mm to 200 km up, any normal, rays
-    of normal floats."""
+    of normal floats, results above the gradual underflow's range."""
     import mpmath as mp
     from hypothesis import assume
 
@@ -641,6 +641,8 @@ def test_the_planes_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h,
             assert got == 0.0
             return
         reference = dot / mp.mpf(float(dtype(h)))
+        if reference < np.finfo(dtype).tiny / eps:
+            return  # gradual underflow (a ray 1e-300 from the horizon): no relative bound there
         assert float(abs(got - reference) / reference) <= 3 * eps * float(magnitude / dot)
 
 

@@ -3,6 +3,8 @@ of the motion field and its picture."""
 
 from __future__ import annotations
 
+import numpy as np
+
 from . import pick
 from .declare import section, setting
 
@@ -49,7 +51,8 @@ MAX_DRAWN_PX = 16384
 
 def lens_problems(camera: dict, supersample: int) -> list[str]:
     """What the camera's keys must satisfy together, as config errors: a distortion whose
-    model folds over inside the image, or needs a pinhole image more than 4x the sensor's to
+    model folds over inside the image (its border, then its pixel centres' rays:
+    `rayless_pixel_centre`), or needs a pinhole image more than 4x the sensor's to
     cover it (`geometry.camera.Camera.pinhole_cover`); else an image to draw (the camera's,
     S = render.supersample times its size, with its lens's cover) larger than OpenGL's
     framebuffers hold. The camera model is imported here, so that the settings import
@@ -61,6 +64,14 @@ def lens_problems(camera: dict, supersample: int) -> list[str]:
         model.pinhole_cover()  # a pinhole: itself, nothing to check
     except ValueError as exc:
         return [f"config key '{exc}".replace(":", "':", 1)]
+    if not model.distortion.is_pinhole:
+        missing = rayless_pixel_centre(model)
+        if missing is not None:
+            return [
+                f"config key 'camera.distortion': {model.distortion} folds over inside the {model.width} x "
+                f"{model.height} image: pixel ({missing[0]}, {missing[1]}) has no ray; expected a lens whose model "
+                "is one-to-one over the image (smaller coefficients, tangential ones above all)"
+            ]
     cover = model.scaled(supersample).pinhole_cover()
     if max(cover.width, cover.height) <= MAX_DRAWN_PX:
         return []
@@ -69,6 +80,23 @@ def lens_problems(camera: dict, supersample: int) -> list[str]:
         f"{camera['width']} x {camera['height']} camera draw {cover.width} x {cover.height} px (with the lens's "
         f"margin); expected at most {MAX_DRAWN_PX} px a side, got {supersample}"
     ]
+
+
+# The pixel centres a side whose rays the config check computes: every one up to this size,
+# evenly spread beyond (the motion-field stage computes them all; a fold narrower than the
+# spacing could then slip through: docs/accuracy.md "End-to-end stress").
+CHECKED_CENTRES = 512
+
+
+def rayless_pixel_centre(model) -> tuple[int, int] | None:
+    """(column, row) of a checked pixel centre whose ray the lens's inverse does not find (the
+    model folds over there: its tangential terms can fold an image whose border maps one to
+    one), or None; every centre of images up to CHECKED_CENTRES a side."""
+    columns = np.unique(np.linspace(0, model.width - 1, min(model.width, CHECKED_CENTRES)).round().astype(int))
+    rows = np.unique(np.linspace(0, model.height - 1, min(model.height, CHECKED_CENTRES)).round().astype(int))
+    rays = model.back_project(columns[None, :] + 0.5 - model.width / 2, rows[:, None] + 0.5 - model.height / 2)
+    bad = np.argwhere(~np.isfinite(rays).all(axis=-1))
+    return None if not len(bad) else (int(columns[bad[0][1]]), int(rows[bad[0][0]]))
 
 
 CAMERA = {
