@@ -117,7 +117,8 @@ class Dynamics:
         """dx/dt for one state (13,) and control (4,), or batches (n, 13), (n, 4).
 
         Domain: pitch inside +-90 deg (the Euler rates grow as 1 / cos(theta)), any roll,
-        yaw, velocity, rates, command and mass. Bound: each component within 4 eps of its
+        yaw, velocity, rates, command and mass, away from underflow (rates and commands 0
+        or at least 1e-100 in size). Bound: each component within 4 eps of its
         terms' absolute values summed (g + T uT / m for the acceleration, the gyroscopic
         products' for the rates: hovering cancels, so the error is absolute there),
         docs/accuracy.md."""
