@@ -4,6 +4,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
+from normal_floats import normal_floats
 from traj2events.trajectory.dynamics import (
     STATE_NAMES,
     Dynamics,
@@ -106,9 +107,8 @@ def test_vehicle_rejects_dry_mass_above_wet_mass():
         Vehicle(mass_kg=5000.0, dry_mass_kg=6000.0)
 
 
-# Away from underflow: 0 or at least 1e-100 in size (products of three stay normal floats;
-# below, rounding is absolute, not relative: a rate of 1e-310 rad/s had 2,500x its bound).
-RATE = st.floats(-1.0, 1.0).map(lambda r: r if abs(r) >= 1e-100 else 0.0)  # rad/s
+# Away from underflow: a rate of 1e-310 rad/s had 2,500x its bound (rounding is absolute there).
+RATE = normal_floats(-1.0, 1.0)  # rad/s
 COUPLE = RATE
 
 
@@ -143,8 +143,8 @@ def exact_derivative(vehicle: Vehicle, x: np.ndarray, u: np.ndarray) -> tuple[li
     return value, size
 
 
-@given(st.floats(-1e4, 1e4), st.floats(-np.pi / 2 + 1e-3, np.pi / 2 - 1e-3), st.floats(-np.pi, np.pi),
-       st.floats(-np.pi, np.pi), RATE, RATE, RATE, RATE.map(abs), COUPLE, COUPLE, COUPLE,
+@given(st.floats(-1e4, 1e4), normal_floats(-np.pi / 2 + 1e-3, np.pi / 2 - 1e-3), normal_floats(-np.pi, np.pi),
+       normal_floats(-np.pi, np.pi), RATE, RATE, RATE, RATE.map(abs), COUPLE, COUPLE, COUPLE,
        st.floats(6000.0, 9472.06))  # fmt: skip
 def test_the_landers_derivative_is_within_4_eps_of_50_digits(v, theta, phi, psi, p, q, r, throttle, u1, u2, u3, m):
     """Its stated bound (docs/accuracy.md): every component of f(x, u) within 4 eps of its
