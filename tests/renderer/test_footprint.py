@@ -4,6 +4,8 @@ read as wide as the pixel's box."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from traj2events.renderer import footprint
 from traj2events.renderer.footprint import area_weights, level_sides, mip_levels, sunlit
@@ -105,3 +107,20 @@ def test_the_box_is_as_wide_as_the_pixels_box_over_level_0s_surface(texels_per_p
         stds.append(np.sqrt(((centres - mean) ** 2 * response).sum() / response.sum()))
     expected = np.sqrt(texels_per_px**2 / 12 + 1 / 6)
     assert np.mean(stds) == pytest.approx(expected, rel=0.12)
+
+
+@settings(max_examples=max(settings.default.max_examples // 10, 10))  # a dense (n / 2, n) matrix each
+@given(st.integers(2, 2049), st.floats(0.3, 1.0))
+def test_area_weights_are_within_their_bound_of_the_exact_overlaps(n_from, shrink):
+    """Its stated bound (docs/accuracy.md): each weight within 2 n_to eps of the exact
+    rational overlap, |[i, i+1) / n_to  &  [j, j+1) / n_from| n_to (integers: no rounding),
+    and exactly 0 where the intervals do not overlap, for sides 2..2049 and any coarser
+    side: the edges' rounding (an ulp of 1) over a row's sum (1 / n_to), far inside the
+    float32 the levels are stored in."""
+    n_to = max(int(n_from * shrink), 1)
+    i, j = np.arange(n_to)[:, None], np.arange(n_from)[None, :]
+    overlap = np.clip(np.minimum((i + 1) * n_from, (j + 1) * n_to) - np.maximum(i * n_from, j * n_to), 0, None)
+    exact = overlap / n_from  # the rational overlap / n_from, one rounding (0.5 ulp of a weight <= 1)
+    weights = area_weights(n_from, n_to)
+    assert np.all(weights[overlap == 0] == 0)
+    assert np.abs(weights - exact).max() <= 2 * n_to * np.finfo(float).eps

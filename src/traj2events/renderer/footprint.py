@@ -87,7 +87,9 @@ def sampled_levels(texture_filter: str, side: int) -> list[int]:
 
 def area_weights(n_from: int, n_to: int) -> np.ndarray:
     """(n_to, n_from): row i holds how much of target texel i's interval [i, i+1) / n_to
-    each source texel's [j, j+1) / n_from covers, normalised to sum to 1."""
+    each source texel's [j, j+1) / n_from covers, normalised to sum to 1: within 2 n_to eps
+    of the exact overlaps (the edges' rounding over the row's sum, 1 / n_to; docs/accuracy.md),
+    far inside the float32 the levels are stored in."""
     edges_to = np.arange(n_to + 1) / n_to
     edges_from = np.arange(n_from + 1) / n_from
     lo = np.maximum(edges_to[:-1, None], edges_from[None, :-1])
