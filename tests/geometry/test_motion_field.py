@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from normal_floats import normal_floats
+from normal_floats import flushed, normal_floats
 from traj2events.geometry.camera import Camera, camera_motion, camera_pose
 from traj2events.geometry.distortion import Distortion
 from traj2events.geometry.motion_field import (
@@ -662,7 +662,7 @@ def test_the_flow_law_is_within_its_bound_of_a_50_digit_reference(x, y, f, h, vx
     1e5 px, inverse depths to 1 /m, speeds to 300 m/s and rates to 1 rad/s, away from underflow."""
     import mpmath as mp
 
-    inputs = [dtype(v) for v in (x, y, f, h, vx, vy, vz, p, q, r)]
+    inputs = [flushed(v, dtype) for v in (x, y, f, h, vx, vy, vz, p, q, r)]
     u, v = motion_field(np.array([[inputs[0]]]), np.array([[inputs[1]]]), float(inputs[2]),
                         np.array([[inputs[3]]], dtype), inputs[4:7], inputs[7:])  # fmt: skip
     with mp.workdps(50):

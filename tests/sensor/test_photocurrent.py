@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from traj2events.config import section
 from traj2events.sensor.laws import KNEE_DN
@@ -83,3 +85,42 @@ def test_the_emulator_white_is_the_radiance_at_255_dn_on_either_scale():
     white = emulator_white_w_m2_sr({**events, "input": "sensor"}, 40.0)
     assert sensor_dn(np.array([white]), _sensor())[0] == pytest.approx(255.0)
     assert white == pytest.approx(12.75 * 1e-15 / photocurrent_a(np.array([1.0]), _sensor())[0])  # 12.75 dark currents
+
+
+def exact_solar_band(lo_m: float, hi_m: float, temperature_k: float) -> tuple:
+    """Planck's law integrated over the band by mpmath's quadrature at 30 digits, over the
+    total sigma T^4 / pi with sigma = 2 pi^5 k^4 / (15 h^3 c^2) of the SI's exact h, k, c:
+    (share, photons per joule)."""
+    import mpmath as mp
+
+    from traj2events.sensor.photocurrent import BOLTZMANN_J_K, LIGHT_SPEED_M_S, PLANCK_J_S
+
+    with mp.workdps(30):
+        h, c, k, t = mp.mpf(PLANCK_J_S), mp.mpf(LIGHT_SPEED_M_S), mp.mpf(BOLTZMANN_J_K), mp.mpf(temperature_k)
+
+        def planck(lam):
+            return 2 * h * c**2 / lam**5 / mp.expm1(h * c / (lam * k * t))
+
+        lo, hi = mp.mpf(lo_m), mp.mpf(hi_m)
+        nodes = [lo * (hi / lo) ** (mp.mpf(i) / 8) for i in range(9)]  # log-spaced pieces
+        in_band = mp.quad(planck, nodes)
+        photons = mp.quad(lambda lam: planck(lam) * lam / (h * c), nodes)
+        sigma = 2 * mp.pi**5 * k**4 / (15 * h**3 * c**2)
+        return in_band / (sigma * t**4 / mp.pi), photons / in_band
+
+
+@settings(max_examples=max(settings.default.max_examples // 20, 10))  # two 30-digit quadratures each
+@given(st.floats(2e-7, 1e-5), st.floats(1e-4, 2.0), st.floats(3000.0, 10000.0))
+def test_the_bands_share_and_photons_are_within_their_bound_of_planck(lo_m, log_ratio, temperature_k):
+    """Its stated bound (docs/accuracy.md): the band's share of the Sun's power and its
+    photons per joule within 1e-8 (x ln(hi / lo))^2 + 1e-10 relative of Planck's law
+    integrated at 30 digits, x = max(hc / (lo k T), 5) (Wien's steep side), for bands from
+    200 nm to 10 um wide to two decades and black bodies 3000-10000 K: the trapezoids' error
+    on the 4001-point log grid, and the rounded Stefan-Boltzmann constant's (3e-11)."""
+    hi_m = lo_m * 10.0**log_ratio
+    share, photons_per_j = solar_band((lo_m, hi_m), temperature_k)
+    exact_share, exact_photons = exact_solar_band(lo_m, hi_m, temperature_k)
+    x = max(0.0143877688 / (lo_m * temperature_k), 5.0)  # hc / (lambda k T), m K over m K
+    bound = 1e-8 * (x * np.log(hi_m / lo_m)) ** 2 + 1e-10
+    assert float(abs(share - exact_share) / exact_share) <= bound
+    assert float(abs(photons_per_j - exact_photons) / exact_photons) <= bound
