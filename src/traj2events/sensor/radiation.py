@@ -69,7 +69,8 @@ def burst_levels(charge_ratio: float, theta_on: float, theta_off: float) -> tupl
 
 
 def recovery_times_s(charge_ratio: float, levels: np.ndarray, tau_s: float) -> np.ndarray:
-    """When the pixel's log falls back to each level: ln(1 + r e^(-t / tau)) = L."""
+    """When the pixel's log falls back to each level: ln(1 + r e^(-t / tau)) = L; within
+    4 eps (tau + t) (docs/accuracy.md)."""
     return tau_s * np.log(charge_ratio / np.expm1(levels))
 
 
@@ -111,7 +112,7 @@ def track_charges(
     sigma_px = params.charge_diffusion_um / pitch_um
     offsets = np.arange(-math.ceil(4 * sigma_px), math.ceil(4 * sigma_px) + 1)
     cols, rows = np.floor(xs)[:, None] + offsets, np.floor(ys)[:, None] + offsets  # (steps, cells)
-    share = _cell_shares(ys[:, None], rows, sigma_px)[:, :, None] * _cell_shares(xs[:, None], cols, sigma_px)[:, None]
+    share = cell_shares(ys[:, None], rows, sigma_px)[:, :, None] * cell_shares(xs[:, None], cols, sigma_px)[:, None]
     inside = ((rows >= 0) & (rows < height))[:, :, None] & ((cols >= 0) & (cols < width))[:, None, :]
     keep = inside & (share > 1e-9)
     pixels = (rows[:, :, None] * width + cols[:, None, :])[keep].astype(np.int64)
@@ -119,8 +120,9 @@ def track_charges(
     return unique, np.bincount(slot, weights=share[keep]) * (total_e / steps)
 
 
-def _cell_shares(centre, cells: np.ndarray, sigma: float) -> np.ndarray:
-    """A Gaussian's share in each unit cell [c, c + 1) along one axis."""
+def cell_shares(centre, cells: np.ndarray, sigma: float) -> np.ndarray:
+    """A Gaussian's share in each unit cell [c, c + 1) along one axis: within 2 eps absolute
+    (the difference of two erfs; docs/accuracy.md)."""
     scale = sigma * math.sqrt(2.0)
     return 0.5 * (special.erf((cells + 1 - centre) / scale) - special.erf((cells - centre) / scale))
 
