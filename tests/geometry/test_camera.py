@@ -116,6 +116,7 @@ EPS = np.finfo(float).eps
 COORDINATE = normal_floats(-2e5, 2e5)  # m: 200 km out, away from underflow
 
 
+@pytest.mark.accuracy
 @given(st.integers(1, 8192), st.floats(0.5, 179.5), COORDINATE, COORDINATE, st.floats(1e-3, 2e5))
 def test_focal_length_projection_and_back_projection_are_within_their_bounds_of_50_digits(width, fov, x, y, z):
     """Their stated bounds (docs/accuracy.md): the focal length within (3 + kappa_tan) eps
@@ -141,6 +142,7 @@ def test_focal_length_projection_and_back_projection_are_within_their_bounds_of_
             assert float(abs(got - want)) <= EPS * float(abs(want))
 
 
+@pytest.mark.accuracy
 @given(*[normal_floats(-np.pi, np.pi)] * 3, *[COORDINATE] * 3, COORDINATE, COORDINATE, normal_floats(-1e5, 0.0))
 def test_a_points_camera_coordinates_are_within_4_eps_of_50_digits(phi, theta, psi, px, py, pz, cx, cy, cz):
     """Its stated bound (docs/accuracy.md): R^T (p - c) within 4 eps sum_j |R_ji| |p_j - c_j|

@@ -146,6 +146,7 @@ def test_resampled_depth_keeps_sky_where_most_of_the_samples_are_sky():
     assert np.all(out[sky_side] == 0) and np.all(out[~sky_side] == pytest.approx(50.0))
 
 
+@pytest.mark.accuracy
 @example(
     0.31086957832935425,
     0.004518928803564035,

@@ -524,6 +524,7 @@ def test_the_numpy_fields_follow_the_lens_too():
     np.testing.assert_allclose(from_depth[terrain], flow[terrain], rtol=1e-9, atol=1e-9)
 
 
+@pytest.mark.accuracy
 @given(st.floats(1e-3, 2e5), st.floats(-1, 1), st.floats(-1, 1), st.floats(0, 1), st.floats(-2, 2), st.floats(-2, 2),
        st.sampled_from([np.float64, np.float32]))  # fmt: skip
 def test_the_spheres_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h, nx, ny, nz, a, b, dtype):
@@ -553,6 +554,7 @@ def test_the_spheres_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h
         assert got > 0 and float(abs(got - reference) / reference) <= 4 * eps * float(kappa)
 
 
+@pytest.mark.accuracy
 @given(st.floats(-2e5, 2e5), st.floats(-2e5, 2e5), st.floats(1e-3, 2e5))
 def test_the_height_above_the_sphere_is_within_4_eps_of_a_50_digit_reference(x, y, height_m):
     """Its stated bound (docs/accuracy.md): the camera's height above the sphere to 4 eps
@@ -569,6 +571,7 @@ def test_the_height_above_the_sphere_is_within_4_eps_of_a_50_digit_reference(x, 
 VECTOR = st.tuples(*[st.floats(-1, 1)] * 3)
 
 
+@pytest.mark.accuracy
 @given(st.floats(0, 5), st.floats(-60, 60), st.floats(-80, 89.9), st.floats(-180, 180), st.floats(-3, 0), VECTOR,
        VECTOR, st.floats(-1e4, 1e4))  # fmt: skip
 def test_the_spheres_exact_displacement_is_within_its_bound_of_a_50_digit_reference(
@@ -618,6 +621,7 @@ def test_the_spheres_exact_displacement_is_within_its_bound_of_a_50_digit_refere
 RAY = st.floats(-2, 2, allow_subnormal=False)  # a pixel's ray: a = x_s / f, never subnormal
 
 
+@pytest.mark.accuracy
 @given(st.floats(1e-3, 2e5), st.floats(-1, 1), st.floats(-1, 1), st.floats(0, 1), RAY, RAY,
        st.sampled_from([np.float64, np.float32]))  # fmt: skip
 def test_the_planes_inverse_depth_is_within_its_bound_of_a_50_digit_reference(h, nx, ny, nz, a, b, dtype):
@@ -654,6 +658,7 @@ SPEED = normal_floats(-300.0, 300.0)
 PIXEL = normal_floats(-4096, 4096)  # px: across an 8192^2 frame
 
 
+@pytest.mark.accuracy
 @given(PIXEL, PIXEL, st.floats(10.0, 1e5), normal_floats(0.0, 1.0), SPEED, SPEED, SPEED, RATE, RATE, RATE,
        st.sampled_from([np.float64, np.float32]))  # fmt: skip
 def test_the_flow_law_is_within_its_bound_of_a_50_digit_reference(x, y, f, h, vx, vy, vz, p, q, r, dtype):

@@ -109,6 +109,7 @@ def test_the_box_is_as_wide_as_the_pixels_box_over_level_0s_surface(texels_per_p
     assert np.mean(stds) == pytest.approx(expected, rel=0.12)
 
 
+@pytest.mark.accuracy
 @settings(max_examples=max(settings.default.max_examples // 10, 10))  # a dense (n / 2, n) matrix each
 @given(st.integers(2, 2049), st.floats(0.3, 1.0))
 def test_area_weights_are_within_their_bound_of_the_exact_overlaps(n_from, shrink):

@@ -110,6 +110,7 @@ def test_the_exact_h_function_is_chandrasekhars_tabulated_value():
     assert chandrasekhar_h_exact(1.0, 1.0 - 1e-12) == pytest.approx(2.9078, abs=2e-4)  # conservative scattering
 
 
+@pytest.mark.accuracy
 @settings(max_examples=max(settings.default.max_examples // 5, 20))  # a quadrature each: fewer examples
 @given(st.floats(1e-4, 1.0), st.floats(0.0, 0.999))
 def test_hapkes_h_function_is_within_1_percent_of_chandrasekhars(mu, w):
@@ -133,6 +134,7 @@ def lunar_lambert_50_digit(mu0: float, mu: float, cos_g: float, albedo: float) -
 EPS = np.finfo(np.float64).eps
 
 
+@pytest.mark.accuracy
 @given(st.floats(1e-12, 1.0), st.floats(1e-12, 1.0), st.floats(-1.0, 1.0), st.floats(1e-3, 1.0))
 def test_lunar_lambert_within_its_bound_of_its_50_digit_value(mu0, mu, cos_g, albedo):
     """Its stated bound (docstring; docs/accuracy.md), over mu0, mu 1e-12..1 (grazing light

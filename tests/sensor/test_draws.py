@@ -92,6 +92,7 @@ def zero_count_share(rate_hz: float, dt: float) -> float:
     return lo / 2**53
 
 
+@pytest.mark.accuracy
 @given(st.floats(1e-6, 1e9), st.floats(1e-9, 10.0))
 def test_the_share_of_pixels_without_an_event_is_within_its_bound_of_exp_minus_rate_dt(rate_hz, dt):
     """Its stated bound (docs/accuracy.md): the draws' P(N = 0) within 2^-52 + 4 eps

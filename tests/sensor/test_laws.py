@@ -79,6 +79,7 @@ def test_the_shot_noise_rate_is_v2es_gain_times_the_nominal_over_the_pixels_thre
     assert shot_noise_rate_hz(400.0, 5.0, 0.25, 0.25, 0.25) == 0.0  # no noise above 346 DN
 
 
+@pytest.mark.accuracy
 @given(st.floats(0, 1e6), st.floats(1e-3, 1e4), st.floats(1e-9, 10.0))
 def test_the_low_pass_gain_is_within_2_ulp_of_a_50_digit_reference(intensity_dn, cutoff_hz, dt_s):
     """eps = -expm1(-2 pi f_c(I) dt), no cancellation for small steps (dt -> 0: eps ~ 2 pi f_c dt)
@@ -91,6 +92,7 @@ def test_the_low_pass_gain_is_within_2_ulp_of_a_50_digit_reference(intensity_dn,
         assert float(abs(got - reference)) <= 2 * np.finfo(float).eps * float(reference)
 
 
+@pytest.mark.accuracy
 @given(st.floats(0, 1e12))
 def test_the_log_response_is_within_2_ulp_of_a_50_digit_reference(intensity_dn):
     """L(I) = I ln 20 / 20 up to the 20 DN knee, ln I above, continuous there (docs/accuracy.md)."""

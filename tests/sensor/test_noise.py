@@ -4,6 +4,7 @@ rates, counts and order over whole frames are tested with the emulator
 (tests/sensor/test_emulator.py)."""
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -28,6 +29,7 @@ def first_gap_share(mean_gap_s: float, dt: float) -> float:
     return (2**32 - lo + 1) / 2**32
 
 
+@pytest.mark.accuracy
 @given(st.floats(1e-9, 10.0), st.floats(1e-3, 100.0))
 def test_the_candidates_gap_is_within_its_bound_of_the_exponential(mean_gap_s, x):
     """Its stated bound (docs/accuracy.md): P(gap < dt) within 2^-31 + 4 eps x exp(-x) of
@@ -56,6 +58,7 @@ def kept_share(majorant, intensity_dn, theta_on, theta_off, theta_nominal) -> fl
     return lo / 2**26
 
 
+@pytest.mark.accuracy
 @given(st.floats(0.0, 400.0), st.floats(0.05, 1.0), st.floats(0.05, 1.0), st.floats(0.05, 1.0), st.floats(1.0, 20.0))
 def test_the_thinning_keeps_with_its_probability_within_its_bound(intensity_dn, on, off, nominal, spread):
     """Its stated bound (docs/accuracy.md): P(kept) within 2^-26 + 4 eps of g(I) w / majorant

@@ -109,6 +109,7 @@ def exact_solar_band(lo_m: float, hi_m: float, temperature_k: float) -> tuple:
         return in_band / (sigma * t**4 / mp.pi), photons / in_band
 
 
+@pytest.mark.accuracy
 @settings(max_examples=max(settings.default.max_examples // 20, 10))  # two 30-digit quadratures each
 @given(st.floats(2e-7, 1e-5), st.floats(1e-4, 2.0), st.floats(3000.0, 10000.0))
 def test_the_bands_share_and_photons_are_within_their_bound_of_planck(lo_m, log_ratio, temperature_k):

@@ -1,12 +1,14 @@
 """The pixel model over one interval (sensor/pixel.py): its laws against 50 digits."""
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from traj2events.sensor.pixel import crossing_time
 
 
+@pytest.mark.accuracy
 @given(st.integers(1, 50), st.floats(0.01, 2.0), st.booleans(), st.floats(-5, 5), st.floats(-5, 5), st.floats(0, 1e5),
        st.floats(1e-9, 10))  # fmt: skip
 def test_a_crossing_time_is_within_its_bound_of_a_50_digit_reference(j, theta, on, x0, x1, t0_s, dt_s):

@@ -150,6 +150,7 @@ def test_hits_need_a_photoreceptor_bandwidth():
         SpaceParams(particle_flux_cm2_s=-1.0)
 
 
+@pytest.mark.accuracy
 @given(normal_floats(-50.0, 50.0), st.integers(-60, 60), st.floats(0.05, 10.0))
 def test_a_gaussians_cell_shares_are_within_2_eps_of_50_digits(centre, cell, sigma):
     """Its stated bound (docs/accuracy.md): each cell's share of the charge within 2 eps
@@ -165,6 +166,7 @@ def test_a_gaussians_cell_shares_are_within_2_eps_of_50_digits(centre, cell, sig
         assert float(abs(got - exact)) <= 2 * np.finfo(float).eps
 
 
+@pytest.mark.accuracy
 @given(st.floats(1e-6, 1e12), st.floats(1e-3, 1.0), st.floats(1e-6, 10.0))
 def test_the_recovery_times_are_within_their_bound_of_50_digits(charge_ratio, level_fraction, tau_s):
     """Its stated bound (docs/accuracy.md): the time the pixel's log falls back to a level L

@@ -78,6 +78,7 @@ def test_off_does_nothing_and_bad_values_are_named():
         ReadoutParams(mode="queue")
 
 
+@pytest.mark.accuracy
 @settings(max_examples=max(settings.default.max_examples // 10, 10))  # a queue of up to 1e6 events each
 @given(st.floats(0.0, 4.29e9), st.floats(3.0, 9.0), st.integers(1, 6))
 @example(4.29e9, np.log10(3e8), 6)  # the scratch search's counterexample: a running sum drifted 0.24 us

@@ -143,6 +143,7 @@ def exact_derivative(vehicle: Vehicle, x: np.ndarray, u: np.ndarray) -> tuple[li
     return value, size
 
 
+@pytest.mark.accuracy
 @given(st.floats(-1e4, 1e4), normal_floats(-np.pi / 2 + 1e-3, np.pi / 2 - 1e-3), normal_floats(-np.pi, np.pi),
        normal_floats(-np.pi, np.pi), RATE, RATE, RATE, RATE.map(abs), COUPLE, COUPLE, COUPLE,
        st.floats(6000.0, 9472.06))  # fmt: skip

@@ -2,6 +2,7 @@
 shortest way between two samples whatever the quaternions' signs, within its bound."""
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -43,6 +44,7 @@ def exact_slerp(q0, q1, s):
             (2 * (xs * zs - ys * ws), 2 * (ys * zs + xs * ws), 1 - 2 * (xs * xs + ys * ys)))])  # fmt: skip
 
 
+@pytest.mark.accuracy
 @given(UNIT, st.tuples(*[st.floats(-1, 1)] * 3), st.floats(0, MAX_STEP_DEG), st.floats(0, 1), st.booleans())
 def test_slerp_is_within_8_eps_of_a_50_digit_rotation_the_short_way(q, axis, angle_deg, s, flip):
     """Its stated bound (docs/accuracy.md): each entry of the interpolated rotation within
@@ -81,6 +83,7 @@ def exact_hermite(t_nodes, position, velocity, t):
         return out
 
 
+@pytest.mark.accuracy
 @given(st.floats(-3, 1), st.floats(-3, 3), st.tuples(*[normal_floats(-2e5, 2e5)] * 9),
        st.tuples(*[normal_floats(-2e3, 2e3)] * 9), st.floats(0, 1))  # fmt: skip
 def test_hermite_positions_at_uneven_steps_are_within_their_bound_of_50_digits(log_h, log_ratio, p, v, s):

@@ -154,6 +154,7 @@ def test_the_altitude_keeps_its_digits_at_touchdown():
             assert float(abs(h - reference) / reference) <= 4 * np.finfo(float).eps
 
 
+@pytest.mark.accuracy
 @given(st.floats(-np.pi, np.pi), st.floats(-np.pi / 2, np.pi / 2), st.floats(-np.pi, np.pi),
        st.tuples(*[st.floats(-100, 100)] * 3))  # fmt: skip
 def test_the_specific_force_is_within_4_eps_of_50_digits(phi, theta, psi, acceleration):

@@ -1,6 +1,7 @@
 """The state's attitude laws: R_iv and its quaternion, against scipy's Rotation."""
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
@@ -34,6 +35,7 @@ def exact_rotation(phi: float, theta: float, psi: float) -> list:
             [sp * ct, sp * st_ * sf + cp * cf, sp * st_ * cf - cp * sf], [-st_, ct * sf, ct * cf]]  # fmt: skip
 
 
+@pytest.mark.accuracy
 @given(ANGLE, st.floats(-np.pi / 2, np.pi / 2), ANGLE)
 def test_the_attitude_rotation_and_quaternion_are_within_4_eps_of_50_digits(phi, theta, psi):
     """Their stated bound (docs/accuracy.md): every entry of R_iv and of its quaternion

@@ -126,6 +126,7 @@ def exact_burn(vehicle, x0: np.ndarray, u: np.ndarray, t: float) -> np.ndarray:
         return np.array([float(v) for v in state])
 
 
+@pytest.mark.accuracy
 @settings(max_examples=max(settings.default.max_examples // 10, 10))  # an integration each: fewer examples
 @given(st.booleans(), st.floats(0.05, 1.0), st.floats(-1.0, 1.0), st.floats(-1.2, 1.2), st.floats(-1.2, 1.2),
        st.floats(-np.pi, np.pi), st.floats(5.0, 120.0), st.integers(1, 40), st.floats(6500.0, 9472.06))  # fmt: skip
