@@ -3,8 +3,6 @@ of the motion field and its picture."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from . import pick
 from .declare import section, setting
 
@@ -92,6 +90,8 @@ def rayless_pixel_centre(model) -> tuple[int, int] | None:
     """(column, row) of a checked pixel centre whose ray the lens's inverse does not find (the
     model folds over there: its tangential terms can fold an image whose border maps one to
     one), or None; every centre of images up to CHECKED_CENTRES a side."""
+    import numpy as np  # here: the settings import without numpy (a Snakemake-alone lint)
+
     columns = np.unique(np.linspace(0, model.width - 1, min(model.width, CHECKED_CENTRES)).round().astype(int))
     rows = np.unique(np.linspace(0, model.height - 1, min(model.height, CHECKED_CENTRES)).round().astype(int))
     rays = model.back_project(columns[None, :] + 0.5 - model.width / 2, rows[:, None] + 0.5 - model.height / 2)
