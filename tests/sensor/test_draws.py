@@ -1,5 +1,7 @@
 """Counter-based draws: uniform, independent between keys, Poisson counts and exponential gaps."""
 
+import bisect
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -83,13 +85,9 @@ def first_uniform_key(k: int) -> np.uint64:
 def zero_count_share(rate_hz: float, dt: float) -> float:
     """The code's own P(N = 0), exactly: the share of the 2^53 first uniforms that give no
     event (N = 0 for every uniform up to a threshold: smaller uniforms, longer gaps)."""
-    if poisson_arrivals(first_uniform_key(1), rate_hz, dt) != 0:
-        return 0.0
-    lo, hi = 1, 2**53  # N = 0 at lo; above hi none
-    while lo < hi:
-        mid = (lo + hi + 1) // 2
-        lo, hi = (mid, hi) if poisson_arrivals(first_uniform_key(mid), rate_hz, dt) == 0 else (lo, mid - 1)
-    return lo / 2**53
+    uniforms = range(1, 2**53 + 1)
+    zeros = bisect.bisect_left(uniforms, True, key=lambda k: poisson_arrivals(first_uniform_key(k), rate_hz, dt) > 0)
+    return zeros / 2**53
 
 
 @pytest.mark.accuracy

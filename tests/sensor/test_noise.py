@@ -3,6 +3,8 @@ coin, each on its bit grid, against the law's exact probabilities at 50 digits. 
 rates, counts and order over whole frames are tested with the emulator
 (tests/sensor/test_emulator.py)."""
 
+import bisect
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -17,16 +19,10 @@ def first_gap_share(mean_gap_s: float, dt: float) -> float:
     of the gap's uniform (k 2^-32, the draw's high 32 bits k - 1) that land it within dt
     (larger uniforms, shorter gaps)."""
 
-    def within(k: int) -> bool:
-        return candidate(np.uint64((k - 1) << 32), 0, 0.0, mean_gap_s)[0] < dt
-
-    if not within(2**32):
-        return 0.0
-    lo, hi = 1, 2**32  # the smallest k within dt lies in [lo, hi]
-    while lo < hi:
-        mid = (lo + hi) // 2
-        lo, hi = (lo, mid) if within(mid) else (mid + 1, hi)
-    return (2**32 - lo + 1) / 2**32
+    outside = bisect.bisect_left(
+        range(1, 2**32 + 1), True, key=lambda k: candidate(np.uint64((k - 1) << 32), 0, 0.0, mean_gap_s)[0] < dt
+    )
+    return (2**32 - outside) / 2**32
 
 
 @pytest.mark.accuracy
@@ -48,14 +44,11 @@ def test_the_candidates_gap_is_within_its_bound_of_the_exponential(mean_gap_s, x
 def kept_share(majorant, intensity_dn, theta_on, theta_off, theta_nominal) -> float:
     """The code's own P(kept), exactly: the share of the coin's 2^26 values (c 2^-26) that
     keep a candidate (smaller coins keep)."""
-    lo, hi = 0, 2**26  # the first coin not kept lies in [lo, hi] (hi: every coin keeps)
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if kept(mid * 2.0**-26, majorant, intensity_dn, theta_on, theta_off, theta_nominal):
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo / 2**26
+    keeping = bisect.bisect_left(
+        range(2**26), True, key=lambda c: not kept(c * 2.0**-26, majorant, intensity_dn, theta_on, theta_off,
+                                                   theta_nominal)
+    )  # fmt: skip
+    return keeping / 2**26
 
 
 @pytest.mark.accuracy

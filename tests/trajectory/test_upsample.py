@@ -21,6 +21,9 @@ from traj2events.trajectory.upsample import (
 )
 from trajectory.test_state import exact_rotation
 
+VEHICLE = Vehicle()
+DYNAMICS = Dynamics(VEHICLE)  # once: a CasADi function takes a while to build
+
 
 def test_frame_times_cover_zero_to_tf():
     t = frame_times(1.0, 10.0)
@@ -134,10 +137,9 @@ def test_reintegration_is_within_its_bound_of_the_closed_form(engine, throttle, 
     """Its stated bound (docs/accuracy.md): every state within 4 ATOL (4e-7 m, 4e-8 m/s,
     4e-10 rad, 4e-11 rad/s, 4e-6 kg) of the closed-form burn at 50 digits, over 5..120 s
     cut in 1..40 intervals of uneven length, any held attitude with pitch within 70 deg."""
-    vehicle = Vehicle()
     x0 = np.array([100.0, -50.0, -2000.0, 40.0, 3.0, -5.0, phi, theta, psi, 0.0, 0.0, 0.0, m0])
     u = np.array([throttle, 0.0, 0.0, 0.0]) if engine else np.array([0.0, couple, 0.0, 0.0])
     t_nodes = np.sort(np.concatenate([[0.0, tf], np.random.default_rng(n).uniform(0.0, tf, n - 1)]))
-    _, final = reintegrate(Dynamics(vehicle), t_nodes, x0, np.tile(u, (n + 1, 1)))
-    error = np.abs(final - exact_burn(vehicle, x0, u, tf))
+    _, final = reintegrate(DYNAMICS, t_nodes, x0, np.tile(u, (n + 1, 1)))
+    error = np.abs(final - exact_burn(VEHICLE, x0, u, tf))
     assert np.all(error <= 4 * ATOL), error / ATOL
