@@ -1,13 +1,20 @@
 """The optimal-control problem: constraints hold, accuracy scales with N, and the edges."""
 
+import casadi as ca
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from conftest import ROOT, landing_bc
+from normal_floats import normal_floats
 from traj2events.config import load_config
 from traj2events.trajectory.dynamics import Dynamics, Vehicle
-from traj2events.trajectory.ocp import FINAL_FIXED, LandingProblem, OcpSettings, node_fractions
+from traj2events.trajectory.ocp import FINAL_FIXED, LandingProblem, OcpSettings, node_fractions, split_controls
+from traj2events.trajectory.state import N_STATE, POSITION, STATE_SCALE, TIME_S, VELOCITY
 from traj2events.trajectory.upsample import final_state_error, interpolate_controls
+from trajectory.test_state import exact_rotation
+from trajectory.test_upsample import exact_burn
 
 
 def max_tilt_deg(sol):
@@ -134,3 +141,73 @@ def test_settings_reject_bad_values():
         OcpSettings(transcription="euler")
     with pytest.raises(ValueError, match="refine_n_nodes"):
         OcpSettings(n_nodes=40, refine_n_nodes=30)
+
+
+def nlp_defects(problem: LandingProblem):
+    """The NLP's own Hermite-Simpson defects (its first constraint, N_STATE x (N - 1)) as a
+    function of the nodes' physical states, t_f and constant physical commands: (N - 1, 13)
+    in SI units."""
+    opti, n = problem._opti, problem.settings.n_nodes
+    g = ca.Function("g", [problem._X, problem._W, problem._tau, problem._x0, problem._xf], [opti.g])
+
+    def defects(states, control, tf_s):
+        w = split_controls(np.tile(control, (n, 1)))
+        scaled = states / STATE_SCALE
+        out = np.asarray(g(scaled.T, w.T, tf_s / TIME_S, scaled[0], scaled[-1, FINAL_FIXED])).ravel()
+        return out[: N_STATE * (n - 1)].reshape(N_STATE, n - 1, order="F").T * STATE_SCALE
+
+    return defects
+
+
+def nlp_node_times(problem: LandingProblem, tf_s: float) -> list:
+    """The node times the NLP's intervals add up to, exactly (mpmath): t_f / TIME_S (its
+    variable) times the sums of its float fractions' steps. Node times rounded to floats
+    would differ from them by eps t, which a short step late in a flight feels as eps t f."""
+    import mpmath as mp
+
+    with mp.workdps(50):
+        steps = [mp.mpf(float(s)) for s in np.diff(problem.fractions)]
+        scale = mp.mpf(TIME_S) * mp.mpf(tf_s / TIME_S)
+        return [scale * mp.fsum(steps[:k]) for k in range(len(steps) + 1)]
+
+
+@pytest.mark.accuracy
+@settings(max_examples=max(settings.default.max_examples // 3, 10), deadline=None)
+@given(st.booleans(), st.floats(0.05, 1.0), normal_floats(-1.0, 1.0), st.floats(-1.2, 1.2), st.floats(-1.2, 1.2),
+       st.floats(-np.pi, np.pi), st.floats(5.0, 200.0), st.floats(6500.0, 9472.06))  # fmt: skip
+def test_hermite_simpson_defects_are_simpsons_and_hermites_remainders(
+    problem30, dynamics, engine, throttle, couple, phi, theta, psi, tf, m0
+):
+    """The defect of the exact flight, d = x1 - x0 - h/6 (f0 + 4 f(x_m) + f1) with x_m the
+    cubic Hermite midpoint, is Simpson's remainder -h^5/2880 x^(5)(xi1) plus the midpoint's
+    remainder h^4/384 x^(4)(xi2) carried by f's Jacobian times 4h/6 (ocp.py's docstring).
+    Under a held burn the position's f is the velocity and the velocity's depends on the
+    mass alone (linear, so its midpoint is exact): d_pos = h^5 (-p5(xi1)/2880 + p5(xi2)/576),
+    d_vel = -h^5/2880 v5(xi1), with Tsiolkovsky's p5 = -e c 6/(tau - t)^4 and v5 = -e c
+    24/(tau - t)^5 (e the thrust axis, tau = m0 / mdot); every other state is linear or
+    quadratic (a roll couple from rest: every state), its defect rounding alone. Checked
+    within the two mean values' range over each interval, widened by 8 eps of the defect's
+    terms, at 30 clustered nodes over 5..200 s (steps 0.07..10 s), couples 0 or >= 1e-100
+    (no underflow)."""
+    vehicle = problem30.vehicle
+    u = np.array([throttle, 0.0, 0.0, 0.0]) if engine else np.array([0.0, couple, 0.0, 0.0])
+    x0 = np.array([100.0, -50.0, -2000.0, 40.0, 3.0, -5.0, phi, theta, psi, 0.0, 0.0, 0.0, m0])
+    states = np.array([exact_burn(vehicle, x0, u, s) for s in nlp_node_times(problem30, tf)])
+    d = nlp_defects(problem30)(states, u, tf)
+    t = tf * problem30.fractions
+
+    h = np.diff(t)[:, None]
+    f = np.abs([dynamics(x, u) for x in states])
+    terms = np.abs(states[1:]) + np.abs(states[:-1]) + h / 6 * (f[:-1] + 4 * np.maximum(f[:-1], f[1:]) + f[1:])
+    slack = 8 * np.finfo(float).eps * terms
+    low, high = np.zeros_like(d), np.zeros_like(d)
+    if engine:
+        c = vehicle.isp_s * vehicle.g0_m_s2
+        tau = m0 / (vehicle.thrust_main_N * throttle / c)
+        axis = np.array([float(row[2]) for row in exact_rotation(phi, theta, psi)])
+        ends = np.stack([t[:-1], t[1:]])[..., None]  # (2, N - 1, 1): each interval's two ends
+        p5, v5 = -axis * c * 6 / (tau - ends) ** 4, -axis * c * 24 / (tau - ends) ** 5
+        low[:, POSITION] = h**5 * (-p5.max(0) / 2880 + p5.min(0) / 576)
+        high[:, POSITION] = h**5 * (-p5.min(0) / 2880 + p5.max(0) / 576)
+        low[:, VELOCITY], high[:, VELOCITY] = -(h**5) * v5.max(0) / 2880, -(h**5) * v5.min(0) / 2880
+    assert np.all(d >= low - slack) and np.all(d <= high + slack), np.max(np.maximum(low - d, d - high) / slack)

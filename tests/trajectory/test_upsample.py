@@ -106,12 +106,13 @@ def test_shooting_check_agrees_with_dop853(solved30, dynamics):
 def exact_burn(vehicle, x0: np.ndarray, u: np.ndarray, t: float) -> np.ndarray:
     """The lander's state at t under constant commands, in closed form at 50 digits: the
     engine at a held attitude (Tsiolkovsky's velocity and its integral, mass linear), or
-    the engine off with a roll couple from rest (p linear, roll quadratic, gravity alone)."""
+    the engine off with a roll couple from rest (p linear, roll quadratic, gravity alone).
+    t: a float or an mpmath number (a time the float grid does not hold)."""
     import mpmath as mp
 
     with mp.workdps(50):
         T, c = mp.mpf(vehicle.thrust_main_N), mp.mpf(vehicle.isp_s) * mp.mpf(vehicle.g0_m_s2)
-        g, m0, t = mp.mpf(vehicle.g_m_s2), mp.mpf(float(x0[MASS])), mp.mpf(float(t))
+        g, m0, t = mp.mpf(vehicle.g_m_s2), mp.mpf(float(x0[MASS])), mp.mpf(t)
         couple = 2 * mp.mpf(vehicle.thrust_rcs_N) * mp.mpf(float(u[1]))
         k = (T * mp.mpf(float(u[0])) + abs(couple)) / c  # kg/s
         y = 1 - k * t / m0  # m(t) / m0

@@ -16,6 +16,18 @@ scaling off (bounded iteration counts for every t_f guess) and constant bounds g
 IPOPT as variable bounds (they then hold at every iterate, and the KKT system is
 smaller). It is built once and solved many times with
 new boundary conditions.
+
+Hermite-Simpson's defect on each interval of length h,
+    d = x1 - x0 - h/6 (f0 + 4 f(x_m, u_m) + f1),   x_m = (x0 + x1)/2 + h/8 (f0 - f1),
+is zero on the flight it accepts. On an exact flight it is Simpson's remainder plus the
+cubic Hermite midpoint's, carried by f's Jacobian J:
+    d = -h^5/2880 x^(5)(xi1) + (2h/3) J h^4/384 x^(4)(xi2),   xi1, xi2 in the interval,
+so it falls as h^5 where the flight is smooth (a held burn: h^5/720 p^(5) for positions,
+-h^5/2880 v^(5) for velocities) and is exact for states at most quadratic in time.
+Domain and bound (tests/trajectory/test_ocp.py, docs/accuracy.md): held burns and roll
+couples from rest, roll and pitch within 1.2 rad, 5..200 s at 30 clustered nodes;
+the defect within the two remainders' range over its interval plus 8 eps of its terms'
+absolute values (abs(x0) + abs(x1) + h/6 (abs(f0) + 4 max(abs(f0), abs(f1)) + abs(f1))).
 """
 
 from __future__ import annotations
