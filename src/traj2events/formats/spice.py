@@ -6,6 +6,10 @@ Moon's body-fixed frame, then turned into the site frame (trajectory.external.in
 
 The camera's frame is taken as this project's camera frame: +z the boresight, +x along the
 image's columns, +y along its rows (SPICE's usual instrument frame).
+
+Accuracy: the states, frames and their interpolation are SPICE's own (NAIF's, in double
+precision); this module scales km to m and takes scipy's quaternion of each rotation
+matrix; the site frame's bound is in_site_frame's (docs/accuracy.md).
 """
 
 from __future__ import annotations
