@@ -28,6 +28,15 @@ below a rim, where a low Sun's lit crescent lies, this makes S ~5 % low (the bow
 Checked against the spherical bowl, whose every interior point receives the same
 E = A E_sun sin(e) a^2 / (4 R_s^2) from its lit part (rim radius a, sphere radius R_s,
 Sun elevation e; tests/scene/test_scattering.py).
+
+Domain and bound (docs/accuracy.md): a discretisation's, not rounding's. In bowls of rim
+radius 20..80 m and depth 0.1..0.7 of it, with the Sun 2..80 deg up, each point's S is
+within (2 + 2 / sin e) / azimuths of the exact one at the default step fraction: the
+azimuths sample the lit crescent, a thin band below the far rim at low Suns (16 azimuths:
+up to 1.6x at e = 3 deg, 13 % at 20 deg; the mean over the floor within 8 %). S is finite
+and >= 0 for any terrain and normal; the azimuths' midpoint sum may take it above the
+physical limit 1 by max(2 / azimuths^2, pi / azimuths - 1) (0.65 % at 16, for a receiver
+facing a cliff that fills its view).
 """
 
 from __future__ import annotations
