@@ -6,10 +6,11 @@
 1. The march (scene/scattering.py) against closed forms, for each number of azimuths and
    step fraction: microseconds per point (one core, after compilation), the spherical
    bowl's S at 60 interior points against sin(e) a^2 / (4 R_s^2) (Sun at 10, 20, 40 deg:
-   mean and largest relative error), a long lit wall's against its view factor.
+   mean and largest relative error; at 3 and 6 deg, the landings' low Suns: largest), a
+   long lit wall's against its view factor.
 2. For each trajectory given, windows of --frames frames at --fps (mid-flight from t_f / 2,
    the last second), rendered at --size^2 with the default settings, scattered light off
-   (azimuths 0: black shadows), on (the default), and on with earthshine from an Earth 60 deg
+   (azimuths 0: black shadows), on (16 and 64 azimuths), and on with earthshine from an Earth 60 deg
    up opposite the Sun's azimuth, alternated --repeats times: seconds
    building the window's tiles from scratch (no tile cache) and drawing a frame (the best
    round), the shadow pixels' median radiance (pixels black without scattered light)
@@ -43,10 +44,10 @@ from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.upsample import ReintegratedStates
 
 
-def bowl_errors(azimuths: int, step_fraction: float) -> tuple[float, float, float]:
+def bowl_errors(azimuths: int, step_fraction: float, elevations=(10.0, 20.0, 40.0)) -> tuple[float, float, float]:
     """(microseconds per point, mean and largest |S / S_exact - 1| over the bowl's cases)."""
     errors, seconds, points = [], 0.0, 0
-    for elevation in (10.0, 20.0, 40.0):
+    for elevation in elevations:
         x, h, p, n, sunlit, sphere = spherical_bowl(elevation_deg=elevation)
         inside = np.argwhere(np.hypot(p[..., 0], p[..., 1]) < 40.0)[::500]
         args = (h[None], sunlit[None], np.array([[x[0], x[0]]]), np.array([x[1] - x[0]]))
@@ -73,13 +74,16 @@ def wall_error(azimuths: int, step_fraction: float) -> float:
 def analytic_table() -> None:
     scattered_sunlight(np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros((1, 2)), np.ones(1),
                        np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), FLAT_MOON)  # compiled  # fmt: skip
-    print("| azimuths | step fraction | us per point | bowl mean error | bowl largest | wall largest |")
-    print("|---|---|---|---|---|---|")
-    for azimuths in (8, 16, 32):
+    print("| azimuths | step fraction | us per point | bowl mean error | bowl largest | bowl largest, Sun 3-6 deg "
+          "| wall largest |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|")
+    for azimuths in (8, 16, 32, 64):
         for fraction in (0.5, 0.35, 0.25):
             us, mean, largest = bowl_errors(azimuths, fraction)
+            low_sun = bowl_errors(azimuths, fraction, (3.0, 6.0))[2]  # the landings' Suns (2-7 deg)
             wall = wall_error(azimuths, fraction)
-            print(f"| {azimuths} | {fraction} | {us:.1f} | {mean:.1%} | {largest:.1%} | {wall:.1%} |", flush=True)
+            print(f"| {azimuths} | {fraction} | {us:.1f} | {mean:.1%} | {largest:.1%} | {low_sun:.1%} | {wall:.1%} |",
+                  flush=True)  # fmt: skip
 
 
 def render_window(settings: RenderSettings, states, times):
@@ -114,7 +118,8 @@ def windows_table(paths: list[Path], size: int, n_frames: int, fps: float, repea
         earth = {"azimuth_deg": base.sun["azimuth_deg"] + 180.0, "elevation_deg": 60.0}
         variants = {
             "off": dataclasses.replace(base, scattered_light={"azimuths": 0}),
-            "on (16 azimuths)": base,
+            "on (16 azimuths)": dataclasses.replace(base, scattered_light={"azimuths": 16}),
+            "on (64 azimuths)": dataclasses.replace(base, scattered_light={"azimuths": 64}),
             "on, and earthshine": dataclasses.replace(base, earth=earth),
         }
         states = ReintegratedStates(Dynamics(tr.vehicle), tr.t_nodes, tr.state_nodes[0], tr.control_nodes)
