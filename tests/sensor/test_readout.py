@@ -21,9 +21,9 @@ def stream(n_intervals=50, per_interval=2000, interval_us=1000, seed=0, labels=T
         yield events, (rng.integers(0, 4, len(t)).astype(np.uint8) if labels else None)
 
 
-def run(params, intervals, seed=1):
+def run(params, intervals, seed=1, end_us=np.iinfo(np.int64).max):
     readout = Readout(params, seed, 4)
-    parts = [readout.process(e, lab) for e, lab in intervals] + [readout.flush()]
+    parts = [readout.process(e, lab) for e, lab in intervals] + [readout.flush(end_us)]
     out = {k: np.concatenate([p[k] for p in parts if p is not None]) for k in ("x", "y", "t", "p", "label")}
     return out, readout
 
@@ -100,3 +100,22 @@ def test_a_burst_leaves_on_the_arbiters_clock_within_its_bound(start_us, log_rat
         rounding = [2 * np.spacing(float(e)) for e in exact]  # one multiply-add's rounding, twice
         for got, e, r in zip(out[k], exact, rounding):
             assert int(mp.floor(e - r)) <= got <= int(mp.floor(e + r))
+
+
+@pytest.mark.parametrize("params", [ReadoutParams(max_event_rate_hz=1e4), ReadoutParams(latency_s=0.3)],
+                         ids=["queue", "latency"])  # fmt: skip
+def test_the_recording_ends_at_its_last_frame_and_counts_what_leaves_after_it(params):
+    # The config search's counterexample (issue 71): a queue at 1 event/s drained for an
+    # hour past a 0.04 s recording, beyond events.h5's uint32 clock. A camera whose
+    # recording stops keeps nothing of what leaves later: those are dropped, per cause.
+    inputs = list(stream(5, 2000, interval_us=100_000))  # 10,000 events in 0.5 s
+    everything, _ = run(params, inputs)
+    end_us = 500_000
+    out, readout = run(params, inputs, end_us=end_us)
+    late = everything["t"] > end_us
+    assert late.sum() > 1000 and out["t"].max() <= end_us
+    np.testing.assert_array_equal(out["t"], everything["t"][~late])
+    assert readout.dropped.tolist() == np.bincount(everything["label"][late], minlength=4).tolist()
+    readout = Readout(params, 1, 4)
+    for events, labels in inputs:  # none leave past the latest crossing until the end
+        assert readout.process(events, labels)["t"].max(initial=0) <= events["t"][-1]

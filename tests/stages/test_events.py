@@ -4,11 +4,14 @@ events for the same frames, the same seed gives the same bytes, bad inputs are n
 import h5py
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 from PIL import Image
 from scipy.special import erf
 
 from traj2events.formats.events import EVENT_LABELS, read_events
 from traj2events.sensor.sources import frame_source
+from traj2events.settings.events import EmulatorParams, ReadoutParams, SpaceParams
 from traj2events.stages.events import emulate, preset_params
 from traj2events.stages.pictures import events_picture
 from traj2events.video import VideoWriter
@@ -353,3 +356,70 @@ def test_the_standalone_emulator_takes_a_window_a_crop_a_size_and_timestamps(tmp
     assert main([*argv, "-o", str(tmp_path / "missing" / "e.h5")]) == 2
     assert not (tmp_path / "missing").exists()
     assert progress_line(50, 200, 7, 10.0) == "  50/200 frames (25 %, ETA 30 s), 7 events, 5 frames/s"
+
+
+# Caps on the bounds the declarations leave open (a rate's ge=0 and no more): events enough
+# to exercise every law in a 3 x 4 image over 0.4 s, few enough to stay a unit test.
+OPEN_CAPS = {"Hz": 1e4, "s": 0.05, "ln": 5.0, "cm^-2 s^-1": 1e5, "": 1.0}
+
+
+def declared_values(cls, **caps):
+    """A strategy for a section's every key, drawn across its declared bounds (open ones
+    capped by unit, OPEN_CAPS, or by `caps`): floats 0 or >= 1e-100, choices, booleans."""
+    from normal_floats import normal_floats
+    from traj2events.settings.declare import declared_fields
+
+    keys = {}
+    for f in declared_fields(cls):
+        meta, bounds = f.metadata, f.metadata["bounds"]
+        if meta["choices"]:
+            keys[f.name] = st.sampled_from(meta["choices"])
+        elif f.type in ("bool", bool):
+            keys[f.name] = st.booleans()
+        elif f.type in ("float", float):
+            lo = bounds.get("ge", bounds.get("gt", 0.0))
+            hi = bounds.get("le", bounds.get("lt"))
+            hi = min(hi if hi is not None else np.inf, caps.get(f.name, OPEN_CAPS.get(meta["unit"], np.inf)))
+            keys[f.name] = normal_floats(lo, hi).filter(lambda x, b=bounds: x > b.get("gt", -np.inf))
+    return st.fixed_dictionaries(keys)
+
+
+@settings(max_examples=max(settings.default.max_examples // 6, 10), deadline=None)
+@example(
+    {**dict(preset_params("clean").__dict__), "theta_on": 1.0, "theta_off": 1.0},
+    {"latency_s": 0.0, "jitter_s": 0.0, "max_event_rate_hz": 1e-14, "mode": "delay"},
+    {"enabled": False},
+    0,
+)
+@given(declared_values(EmulatorParams, theta_on=2.0, theta_off=2.0), declared_values(ReadoutParams),
+       declared_values(SpaceParams), st.integers(0, 2**32 - 1))  # fmt: skip
+def test_no_pixel_readout_or_space_the_check_accepts_gives_events_off_the_clock(tmp_path_factory, pixel, readout,
+                                                                                space, seed):  # fmt: skip
+    """Issue 71: events.pixel, events.readout and events.space drawn across their declared
+    bounds; for each config the check accepts, the events stage on frames from black to
+    1e6 DN at uneven steps (10 us to 0.2 s) writes events whose times are in order, on the
+    recording's clock (0 to the last frame: a NaN cast to uint32 would not be) and whose
+    pixels are in the image. The search found a readout queue (1 event/s) draining for an
+    hour past the recording's end, beyond events.h5's clock, and one (1e-14 events/s)
+    whose departures wrapped int64: the recording now ends at its last frame, and a
+    departure past int64's clock is never (sensor/readout.py)."""
+    from traj2events.config import ConfigError, resolve_config
+    from traj2events.sensor.sources import SENSOR_KIND, FrameSource
+    from traj2events.stages.events import emulate_with_settings, pixel_and_sensor
+
+    try:
+        config = resolve_config({"events": {"pixel": pixel, "readout": readout, "space": space, "input": "sensor"}})
+    except ConfigError:
+        return
+    rng = np.random.default_rng(seed)
+    times = np.cumsum(np.concatenate([[0.0], 10 ** rng.uniform(-5, np.log10(0.2), 5)]))
+    frames = (10 ** rng.uniform(-3, 6, (6, 3, 4)) * (rng.random((6, 3, 4)) > 0.1)).astype(np.float32)
+    source = FrameSource(4, 3, SENSOR_KIND, iter([(frames, times)]))
+    settings_ = config["events"]
+    params, _ = pixel_and_sensor(settings_)
+    output = tmp_path_factory.mktemp("events") / "events.h5"
+    emulate_with_settings(source, params, settings_, seed, output, "drawn", chunk=8)
+    events, _ = read_events(output)
+    assert np.all(np.diff(events["t"].astype(np.int64)) >= 0)
+    assert events["t"].max(initial=0) <= round(1e6 * times[-1])
+    assert np.all(events["x"] < 4) and np.all(events["y"] < 3)

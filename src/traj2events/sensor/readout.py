@@ -14,6 +14,8 @@ The readout then passes at most `max_event_rate_hz` events per second:
     event is dropped when the events kept in the 1 ms before it, itself included, would
     exceed rate x 1 ms: no 1 ms window holds more. The dropped ones are counted per cause
     (events.h5 attributes `readout_dropped_<label>`).
+The recording ends at its last frame: events that would leave after it (a queue still
+draining, a latency past the end) are not recorded, and are counted as dropped too.
 Times are integer microseconds, as events.h5 stores them.
 """
 
@@ -25,6 +27,9 @@ from numba import njit
 from ..settings.events import ReadoutParams
 
 WINDOW_US = 1000  # the drop mode's window
+# A departure past int64's microseconds (292,000 years: a rate limit near 0) is taken as
+# never: it leaves after any recording's end (the cast would wrap to a negative time).
+NEVER_US = np.iinfo(np.int64).max
 
 
 @njit(cache=True, nogil=True)
@@ -39,7 +44,8 @@ def _queue(arrival_us, spacing_us, busy_start_us, queued):
         arrival = float(arrival_us[k])
         if arrival >= busy_start_us + queued * spacing_us:  # the queue is empty: a new busy period
             busy_start_us, queued = arrival, 0
-        out[k] = np.int64(np.floor(busy_start_us + queued * spacing_us))
+        departure = np.floor(busy_start_us + queued * spacing_us)
+        out[k] = np.int64(departure) if departure < 9.2e18 else NEVER_US
         queued += 1
     return out, busy_start_us, queued
 
@@ -66,13 +72,15 @@ class Readout:
     """The readout of one recording, interval by interval (events sorted by crossing time,
     intervals in time order): `process` returns the events sure to leave before any event
     still to come (those arriving by the latest crossing seen: a later crossing cannot
-    arrive before it), sorted by output time; `flush` the rest at the end."""
+    arrive before it, nor leave the arbiter's queue before it), sorted by output time;
+    `flush` the rest that leave by the recording's end."""
 
     def __init__(self, params: ReadoutParams, seed: int, n_labels: int):
         self.params = params
         delays = params.jitter_s or params.latency_s
         self.rng = np.random.Generator(np.random.PCG64([seed, 0x7EAD0])) if delays else None  # its own stream
-        self.held: dict[str, np.ndarray] | None = None
+        self.held: dict[str, np.ndarray] | None = None  # travelling: not yet through the limit
+        self.leaving: dict[str, np.ndarray] | None = None  # through it, leaving after the latest crossing
         self.busy_start_us, self.queued = -np.inf, 0  # the arbiter's busy period (`_queue`)
         per_window = int(np.floor(params.max_event_rate_hz * WINDOW_US * 1e-6))
         self.ring = np.empty(max(per_window, 1), np.int64)
@@ -95,11 +103,29 @@ class Readout:
         columns = {name: values[order] for name, values in columns.items()}
         leave = int(np.searchsorted(columns["t"], self.latest_crossing_us, side="right"))
         self.held = {name: values[leave:] for name, values in columns.items()}
-        return self._limit({name: values[:leave] for name, values in columns.items()})
+        out = self._leaving(self._limit({name: values[:leave] for name, values in columns.items()}))
+        leave = int(np.searchsorted(out["t"], self.latest_crossing_us, side="right"))  # the queue's backlog waits
+        self.leaving = {name: values[leave:] for name, values in out.items()}
+        return {name: values[:leave] for name, values in out.items()}
 
-    def flush(self):
-        out, self.held = self.held, None
-        return self._limit(out)
+    def flush(self, end_us: int):
+        """The events still travelling or queued that leave by `end_us`, the recording's
+        last frame; the later ones are counted as dropped."""
+        out, self.held = self._leaving(self._limit(self.held)), None
+        self.leaving = None
+        if out is None:
+            return None
+        late = out["t"] > end_us
+        causes = out["label"][late] if "label" in out else np.zeros(int(late.sum()), np.int64)
+        self.dropped += np.bincount(causes, minlength=len(self.dropped))
+        return {name: values[~late] for name, values in out.items()}
+
+    def _leaving(self, columns: dict[str, np.ndarray] | None):
+        """The events already through the limit and not yet returned, then `columns` (which
+        leave after them: the queue keeps their order, the other modes leave none behind)."""
+        if self.leaving is None or columns is None:
+            return columns if columns is not None else self.leaving
+        return {name: np.concatenate([self.leaving[name], columns[name]]) for name in columns}
 
     def _limit(self, columns: dict[str, np.ndarray] | None):
         if columns is None or not len(columns["t"]):

@@ -116,7 +116,7 @@ def emulate(
         write({k: due[k] for k in EVENT_DTYPE.names}, due["label"] if labels else None)
         writer.annotate({"space_hits": space.hits, "space_glitches": space.glitches})
     if stream is not None:
-        events = stream.flush()
+        events = stream.flush(int(round(t_last * 1e6)))
         if events is not None:
             writer.append(events, events.get("label"))
             n_events += len(events["t"])
