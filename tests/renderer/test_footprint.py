@@ -125,3 +125,114 @@ def test_area_weights_are_within_their_bound_of_the_exact_overlaps(n_from, shrin
     weights = area_weights(n_from, n_to)
     assert np.all(weights[overlap == 0] == 0)
     assert np.abs(weights - exact).max() <= 2 * n_to * np.finfo(float).eps
+
+
+# The box read (shaders/footprint.glsl) drawn by OpenGL itself: one fragment per query.
+QUERY_VERT = """#version 330 core
+void main() { vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2); gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0); }
+"""
+QUERY_FRAG = """#version 330 core
+uniform sampler2DArray shading;
+uniform sampler2D queries;  // row 0: texel_at, across; row 1: down
+#include "footprint.glsl"
+out vec4 mean;
+void main() {
+    vec4 a = texelFetch(queries, ivec2(int(gl_FragCoord.x), 0), 0);
+    vec4 b = texelFetch(queries, ivec2(int(gl_FragCoord.x), 1), 0);
+    mean = footprint_mean(shading, a.xy, 0.0, a.zw, b.xy);
+}
+"""
+
+
+def shader_box_means(texture, texel_at, across, down):
+    """footprint_mean (FOOTPRINT_BOX) of a (side, side, 4) texture, uploaded as the renderer
+    uploads it (ShadingArray: its levels, RGBA16F), at each query: (n, 4) float32."""
+    import os
+
+    from traj2events.renderer.context import gl_context
+    from traj2events.renderer.draw import expand_includes, with_defines
+    from traj2events.renderer.shading_array import ShadingArray
+
+    n = len(texel_at)
+    context = gl_context(os.environ.get("TRAJ2EVENTS_TEST_BACKEND", "osmesa"), n, 1)
+    from OpenGL import GL as gl
+
+    program = gl.glCreateProgram()
+    fragment = with_defines(expand_includes(QUERY_FRAG), ("FOOTPRINT_BOX",))
+    for kind, source in ((gl.GL_VERTEX_SHADER, QUERY_VERT), (gl.GL_FRAGMENT_SHADER, fragment)):
+        shader = gl.glCreateShader(kind)
+        gl.glShaderSource(shader, source)
+        gl.glCompileShader(shader)
+        assert gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS), gl.glGetShaderInfoLog(shader)
+        gl.glAttachShader(program, shader)
+    gl.glLinkProgram(program)
+    gl.glUseProgram(program)
+    ShadingArray(gl, 2, texture.shape[0], "box", 2**30).upload(0, texture)
+    queries = np.zeros((2, n, 4), np.float32)
+    queries[0, :, :2], queries[0, :, 2:], queries[1, :, :2] = texel_at, across, down
+    gl.glActiveTexture(gl.GL_TEXTURE3)
+    gl.glBindTexture(gl.GL_TEXTURE_2D, gl.glGenTextures(1))
+    gl.glTexImage2D(gl.GL_TEXTURE_2D, 0, gl.GL_RGBA32F, n, 2, 0, gl.GL_RGBA, gl.GL_FLOAT, queries)
+    gl.glTexParameteri(gl.GL_TEXTURE_2D, gl.GL_TEXTURE_MIN_FILTER, gl.GL_NEAREST)  # no levels: complete
+    for name, value in (("shading", 2), ("queries", 3)):
+        gl.glUniform1i(gl.glGetUniformLocation(program, name), value)
+    gl.glUniform1f(gl.glGetUniformLocation(program, "texture_side"), float(texture.shape[0]))
+    gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, gl.glGenRenderbuffers(1))
+    gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RGBA32F, n, 1)
+    gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, gl.glGenFramebuffers(1))
+    gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER,
+                                 gl.glGetIntegerv(gl.GL_RENDERBUFFER_BINDING))  # fmt: skip
+    gl.glViewport(0, 0, n, 1)
+    gl.glBindVertexArray(gl.glGenVertexArrays(1))
+    gl.glDrawArrays(gl.GL_TRIANGLES, 0, 3)
+    means = np.frombuffer(gl.glReadPixels(0, 0, n, 1, gl.GL_RGBA, gl.GL_FLOAT), np.float32).reshape(n, 4)
+    context.delete_context()
+    return means
+
+
+def exact_box_means(texture, texel_at, across, down):
+    """The box's exact mean over its level's texels as constants (footprint.box_footprint:
+    the level, the box), each texel weighted by its overlap with the box, clamped at the
+    texture's edge; the levels as stored (half floats), in float64."""
+    levels = [np.asarray(level, np.float16).astype(np.float64) for level in mip_levels(texture)]
+    means = []
+    for at, a, b in zip(texel_at, across, down, strict=True):
+        k, box = footprint.box_footprint(np.sqrt(np.square(a, dtype=float) + np.square(b, dtype=float)), len(levels))
+        n_k = len(levels[k])
+        centre = (at.astype(float) + 0.5) * n_k / texture.shape[0] - 0.5
+        weights = []
+        for lo, hi in zip(centre - box / 2, centre + box / 2, strict=True):
+            j = np.arange(np.floor(lo), np.ceil(hi) + 1)
+            w = np.zeros(n_k)
+            np.add.at(
+                w,
+                np.clip(j, 0, n_k - 1).astype(int),
+                np.clip(np.minimum(hi, j + 0.5) - np.maximum(lo, j - 0.5), 0, None),
+            )
+            weights.append(w / w.sum())
+        means.append(np.einsum("b,a,abc->c", weights[0], weights[1], levels[k]))  # s along columns, t along rows
+    return np.array(means)
+
+
+@pytest.mark.accuracy
+@pytest.mark.parametrize("side", [5, 65, 1025])
+def test_the_shaders_box_read_is_within_its_bound_of_the_exact_box_mean(side):
+    """Its stated bound (docs/accuracy.md): the shader's box mean, two bilinear reads a side
+    standing for four texels' weights, within 2 eps32 max(side, 8) of the texels' range of
+    the exact overlap-weighted mean (float32 texture coordinates: an ulp of 1 is side x
+    eps32 texels), for footprints 0.01 texel to the whole texture, at any aspect, anywhere
+    on it, on llvmpipe (a GPU's texture unit weighs a bilinear read in its own fixed point,
+    8 fractional bits on NVIDIA's: TRAJ2EVENTS_TEST_BACKEND=egl measures it there)."""
+    rng = np.random.default_rng(side)
+    texture = rng.random((side, side, 4)).astype(np.float32)
+    n = 400
+    texel_at = rng.uniform(-0.5, side - 0.5, (n, 2)).astype(np.float32)
+    size, angle, aspect = (
+        10 ** rng.uniform(-2, np.log10(side), n),
+        rng.uniform(0, 2 * np.pi, n),
+        10 ** rng.uniform(-1, 1, n),
+    )
+    across = (np.stack([np.cos(angle), np.sin(angle)], -1) * size[:, None]).astype(np.float32)
+    down = (np.stack([-np.sin(angle), np.cos(angle)], -1) * (size * aspect)[:, None]).astype(np.float32)
+    error = np.abs(shader_box_means(texture, texel_at, across, down) - exact_box_means(texture, texel_at, across, down))
+    assert error.max() <= 2 * np.finfo(np.float32).eps * max(side, 8) * np.ptp(texture)
