@@ -45,7 +45,7 @@ def _queue(arrival_us, spacing_us, busy_start_us, queued):
         if arrival >= busy_start_us + queued * spacing_us:  # the queue is empty: a new busy period
             busy_start_us, queued = arrival, 0
         departure = np.floor(busy_start_us + queued * spacing_us)
-        out[k] = np.int64(departure) if departure < 9.2e18 else NEVER_US
+        out[k] = np.int64(departure) if departure < 2.0**63 else NEVER_US
         queued += 1
     return out, busy_start_us, queued
 
@@ -97,35 +97,25 @@ class Readout:
         if self.rng is not None:
             delay = self.rng.normal(self.params.latency_s * 1e6, self.params.jitter_s * 1e6, len(columns["t"]))
             columns["t"] = columns["t"].astype(np.int64) + np.round(np.maximum(delay, 0.0)).astype(np.int64)
-        if self.held is not None:  # the last intervals' events still travelling
-            columns = {name: np.concatenate([self.held[name], columns[name]]) for name in columns}
+        columns = _joined(self.held, columns)  # the last intervals' events still travelling, first
         order = np.argsort(columns["t"], kind="stable")
         columns = {name: values[order] for name, values in columns.items()}
-        leave = int(np.searchsorted(columns["t"], self.latest_crossing_us, side="right"))
-        self.held = {name: values[leave:] for name, values in columns.items()}
-        out = self._leaving(self._limit({name: values[:leave] for name, values in columns.items()}))
-        leave = int(np.searchsorted(out["t"], self.latest_crossing_us, side="right"))  # the queue's backlog waits
-        self.leaving = {name: values[leave:] for name, values in out.items()}
-        return {name: values[:leave] for name, values in out.items()}
+        ready, self.held = _split(columns, self.latest_crossing_us)
+        out, self.leaving = _split(_joined(self.leaving, self._limit(ready)), self.latest_crossing_us)  # backlog waits
+        return out
 
     def flush(self, end_us: int):
         """The events still travelling or queued that leave by `end_us`, the recording's
         last frame; the later ones are counted as dropped."""
-        out, self.held = self._leaving(self._limit(self.held)), None
-        self.leaving = None
-        if out is None:
-            return None
-        late = out["t"] > end_us
-        causes = out["label"][late] if "label" in out else np.zeros(int(late.sum()), np.int64)
-        self.dropped += np.bincount(causes, minlength=len(self.dropped))
-        return {name: values[~late] for name, values in out.items()}
+        out = _joined(self.leaving, self._limit(self.held))
+        self.held = self.leaving = None
+        return None if out is None else self._drop(out, out["t"] > end_us)
 
-    def _leaving(self, columns: dict[str, np.ndarray] | None):
-        """The events already through the limit and not yet returned, then `columns` (which
-        leave after them: the queue keeps their order, the other modes leave none behind)."""
-        if self.leaving is None or columns is None:
-            return columns if columns is not None else self.leaving
-        return {name: np.concatenate([self.leaving[name], columns[name]]) for name in columns}
+    def _drop(self, columns: dict[str, np.ndarray], dropped: np.ndarray) -> dict[str, np.ndarray]:
+        """`columns` without the `dropped` events, counted per cause."""
+        causes = columns["label"][dropped] if "label" in columns else np.zeros(int(dropped.sum()), np.int64)
+        self.dropped += np.bincount(causes, minlength=len(self.dropped))
+        return {name: values[~dropped] for name, values in columns.items()}
 
     def _limit(self, columns: dict[str, np.ndarray] | None):
         if columns is None or not len(columns["t"]):
@@ -139,7 +129,19 @@ class Readout:
             keep, self.head, self.count = _rate_control(
                 columns["t"].astype(np.int64), self.ring, self.head, self.count, WINDOW_US
             )
-            causes = columns["label"][~keep] if "label" in columns else np.zeros(int((~keep).sum()), np.int64)
-            self.dropped += np.bincount(causes, minlength=len(self.dropped))
-            columns = {name: values[keep] for name, values in columns.items()}
+            columns = self._drop(columns, ~keep)
         return columns
+
+
+def _joined(first: dict[str, np.ndarray] | None, then: dict[str, np.ndarray] | None):
+    """Two sets of event columns, `first`'s events before `then`'s (either may be None)."""
+    if first is None or then is None:
+        return then if first is None else first
+    return {name: np.concatenate([first[name], then[name]]) for name in then}
+
+
+def _split(columns: dict[str, np.ndarray], t_us: int) -> tuple[dict, dict]:
+    """(the events up to t_us, the later ones) of columns sorted by time."""
+    k = int(np.searchsorted(columns["t"], t_us, side="right"))
+    before = {name: values[:k] for name, values in columns.items()}
+    return before, {name: values[k:] for name, values in columns.items()}
