@@ -168,6 +168,16 @@ def test_tile_slots_grow_and_keep_what_they_hold(monkeypatch, lod):
     assert np.array_equal(grown.radiance, reference.radiance) and np.array_equal(grown.depth_m, reference.depth_m)
 
 
+def cast_on_the_drawn_mesh(tiles, camera, pose, rows, cols):
+    """(distance to the mesh of the tiles drawn for `pose` along each pixel's ray, or inf;
+    the unit rays, inertial) for pixels (rows, cols)."""
+    keys = tiles.select(pose, camera.pinhole_cover())
+    triangles = np.concatenate([tiles.tile(k).vertices[tiles.tile(k).faces] + tiles.tile(k).centre for k in keys])
+    rays = camera.back_project(cols + 0.5 - camera.width / 2, rows + 0.5 - camera.height / 2) @ pose.rotation.T
+    rays /= np.linalg.norm(rays, axis=1, keepdims=True)
+    return ray_cast(pose.position, rays, triangles), rays
+
+
 @pytest.mark.parametrize("distortion", [PINHOLE, Distortion(k1=-0.3, k2=0.08, p1=0.002)], ids=["pinhole", "lens"])
 def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km(distortion):
     """Through a distorting lens, each pixel's depth is the mesh's along that pixel's own
@@ -175,14 +185,8 @@ def test_depth_matches_a_ray_cast_on_the_mesh_at_5_km(distortion):
     camera = Camera(48, 48, 45.0, distortion=distortion)
     pose = camera_pose(state(x=-3000.0, altitude=5000.0, pitch=20.0, roll=3.0, yaw=10.0))
     frame, tiles = render(ProceduralTerrain(TerrainParams(seed=11)), camera, pose)
-    keys = tiles.select(pose, camera.pinhole_cover())
-    triangles = np.concatenate([tiles.tile(k).vertices[tiles.tile(k).faces] + tiles.tile(k).centre for k in keys])
     rows, cols = np.meshgrid(np.arange(3, 48, 9), np.arange(3, 48, 9), indexing="ij")
-    x_s, y_s = cols.ravel() + 0.5 - 24, rows.ravel() + 0.5 - 24
-    rays_cam = camera.back_project(x_s, y_s)
-    dirs = rays_cam @ pose.rotation.T
-    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
-    distance = ray_cast(pose.position, dirs, triangles)
+    distance, dirs = cast_on_the_drawn_mesh(tiles, camera, pose, rows.ravel(), cols.ravel())
     depth_cast = distance * (dirs @ pose.rotation[:, 2])
     depth_render = frame.depth_m[rows.ravel(), cols.ravel()]
     assert np.all(np.isfinite(depth_cast)) and depth_cast.min() > 4000
@@ -214,13 +218,9 @@ def test_float32_depth_is_within_4_eps_kappa_of_a_float64_ray_cast(altitude_m, p
     pose = camera_pose(state(x=-0.5 * altitude_m * np.tan(np.radians(pitch_deg)), altitude=altitude_m,
                              pitch=pitch_deg, yaw=20.0))  # fmt: skip
     frame, tiles = render(sphere, camera, pose, half_extent=400e3, scattered_azimuths=0, lod=QUICK)
-    keys = tiles.select(pose, camera.pinhole_cover())
-    triangles = np.concatenate([tiles.tile(k).vertices[tiles.tile(k).faces] + tiles.tile(k).centre for k in keys])
     rows, cols = np.meshgrid(np.arange(0, height, max(height // 12, 1)), np.arange(0, width, max(width // 12, 1)),
                              indexing="ij")  # fmt: skip
-    rays = camera.back_project(cols.ravel() + 0.5 - width / 2, rows.ravel() + 0.5 - height / 2) @ pose.rotation.T
-    rays /= np.linalg.norm(rays, axis=1, keepdims=True)
-    distance = ray_cast(pose.position, rays, triangles)
+    distance, rays = cast_on_the_drawn_mesh(tiles, camera, pose, rows.ravel(), cols.ravel())
     ground = np.isfinite(distance)
     normal = pose.position[None] + distance[ground, None] * rays[ground] - [0.0, 0.0, R_MOON]
     kappa = np.linalg.norm(normal, axis=1) / np.abs(np.einsum("ij,ij->i", rays[ground], normal))
