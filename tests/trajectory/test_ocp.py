@@ -1,5 +1,7 @@
 """The optimal-control problem: constraints hold, accuracy scales with N, and the edges."""
 
+import functools
+
 import casadi as ca
 import numpy as np
 import pytest
@@ -143,6 +145,7 @@ def test_settings_reject_bad_values():
         OcpSettings(n_nodes=40, refine_n_nodes=30)
 
 
+@functools.cache  # a CasADi function of the problem's constraints: built once per problem
 def nlp_defects(problem: LandingProblem):
     """The NLP's own Hermite-Simpson defects (its first constraint, N_STATE x (N - 1)) as a
     function of the nodes' physical states, t_f and constant physical commands: (N - 1, 13)

@@ -6,8 +6,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from traj2events.settings.vehicle import Vehicle
-from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.state import MASS
 from traj2events.trajectory.upsample import (
     ATOL,
@@ -20,9 +18,6 @@ from traj2events.trajectory.upsample import (
     upsample,
 )
 from trajectory.test_state import exact_rotation
-
-VEHICLE = Vehicle()
-DYNAMICS = Dynamics(VEHICLE)  # once: a CasADi function takes a while to build
 
 
 def test_frame_times_cover_zero_to_tf():
@@ -134,13 +129,15 @@ def exact_burn(vehicle, x0: np.ndarray, u: np.ndarray, t: float) -> np.ndarray:
 @settings(max_examples=max(settings.default.max_examples // 10, 10))  # an integration each: fewer examples
 @given(st.booleans(), st.floats(0.05, 1.0), st.floats(-1.0, 1.0), st.floats(-1.2, 1.2), st.floats(-1.2, 1.2),
        st.floats(-np.pi, np.pi), st.floats(5.0, 120.0), st.integers(1, 40), st.floats(6500.0, 9472.06))  # fmt: skip
-def test_reintegration_is_within_its_bound_of_the_closed_form(engine, throttle, couple, phi, theta, psi, tf, n, m0):
+def test_reintegration_is_within_its_bound_of_the_closed_form(
+    dynamics, engine, throttle, couple, phi, theta, psi, tf, n, m0
+):
     """Its stated bound (docs/accuracy.md): every state within 4 ATOL (4e-7 m, 4e-8 m/s,
     4e-10 rad, 4e-11 rad/s, 4e-6 kg) of the closed-form burn at 50 digits, over 5..120 s
     cut in 1..40 intervals of uneven length, any held attitude with pitch within 70 deg."""
     x0 = np.array([100.0, -50.0, -2000.0, 40.0, 3.0, -5.0, phi, theta, psi, 0.0, 0.0, 0.0, m0])
     u = np.array([throttle, 0.0, 0.0, 0.0]) if engine else np.array([0.0, couple, 0.0, 0.0])
     t_nodes = np.sort(np.concatenate([[0.0, tf], np.random.default_rng(n).uniform(0.0, tf, n - 1)]))
-    _, final = reintegrate(DYNAMICS, t_nodes, x0, np.tile(u, (n + 1, 1)))
-    error = np.abs(final - exact_burn(VEHICLE, x0, u, tf))
+    _, final = reintegrate(dynamics, t_nodes, x0, np.tile(u, (n + 1, 1)))
+    error = np.abs(final - exact_burn(dynamics.vehicle, x0, u, tf))
     assert np.all(error <= 4 * ATOL), error / ATOL
