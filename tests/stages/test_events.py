@@ -9,8 +9,10 @@ from hypothesis import strategies as st
 from PIL import Image
 from scipy.special import erf
 
+from normal_floats import normal_floats
 from traj2events.formats.events import EVENT_LABELS, read_events
 from traj2events.sensor.sources import frame_source
+from traj2events.settings.declare import declared_fields
 from traj2events.settings.events import EmulatorParams, ReadoutParams, SpaceParams
 from traj2events.stages.events import emulate, preset_params
 from traj2events.stages.pictures import events_picture
@@ -366,9 +368,6 @@ OPEN_CAPS = {"Hz": 1e4, "s": 0.05, "ln": 5.0, "cm^-2 s^-1": 1e5, "": 1.0}
 def declared_values(cls, **caps):
     """A strategy for a section's every key, drawn across its declared bounds (open ones
     capped by unit, OPEN_CAPS, or by `caps`): floats 0 or >= 1e-100, choices, booleans."""
-    from normal_floats import normal_floats
-    from traj2events.settings.declare import declared_fields
-
     keys = {}
     for f in declared_fields(cls):
         meta, bounds = f.metadata, f.metadata["bounds"]
