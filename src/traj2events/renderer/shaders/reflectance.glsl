@@ -23,10 +23,21 @@ float chandrasekhar_h(float x)
     return 1.0 / (1.0 - w * x * (hapke_r0 + 0.5 * (1.0 - 2.0 * hapke_r0 * x) * log_term));
 }
 
-// One Henyey-Greenstein lobe in phase angle: peaks at g = 0 (backscatter) for b > 0.
+// One Henyey-Greenstein lobe in phase angle: peaks at g = 0 (backscatter) for b > 0. Its
+// base a sum of positives (reflectance.henyey_greenstein: the textbook form cancels).
 float hg(float b_, float cos_g)
 {
-    return (1.0 - b_ * b_) / pow(1.0 - 2.0 * b_ * cos_g + b_ * b_, 1.5);
+    float a = abs(b_);
+    float toward_peak = b_ >= 0.0 ? cos_g : -cos_g;
+    return (1.0 - a) * (1.0 + a) / pow((1.0 - a) * (1.0 - a) + 2.0 * a * (1.0 - toward_peak), 1.5);
+}
+
+// Shadow hiding's B(g) = B0 / (1 + tan(g / 2) / h) (reflectance.opposition_surge: no
+// division by zero, no tan near 180 deg).
+float opposition_surge(float cos_g)
+{
+    float toward = hw * sqrt(1.0 + cos_g);
+    return b0 * toward / (toward + sqrt(1.0 - cos_g));
 }
 
 // The part of the law that depends on the phase angle alone (Hapke: (1 + B(g)) P(g);
@@ -36,9 +47,7 @@ float phase_term(float cos_g)
 {
     cos_g = clamp(cos_g, -1.0, 1.0);
     if (model == 0) {
-        float g = acos(cos_g);
-        float opposition = b0 / (1.0 + tan(0.5 * g) / hw);
-        return (1.0 + opposition) * (0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g));
+        return (1.0 + opposition_surge(cos_g)) * (0.5 * (1.0 + c) * hg(b, cos_g) + 0.5 * (1.0 - c) * hg(-b, cos_g));
     }
     float g = degrees(acos(cos_g));
     return clamp(1.0 - 0.019 * g + 2.42e-4 * g * g - 1.46e-6 * g * g * g, 0.0, 1.0);
