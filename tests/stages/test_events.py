@@ -9,10 +9,9 @@ from hypothesis import strategies as st
 from PIL import Image
 from scipy.special import erf
 
-from normal_floats import normal_floats
+from declared_values import declared_values
 from traj2events.formats.events import EVENT_LABELS, read_events
 from traj2events.sensor.sources import frame_source
-from traj2events.settings.declare import declared_fields
 from traj2events.settings.events import EmulatorParams, ReadoutParams, SpaceParams
 from traj2events.stages.events import emulate, preset_params
 from traj2events.stages.pictures import events_picture
@@ -358,29 +357,6 @@ def test_the_standalone_emulator_takes_a_window_a_crop_a_size_and_timestamps(tmp
     assert main([*argv, "-o", str(tmp_path / "missing" / "e.h5")]) == 2
     assert not (tmp_path / "missing").exists()
     assert progress_line(50, 200, 7, 10.0) == "  50/200 frames (25 %, ETA 30 s), 7 events, 5 frames/s"
-
-
-# Caps on the bounds the declarations leave open (a rate's ge=0 and no more): events enough
-# to exercise every law in a 3 x 4 image over 0.4 s, few enough to stay a unit test.
-OPEN_CAPS = {"Hz": 1e4, "s": 0.05, "ln": 5.0, "cm^-2 s^-1": 1e5, "": 1.0}
-
-
-def declared_values(cls, **caps):
-    """A strategy for a section's every key, drawn across its declared bounds (open ones
-    capped by unit, OPEN_CAPS, or by `caps`): floats 0 or >= 1e-100, choices, booleans."""
-    keys = {}
-    for f in declared_fields(cls):
-        meta, bounds = f.metadata, f.metadata["bounds"]
-        if meta["choices"]:
-            keys[f.name] = st.sampled_from(meta["choices"])
-        elif f.type in ("bool", bool):
-            keys[f.name] = st.booleans()
-        elif f.type in ("float", float):
-            lo = bounds.get("ge", bounds.get("gt", 0.0))
-            hi = bounds.get("le", bounds.get("lt"))
-            hi = min(hi if hi is not None else np.inf, caps.get(f.name, OPEN_CAPS.get(meta["unit"], np.inf)))
-            keys[f.name] = normal_floats(lo, hi).filter(lambda x, b=bounds: x > b.get("gt", -np.inf))
-    return st.fixed_dictionaries(keys)
 
 
 @settings(max_examples=max(settings.default.max_examples // 6, 10), deadline=None)

@@ -1,0 +1,108 @@
+"""The render stage driven by configs the check accepts: the reflectance law and the Sun
+drawn across their declared bounds (docs/accuracy.md "End-to-end stress")."""
+
+import h5py
+import numpy as np
+import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from declared_values import declared_values
+from normal_floats import normal_floats
+from traj2events.config import ConfigError, resolve_config
+from traj2events.formats.trajectory import write_trajectory
+from traj2events.geometry.camera import Camera
+from traj2events.renderer.law_uniforms import law_uniforms
+from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
+from traj2events.scene.sun import Sun
+from traj2events.settings.render import RenderSettings
+from traj2events.stages.render import render_trajectory
+
+WIDTH, HEIGHT = 8, 6
+
+
+def write_poses(path, altitude_m: float, pitch_deg: float, fps: float = 10.0) -> None:
+    """Two poses of a camera `altitude_m` up, pitched `pitch_deg` toward the horizon, moving
+    1 m forward between them."""
+    t = np.array([0.0, 1.0 / fps])
+    state = np.zeros((2, 13))
+    state[:, 0], state[:, 2], state[:, 7], state[:, 12] = [0.0, 1.0], -altitude_m, np.radians(pitch_deg), 1000.0
+    nodes = (t, state, np.zeros((2, 4)))
+    write_trajectory(path, nodes, nodes, {"fps": fps, "scenario": "descent", "id": 0, "tf_s": t[-1]}, 1.0)
+
+
+@settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)
+@example({"opposition_b0": 10.0}, 0.0, 45.0, 100.0, 0.0)  # the surge's largest, the Sun behind the camera
+@given(
+    declared_values(ReflectanceParams), st.floats(-360.0, 360.0), normal_floats(0.0, 90.0),
+    st.floats(2.0, 3000.0), st.floats(0.0, 80.0),
+)  # fmt: skip
+def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radiance(
+    tmp_path_factory, reflectance, sun_azimuth_deg, sun_elevation_deg, altitude_m, pitch_deg
+):
+    """Issue 71: render.reflectance (either law, every parameter) and the scenario's Sun
+    drawn across their declared bounds; for each config the check accepts, the render stage
+    over flat ground (seen from 2 m to 3 km up, to 80 deg toward the horizon) writes
+    radiance that is finite, >= 0 and at most the law's brightest (law_uniforms'
+    radiance_max), and a depth that is finite and > 0 on the ground."""
+    folder = tmp_path_factory.mktemp("render")
+    np.save(folder / "flat.npy", np.zeros((8, 8)))
+    overlay = {
+        "camera": {"width": WIDTH, "height": HEIGHT, "fps": 10.0, "mount_height_m": 1.0},
+        "terrain": {"elevation_grid": str(folder / "flat.npy"), "grid_spacing_m": 1e4},
+        "render": {"reflectance": reflectance, "preview": False, "tile_cache": None},
+        "scenarios": {"descent": {"sun": {"azimuth_deg": sun_azimuth_deg, "elevation_deg": sun_elevation_deg}}},
+    }
+    try:
+        config = resolve_config(overlay)
+    except ConfigError:
+        return
+    write_poses(folder / "trajectory.h5", altitude_m, pitch_deg)
+    render = RenderSettings.from_config(config, "descent")
+    render_trajectory(folder / "trajectory.h5", render, folder / "frames.h5", folder / "video.mkv", None, "osmesa")
+    with h5py.File(folder / "frames.h5") as f:
+        radiance, depth = f["radiance"][:], f["depth_m"][:]
+    law, sun = ReflectanceParams(**render.reflectance), Sun(**render.sun)
+    assert np.all(np.isfinite(radiance)) and np.all(radiance >= 0)
+    assert radiance.max() <= law_uniforms(law, sun)["radiance_max"] * (1 + 1e-3)
+    ground = depth[0] > 0
+    assert ground.any() and np.all(np.isfinite(depth[0][ground]))
+    if sun_elevation_deg <= 2 * np.degrees(sun.angular_radius_rad):
+        return  # the Sun's disk partly below the horizon: lit by the part above (scene.illumination)
+    expected = np.full(depth[0].shape, np.nan)
+    expected[ground] = radiance_on_the_sphere(render, law, sun, depth[0], ground, altitude_m, pitch_deg)
+    # A pixel is the law's mean over its footprint: within the law's change to its neighbours.
+    padded = np.pad(expected, 1, constant_values=np.nan)
+    neighbours = [padded[1 + dy : padded.shape[0] - 1 + dy, 1 + dx : padded.shape[1] - 1 + dx]
+                  for dy, dx in ((-1, 0), (1, 0), (0, -1), (0, 1))]  # fmt: skip
+    change = np.nanmax(np.abs(np.array(neighbours) - expected), axis=0, initial=0.0)
+    error = np.abs(radiance[0] - expected)
+    assert np.all(error[ground] <= 0.02 * expected[ground] + change[ground]), (radiance[0], expected)
+
+
+def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_deg):
+    """The law (numpy, float64) at the ground pixels' points of the first pose: the normal
+    is the Moon's radial vertical there, the Sun's direction the same everywhere."""
+    camera = Camera.from_settings(vars(render))
+    state = np.zeros(13)
+    state[2], state[7], state[12] = -altitude_m, np.radians(pitch_deg), 1000.0
+    pose = camera.pose(state)
+    x_s, y_s = np.broadcast_arrays(*camera.pixel_coordinates())
+    points = (
+        pose.position + (camera.back_project(x_s[ground], y_s[ground]) * depth_m[ground][:, None]) @ pose.rotation.T
+    )
+    normal = points - [0.0, 0.0, render.moon_radius_m]  # the centre, below the site (z down)
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    to_camera = pose.position - points
+    to_camera /= np.linalg.norm(to_camera, axis=-1, keepdims=True)
+    to_sun = np.broadcast_to(sun.direction, points.shape)
+    return radiance_factor(*angles(normal, to_sun, to_camera), law) * sun.irradiance_w_m2 / np.pi
+
+
+def test_a_surge_whose_scattered_light_leaves_float32_is_refused():
+    """B0 1e25 (the search's counterexample, the check's bound lifted) rendered black
+    frames: the law's albedo squared, the weight of the light scattered into shadows, is
+    1e48, past float32, and inf times no scattered light a NaN, clamped to 0. The check
+    now bounds B0 (at most 10)."""
+    with pytest.raises(ConfigError, match="render.reflectance.opposition_b0"):
+        resolve_config({"render": {"reflectance": {"opposition_b0": 1e25}}})
