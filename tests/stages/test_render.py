@@ -21,12 +21,19 @@ from traj2events.stages.render import render_trajectory
 WIDTH, HEIGHT = 8, 6
 
 
+def lander_state(x_m: float, altitude_m: float, pitch_deg: float) -> np.ndarray:
+    """The lander `altitude_m` above the site, `x_m` down-range, pitched `pitch_deg` (its
+    camera toward the horizon), at rest."""
+    state = np.zeros(13)
+    state[0], state[2], state[7], state[12] = x_m, -altitude_m, np.radians(pitch_deg), 1000.0
+    return state
+
+
 def write_poses(path, altitude_m: float, pitch_deg: float, fps: float = 10.0) -> None:
     """Two poses of a camera `altitude_m` up, pitched `pitch_deg` toward the horizon, moving
     1 m forward between them."""
     t = np.array([0.0, 1.0 / fps])
-    state = np.zeros((2, 13))
-    state[:, 0], state[:, 2], state[:, 7], state[:, 12] = [0.0, 1.0], -altitude_m, np.radians(pitch_deg), 1000.0
+    state = np.array([lander_state(x, altitude_m, pitch_deg) for x in (0.0, 1.0)])
     nodes = (t, state, np.zeros((2, 4)))
     write_trajectory(path, nodes, nodes, {"fps": fps, "scenario": "descent", "id": 0, "tf_s": t[-1]}, 1.0)
 
@@ -44,7 +51,9 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     drawn across their declared bounds; for each config the check accepts, the render stage
     over flat ground (seen from 2 m to 3 km up, to 80 deg toward the horizon) writes
     radiance that is finite, >= 0 and at most the law's brightest (law_uniforms'
-    radiance_max), and a depth that is finite and > 0 on the ground."""
+    radiance_max), a depth that is finite and > 0 on the ground, and, with the Sun's disk
+    wholly up, each ground pixel within 2 % of the law at its centre plus the law's change
+    to its neighbours."""
     folder = tmp_path_factory.mktemp("render")
     np.save(folder / "flat.npy", np.zeros((8, 8)))
     overlay = {
@@ -68,7 +77,7 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     ground = depth[0] > 0
     assert ground.any() and np.all(np.isfinite(depth[0][ground]))
     if sun_elevation_deg <= 2 * np.degrees(sun.angular_radius_rad):
-        return  # the Sun's disk partly below the horizon: lit by the part above (scene.illumination)
+        return  # the Sun's disk partly below the horizon: lit by the part above (scene.tiles' penumbrae)
     expected = np.full(depth[0].shape, np.nan)
     expected[ground] = radiance_on_the_sphere(render, law, sun, depth[0], ground, altitude_m, pitch_deg)
     # A pixel is the law's mean over its footprint: within the law's change to its neighbours.
@@ -84,9 +93,7 @@ def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_
     """The law (numpy, float64) at the ground pixels' points of the first pose: the normal
     is the Moon's radial vertical there, the Sun's direction the same everywhere."""
     camera = Camera.from_settings(vars(render))
-    state = np.zeros(13)
-    state[2], state[7], state[12] = -altitude_m, np.radians(pitch_deg), 1000.0
-    pose = camera.pose(state)
+    pose = camera.pose(lander_state(0.0, altitude_m, pitch_deg))
     x_s, y_s = np.broadcast_arrays(*camera.pixel_coordinates())
     points = (
         pose.position + (camera.back_project(x_s[ground], y_s[ground]) * depth_m[ground][:, None]) @ pose.rotation.T
