@@ -107,7 +107,7 @@ def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_
 
 
 def test_a_surge_whose_scattered_light_leaves_float32_is_refused():
-    """B0 1e25 (the search's counterexample, the check's bound lifted) rendered black
+    """B0 1e25 (a probe of the bounds' extremes, the check's bound lifted) rendered black
     frames: the law's albedo squared, the weight of the light scattered into shadows, is
     1e48, past float32, and inf times no scattered light a NaN, clamped to 0. The check
     now bounds B0 (at most 10)."""
