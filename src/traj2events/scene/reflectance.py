@@ -70,9 +70,9 @@ def opposition_surge(cos_g: np.ndarray, b0: float, h: float) -> np.ndarray:
 
 def hapke_radiance_factor(mu0: np.ndarray, mu: np.ndarray, cos_g: np.ndarray, p: ReflectanceParams) -> np.ndarray:
     """Hapke's law (module docstring); 0 where mu0 or mu <= 0. Domain and bound: mu0, mu in
-    (0, 1], any phase, every parameter the config accepts: within 8 eps of its terms,
-    (w / 4) mu0 / (mu0 + mu) [(1 + B) P + H(mu0) H(mu)], of the law at 50 digits (the -1
-    cancels against H H only; docs/accuracy.md)."""
+    (0, 1], any phase, every w, b, c the config accepts, B0 0..10, h 1e-4..10: within 8 eps
+    of its terms, (w / 4) mu0 / (mu0 + mu) [(1 + B) P + H(mu0) H(mu)], of the law at 50
+    digits (the -1 cancels against H H only; docs/accuracy.md)."""
     mu0, mu = np.asarray(mu0, dtype=float), np.asarray(mu, dtype=float)
     cos_g = np.clip(np.asarray(cos_g, dtype=float), -1.0, 1.0)
     w = p.single_scattering_albedo
