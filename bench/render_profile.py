@@ -45,7 +45,7 @@ import time
 
 from common import CASES, stretch_renderer
 
-from traj2events.renderer import draw as render_module
+from traj2events.renderer import glsl
 from traj2events.renderer.footprint import TEXTURE_FILTERS
 from traj2events.scene.tiles import LodSettings
 
@@ -85,9 +85,9 @@ PROBES = {
 
 
 def probed_shader_source(old: str, new: str):
-    """render.shader_source with `old` replaced by `new` in PROBED_SHADER; an error if the
+    """glsl.shader_source with `old` replaced by `new` in PROBED_SHADER; an error if the
     shader no longer contains `old`."""
-    committed = render_module.shader_source
+    committed = glsl.shader_source
 
     def source(name: str) -> str:
         text = committed(name)
@@ -103,7 +103,7 @@ def probed_shader_source(old: str, new: str):
 def probe_ms(probe: str, size: int, frames: int) -> float:
     """Median ms per frame over the braking stretch with `probe`'s shaders ("committed": as they are)."""
     if probe != "committed":
-        render_module.shader_source = probed_shader_source(*PROBES[probe])
+        glsl.shader_source = probed_shader_source(*PROBES[probe])
     state, sun, extent = CASES["braking, 2 km, pitch 55 deg"]
     budget, levels = LodSettings.pixels_per_cell, LodSettings.shading_levels
     # the probes take the trilinear read apart (the box's is compiled from other text)

@@ -33,6 +33,7 @@ import numpy as np
 from common import silhouettes
 
 import traj2events.renderer.draw as draw
+import traj2events.renderer.glsl as glsl
 from traj2events.config import resolve_config
 from traj2events.formats.trajectory import read_trajectory
 from traj2events.renderer.footprint import TEXTURE_FILTERS
@@ -121,13 +122,13 @@ def main() -> None:
                 with sensor_renderer(tiles, camera, sun, reflectance, **kwargs) as renderer:
                     dn = [radiance_to_dn(renderer.render(p).radiance, settings.display_white_w_m2_sr) for p in poses]
                 counts[name] = events_per_frame(dn, times)
-            draw.shader_source, plain = distance_shader(draw.shader_source), draw.shader_source
+            glsl.shader_source, plain = distance_shader(glsl.shader_source), glsl.shader_source
             try:
                 distances = draw.TerrainRenderer(tiles, camera, sun, reflectance, texture_filter=args.texture_filter)
                 with distances as renderer:
                     frames = [renderer.render(p) for p in poses]
             finally:
-                draw.shader_source = plain
+                glsl.shader_source = plain
             coded = np.array([f.radiance.astype(np.float64) for f in frames])
             # Not the sky (cleared to 0: no distance), the horizon or depth edges.
             terrain = np.array([~np.logical_or(*silhouettes(f.depth_m)) for f in frames])

@@ -547,15 +547,6 @@ def test_hapke_r0_for_the_shaders_is_the_published_formula(w, r0):
     assert hapke_r0_float32(w) == pytest.approx(r0, rel=1e-6, abs=1e-7)
 
 
-def test_shaders_take_the_reflectance_law_from_one_file():
-    from traj2events.renderer.draw import expand_includes, shader_source
-
-    vertex = shader_source("terrain.vert")
-    assert "#include" not in vertex and vertex.count("float reflectance_factor(") == 1
-    assert vertex.startswith("#version 330 core\n")  # GLSL wants it first: the law comes after
-    assert expand_includes('x\n#include "reflectance.glsl"\ny\n') == "x\n" + shader_source("reflectance.glsl") + "y\n"
-
-
 def test_shading_per_pixel_keeps_the_drawn_geometry():
     """Shading levels change the shading only: the same tiles, the same depth, and a
     radiance close to that of tiles as fine as the texture."""

@@ -127,67 +127,21 @@ def test_area_weights_are_within_their_bound_of_the_exact_overlaps(n_from, shrin
     assert np.abs(weights - exact).max() <= 2 * n_to * np.finfo(float).eps
 
 
-# The box read (shaders/footprint.glsl) drawn by OpenGL itself: one fragment per query.
-QUERY_VERT = """#version 330 core
-void main() { vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2); gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0); }
-"""
-QUERY_FRAG = """#version 330 core
-uniform sampler2DArray shading;
-uniform sampler2D queries;  // row 0: texel_at, across; row 1: down
-#include "footprint.glsl"
-out vec4 mean;
-void main() {
-    vec4 a = texelFetch(queries, ivec2(int(gl_FragCoord.x), 0), 0);
-    vec4 b = texelFetch(queries, ivec2(int(gl_FragCoord.x), 1), 0);
-    mean = footprint_mean(shading, a.xy, 0.0, a.zw, b.xy);
-}
-"""
-
-
 def shader_box_means(texture, texel_at, across, down):
     """footprint_mean (FOOTPRINT_BOX) of a (side, side, 4) texture, uploaded as the renderer
-    uploads it (ShadingArray: its levels, RGBA16F), at each query: (n, 4) float32."""
-    import os
-
-    from traj2events.renderer.context import gl_context
-    from traj2events.renderer.draw import expand_includes, with_defines
+    uploads it (ShadingArray: its levels, RGBA16F), at each query, drawn by OpenGL itself
+    (one fragment per query): (n, 4) float32."""
+    from fragment_queries import FragmentQueries
     from traj2events.renderer.shading_array import ShadingArray
 
-    n = len(texel_at)
-    context = gl_context(os.environ.get("TRAJ2EVENTS_TEST_BACKEND", "osmesa"), n, 1)
-    from OpenGL import GL as gl
-
-    program = gl.glCreateProgram()
-    fragment = with_defines(expand_includes(QUERY_FRAG), ("FOOTPRINT_BOX",))
-    for kind, source in ((gl.GL_VERTEX_SHADER, QUERY_VERT), (gl.GL_FRAGMENT_SHADER, fragment)):
-        shader = gl.glCreateShader(kind)
-        gl.glShaderSource(shader, source)
-        gl.glCompileShader(shader)
-        assert gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS), gl.glGetShaderInfoLog(shader)
-        gl.glAttachShader(program, shader)
-    gl.glLinkProgram(program)
-    gl.glUseProgram(program)
-    ShadingArray(gl, 2, texture.shape[0], "box", 2**30).upload(0, texture)
-    queries = np.zeros((2, n, 4), np.float32)
-    queries[0, :, :2], queries[0, :, 2:], queries[1, :, :2] = texel_at, across, down
-    gl.glActiveTexture(gl.GL_TEXTURE3)
-    gl.glBindTexture(gl.GL_TEXTURE_2D, gl.glGenTextures(1))
-    gl.glTexImage2D(gl.GL_TEXTURE_2D, 0, gl.GL_RGBA32F, n, 2, 0, gl.GL_RGBA, gl.GL_FLOAT, queries)
-    gl.glTexParameteri(gl.GL_TEXTURE_2D, gl.GL_TEXTURE_MIN_FILTER, gl.GL_NEAREST)  # no levels: complete
-    for name, value in (("shading", 2), ("queries", 3)):
-        gl.glUniform1i(gl.glGetUniformLocation(program, name), value)
-    gl.glUniform1f(gl.glGetUniformLocation(program, "texture_side"), float(texture.shape[0]))
-    gl.glBindRenderbuffer(gl.GL_RENDERBUFFER, gl.glGenRenderbuffers(1))
-    gl.glRenderbufferStorage(gl.GL_RENDERBUFFER, gl.GL_RGBA32F, n, 1)
-    gl.glBindFramebuffer(gl.GL_FRAMEBUFFER, gl.glGenFramebuffers(1))
-    gl.glFramebufferRenderbuffer(gl.GL_FRAMEBUFFER, gl.GL_COLOR_ATTACHMENT0, gl.GL_RENDERBUFFER,
-                                 gl.glGetIntegerv(gl.GL_RENDERBUFFER_BINDING))  # fmt: skip
-    gl.glViewport(0, 0, n, 1)
-    gl.glBindVertexArray(gl.glGenVertexArrays(1))
-    gl.glDrawArrays(gl.GL_TRIANGLES, 0, 3)
-    means = np.frombuffer(gl.glReadPixels(0, 0, n, 1, gl.GL_RGBA, gl.GL_FLOAT), np.float32).reshape(n, 4)
-    context.delete_context()
-    return means
+    declarations = 'uniform sampler2DArray shading;\n#include "footprint.glsl"'
+    box_mean = "footprint_mean(shading, query(0).xy, 0.0, query(0).zw, query(1).xy)"  # at, across; down
+    with FragmentQueries(declarations, box_mean, len(texel_at), ("FOOTPRINT_BOX",)) as box:
+        ShadingArray(box.gl, 2, texture.shape[0], "box", 2**30).upload(0, texture)
+        box.uniforms(shading=2, texture_side=float(texture.shape[0]))
+        queries = np.zeros((2, len(texel_at), 4), np.float32)
+        queries[0, :, :2], queries[0, :, 2:], queries[1, :, :2] = texel_at, across, down
+        return box(queries)
 
 
 def exact_box_means(texture, texel_at, across, down):

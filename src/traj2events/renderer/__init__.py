@@ -7,6 +7,7 @@ Read first:
 
 Machinery a reader may skip:
     context        the OpenGL backend (EGL or OSMesa) and a headless context of it
+    glsl           the shaders' sources (includes, defines) compiled into programs; uniforms
     camera_matrices  the pinhole camera's OpenGL projection and view matrices
     law_uniforms   the reflectance laws' parameters as the shaders take them
     footprint      a pixel's footprint on the shading texture (its levels, the box filter)

@@ -26,7 +26,6 @@ from __future__ import annotations
 import ctypes
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
-from importlib import resources
 
 import numpy as np
 
@@ -40,6 +39,7 @@ from ..scene.view import depth_range
 from . import footprint
 from .camera_matrices import projection_matrix, view_rotation
 from .context import gl_context, resolve_backend
+from .glsl import package_program, set_uniform
 from .law_uniforms import law_uniforms
 from .shading_array import ShadingArray, quarters, shading_coordinates
 
@@ -80,7 +80,7 @@ class _GLScene:
         self.textured = shading_uv is not None
         # the footprint's read is chosen here, when the program is compiled (shaders/footprint.glsl)
         defines = ("FOOTPRINT_BOX",) if texture_filter == "box" else ()
-        self.program = _compile_program(gl, "terrain_textured" if self.textured else "terrain", defines)
+        self.program = package_program(gl, "terrain_textured" if self.textured else "terrain", defines)
         self.locations = {}
         self.vao = gl.glGenVertexArrays(1)
         gl.glBindVertexArray(self.vao)
@@ -195,15 +195,7 @@ class _GLScene:
         gl = self.gl
         if name not in self.locations:
             self.locations[name] = gl.glGetUniformLocation(self.program, name)
-        loc = self.locations[name]
-        if isinstance(value, int):
-            gl.glUniform1i(loc, value)
-        elif isinstance(value, float):
-            gl.glUniform1f(loc, value)
-        elif np.shape(value) == (4, 4):
-            gl.glUniformMatrix4fv(loc, 1, gl.GL_TRUE, np.asarray(value, np.float32))
-        else:
-            gl.glUniform3f(loc, *(float(x) for x in np.asarray(value, np.float32)))
+        set_uniform(gl, self.locations[name], value)
 
     def draw(self, instances: np.ndarray, uniforms: dict) -> int:
         """Issues one instanced draw of `instances` ((n, 8) float32: offset from the camera,
@@ -278,44 +270,6 @@ class _GLScene:
             gl.glDeleteBuffers(len(self.pixel_buffers), self.pixel_buffers)
         gl.glDeleteVertexArrays(1, [self.vao])
         gl.glDeleteProgram(self.program)
-
-
-def expand_includes(source: str) -> str:
-    """GLSL `source` with each `#include "file"` line replaced by shaders/file. GLSL has no
-    includes; this keeps the reflectance law in one file for every stage that evaluates it."""
-    folder = resources.files("traj2events.renderer") / "shaders"
-    lines = source.splitlines(keepends=True)
-    return "".join(
-        (folder / line.split('"')[1]).read_text() if line.startswith("#include ") else line for line in lines
-    )
-
-
-def shader_source(name: str) -> str:
-    """shaders/`name`, includes expanded."""
-    return expand_includes((resources.files("traj2events.renderer") / "shaders" / name).read_text())
-
-
-def with_defines(source: str, defines: tuple[str, ...]) -> str:
-    """GLSL `source` with a `#define` line for each of `defines` after its `#version` line."""
-    version, rest = source.split("\n", 1)
-    return "".join(f"{line}\n" for line in (version, *(f"#define {name}" for name in defines))) + rest
-
-
-def _compile_program(gl, stem: str, defines: tuple[str, ...] = ()) -> int:
-    """The program of shaders/`stem`.vert and shaders/`stem`.frag, with `defines` set."""
-    program = gl.glCreateProgram()
-    for kind, name in ((gl.GL_VERTEX_SHADER, f"{stem}.vert"), (gl.GL_FRAGMENT_SHADER, f"{stem}.frag")):
-        shader = gl.glCreateShader(kind)
-        gl.glShaderSource(shader, with_defines(shader_source(name), defines))
-        gl.glCompileShader(shader)
-        if not gl.glGetShaderiv(shader, gl.GL_COMPILE_STATUS):
-            raise RuntimeError(f"shaders/{name}: {gl.glGetShaderInfoLog(shader).decode()}")
-        gl.glAttachShader(program, shader)
-        gl.glDeleteShader(shader)  # freed with the program
-    gl.glLinkProgram(program)
-    if not gl.glGetProgramiv(program, gl.GL_LINK_STATUS):
-        raise RuntimeError(f"shaders: {gl.glGetProgramInfoLog(program).decode()}")
-    return program
 
 
 class TerrainRenderer:
