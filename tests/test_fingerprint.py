@@ -58,7 +58,9 @@ def test_no_stage_depends_on_the_command_line_or_config_loading(stage):
 
 
 def test_render_fingerprint_includes_the_shaders():
-    path, source = fingerprint.module_source("traj2events.renderer.draw")
+    # renderer.glsl reads them, for the draw and for the tests' fragment queries
+    assert "traj2events.renderer.glsl" in import_closure("traj2events.stages.render")
+    path, source = fingerprint.module_source("traj2events.renderer.glsl")
     assert {p.name for p in fingerprint.data_files(source, path.parent)} == {
         "terrain.vert",
         "terrain.frag",
