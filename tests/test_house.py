@@ -17,7 +17,7 @@ TESTS = ROOT / "tests"
 WITHOUT_TEST_FILE = {
     "defaults", "memory", "progress", "formats/atomic", "formats/exports", "formats/flow", "formats/imu",
     "formats/rounding", "formats/spice", "geometry/motion_pass", "renderer/camera_matrices",
-    "renderer/context", "renderer/law_uniforms", "renderer/lens", "renderer/shading_array", "scene/populations",
+    "renderer/context", "renderer/lens", "renderer/shading_array", "scene/populations",
     "scene/sun", "scene/terrain_kernels", "scene/view", "sensor/ordering", "sensor/parallel",
     "settings/camera", "settings/events", "settings/generate", "settings/imu", "settings/poses",
     "settings/solve", "settings/tree", "settings/vehicle", "stages/base_solution", "stages/camera_poses",

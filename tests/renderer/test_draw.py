@@ -539,14 +539,6 @@ def test_frames_drawn_ahead_are_the_frames_drawn_one_at_a_time():
         assert frame.n_tiles == alone.n_tiles > 0
 
 
-@pytest.mark.parametrize("w, r0", [(0.36, 1.0 / 9.0), (0.75, 1.0 / 3.0), (0.0, 0.0), (1.0, 1.0)])
-def test_hapke_r0_for_the_shaders_is_the_published_formula(w, r0):
-    """r0 = (1 - g) / (1 + g), g = sqrt(1 - w): g = 0.8 and 0.5 by hand, and the limits."""
-    from traj2events.renderer.law_uniforms import hapke_r0_float32
-
-    assert hapke_r0_float32(w) == pytest.approx(r0, rel=1e-6, abs=1e-7)
-
-
 def test_shading_per_pixel_keeps_the_drawn_geometry():
     """Shading levels change the shading only: the same tiles, the same depth, and a
     radiance close to that of tiles as fine as the texture."""

@@ -6,6 +6,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from normal_floats import normal_floats
+from reflectance_50_digit import hapke_50_digit, lunar_lambert_50_digit
 from traj2events.scene.reflectance import (
     ReflectanceParams,
     bihemispherical_albedo,
@@ -121,17 +122,6 @@ def test_hapkes_h_function_is_within_1_percent_of_chandrasekhars(mu, w):
     assert abs(approx / chandrasekhar_h_exact(mu, w) - 1.0) <= 0.01
 
 
-def lunar_lambert_50_digit(mu0: float, mu: float, cos_g: float, albedo: float) -> float:
-    """McEwen's Lunar-Lambert law at 50 digits on the same (rounded) inputs."""
-    import mpmath as mp
-
-    with mp.workdps(50):
-        mu0, mu, albedo = mp.mpf(mu0), mp.mpf(mu), mp.mpf(albedo)
-        g = mp.degrees(mp.acos(max(min(mp.mpf(cos_g), 1), -1)))
-        limb = min(max(1 - mp.mpf("0.019") * g + mp.mpf("2.42e-4") * g**2 - mp.mpf("1.46e-6") * g**3, 0), 1)
-        return float(albedo * (2 * limb * mu0 / (mu0 + mu) + (1 - limb) * mu0))
-
-
 EPS = np.finfo(np.float64).eps
 
 
@@ -147,30 +137,6 @@ def test_lunar_lambert_within_its_bound_of_its_50_digit_value(mu0, mu, cos_g, al
     got = float(lunar_lambert_radiance_factor(mu0, mu, cos_g, p))
     exact = lunar_lambert_50_digit(mu0, mu, cos_g, albedo)
     assert abs(got - exact) <= 4 * EPS * exact + 20 * EPS * albedo, (got, exact)
-
-
-def hapke_50_digit(mu0: float, mu: float, cos_g: float, p: ReflectanceParams) -> tuple[float, float]:
-    """Hapke's law as the module docstring writes it (tan, arccos, the textbook lobes), at
-    50 digits on the same rounded inputs: (I/F, the same with its bracket's terms summed
-    before the -1: the scale of its rounding)."""
-    import mpmath as mp
-
-    with mp.workdps(50):
-        mu0, mu, cos_g = mp.mpf(mu0), mp.mpf(mu), mp.mpf(cos_g)
-        w, b, c = mp.mpf(p.single_scattering_albedo), mp.mpf(p.phase_b), mp.mpf(p.phase_c)
-        r0 = (1 - mp.sqrt(1 - w)) / (1 + mp.sqrt(1 - w))
-
-        def h_function(x):
-            return 1 / (1 - w * x * (r0 + (1 - 2 * r0 * x) / 2 * mp.log((1 + x) / x)))
-
-        def lobe(b_):
-            return (1 - b_**2) / (1 - 2 * b_ * cos_g + b_**2) ** mp.mpf(1.5)
-
-        surge = mp.mpf(p.opposition_b0) / (1 + mp.tan(mp.acos(cos_g) / 2) / mp.mpf(p.opposition_h))
-        direct = (1 + surge) * ((1 + c) / 2 * lobe(b) + (1 - c) / 2 * lobe(-b))
-        scale = w / 4 * mu0 / (mu0 + mu)
-        multiple = h_function(mu0) * h_function(mu)
-        return float(scale * (direct + multiple - 1)), float(scale * (direct + multiple))
 
 
 @pytest.mark.accuracy

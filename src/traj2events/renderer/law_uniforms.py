@@ -18,6 +18,21 @@ def hapke_r0_float32(w: float) -> float:
     return float((np.float32(1.0) - gamma) / (np.float32(1.0) + gamma))
 
 
+def lobe_width_float32(b: float) -> float:
+    """Hapke's b (declared < 1) as the shaders' float32 `b` uniform: rounded, but to at
+    most float32's largest below 1, 1 - 2^-24. b within 2^-25 of 1 would round to 1, whose
+    lobe (1 - b^2) / base^1.5 is 0 / 0, a NaN, at its peak (exact opposition)."""
+    return float(min(np.float32(b), np.nextafter(np.float32(1.0), np.float32(0.0))))
+
+
+def surge_width_float32(h: float) -> float:
+    """Hapke's h (declared > 0) as the shaders' float32 `hw` uniform: rounded, but to at
+    least float32's least normal, 2^-126. An h below it would reach them as 0 (GPUs flush
+    subnormals), and the surge B0 h' / (h' + sqrt(1 - cos g)) be 0 / 0 at exact
+    opposition, where it is B0 for every h > 0."""
+    return float(max(np.float32(h), np.finfo(np.float32).tiny))
+
+
 def law_uniforms(reflectance: ReflectanceParams, sun: Sun, earth: Earth | None = None) -> dict:
     """The uniforms of reflectance.glsl (`earth` None: no earthshine), and `radiance_max`:
     the law's largest direct light plus the most scattered light there can be
@@ -31,10 +46,10 @@ def law_uniforms(reflectance: ReflectanceParams, sun: Sun, earth: Earth | None =
         "model": 0 if reflectance.model == "hapke" else 1,
         "w": float(reflectance.single_scattering_albedo),
         "hapke_r0": hapke_r0_float32(reflectance.single_scattering_albedo),
-        "b": float(reflectance.phase_b),
+        "b": lobe_width_float32(reflectance.phase_b),
         "c": float(reflectance.phase_c),
         "b0": float(reflectance.opposition_b0),
-        "hw": float(reflectance.opposition_h),
+        "hw": surge_width_float32(reflectance.opposition_h),
         "albedo": float(reflectance.albedo),
         "bounce_albedo": bounce_albedo,
         "earth_dir": earth.direction if earth else np.array([0.0, 0.0, -1.0]),
