@@ -1,6 +1,6 @@
-"""The IMU streams (trajectory/imu.py, stages/imu.py): hovering reads lunar gravity up,
-free fall reads nothing, the noise-free IMU integrated from the initial state gives the
-trajectory back, and imu.h5 agrees with the camera poses of the same integration."""
+"""The IMU streams (trajectory/imu.py): hovering reads lunar gravity up, free fall reads
+nothing, the noise-free IMU integrated from the initial state gives the trajectory back,
+and the noise has its datasheet's densities."""
 
 import numpy as np
 import pytest
@@ -8,10 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from traj2events.config import default_config
-from traj2events.formats.imu import read_imu
-from traj2events.formats.trajectory import read_trajectory, vehicle_attrs, write_trajectory
 from traj2events.settings.vehicle import Vehicle
-from traj2events.stages.imu import imu_command
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.imu import (
     ImuNoise,
@@ -21,7 +18,7 @@ from traj2events.trajectory.imu import (
     specific_force,
     specific_force_body,
 )
-from traj2events.trajectory.state import BODY_RATES, MASS, POSITION, VELOCITY, rotation_body_to_inertial
+from traj2events.trajectory.state import MASS, POSITION, VELOCITY, rotation_body_to_inertial
 from traj2events.trajectory.upsample import ReintegratedStates, interpolate_controls
 from trajectory.test_state import exact_rotation
 
@@ -89,31 +86,6 @@ def test_the_noise_free_imu_integrated_from_the_initial_state_gives_the_trajecto
         a_prev = a
     assert np.linalg.norm(x - states[-1, POSITION]) < 1e-5
     assert np.linalg.norm(v - states[-1, VELOCITY]) < 1e-6
-
-
-def test_imu_h5_agrees_with_the_camera_poses_of_the_same_integration(tmp_path):
-    t_nodes, controls, reintegrated = flight()
-    t_poses = np.arange(0, 401) / 20.0  # 20 fps
-    poses = reintegrated.states(t_poses)
-    nodes = (t_nodes, reintegrated.states(t_nodes), controls)
-    pose_rows = (t_poses, poses, interpolate_controls(t_nodes, controls, t_poses))
-    attrs = {**vehicle_attrs(VEHICLE), "scenario": "test", "id": 3, "fps": 20.0}
-    write_trajectory(tmp_path / "trajectory.h5", nodes, pose_rows, attrs)
-    imu_command(tmp_path / "trajectory.h5", tmp_path / "imu.h5", SETTINGS, seed=5)
-    streams, attrs = read_imu(tmp_path / "imu.h5")
-    assert len(streams["t"]) == 8001 and attrs["rate_hz"] == 400.0 and attrs["id"] == 3
-    every_20th = streams["angular_rate_b"][::20]  # the pose times
-    assert every_20th == pytest.approx(poses[:, BODY_RATES], abs=1e-12)
-    assert streams["altitude_m"][::20] == pytest.approx(altitude_above_sphere(poses, 1737400.0), abs=1e-9)
-    assert read_trajectory(tmp_path / "trajectory.h5").t[-1] == streams["t"][-1]
-    # The measured streams: the truth plus the biases plus white noise; the same seed, the same bytes.
-    residual = streams["angular_rate_b_measured"] - streams["angular_rate_b"] - streams["gyro_bias_b"]
-    gyro = ImuNoise.from_config(SETTINGS["noise"])
-    assert np.std(residual) == pytest.approx(gyro.gyro_random_walk_rad_sqrt_s * np.sqrt(400.0), rel=0.05)
-    imu_command(tmp_path / "trajectory.h5", tmp_path / "again.h5", SETTINGS, seed=5)
-    assert (tmp_path / "again.h5").read_bytes() == (tmp_path / "imu.h5").read_bytes()
-    with pytest.raises(ValueError, match="rate_hz"):
-        imu_command(tmp_path / "trajectory.h5", tmp_path / "bad.h5", {**SETTINGS, "rate_hz": 0.0})
 
 
 def test_hg1700_units_and_the_noise_laws():

@@ -85,9 +85,11 @@ STANDARD_GRAVITY_M_S2 = 9.80665  # a datasheet's "g"
 def measured(truth: np.ndarray, density: float, bias: float, walk_time_s: float, rate_hz: float, rng) -> tuple:
     """(readings, biases), each (n, 3): truth + bias + white noise. The white noise's
     samples have sigma density sqrt(rate) (its Allan deviation at tau is density / sqrt(tau));
-    the bias starts at N(0, bias^2) and steps by N(0, bias^2 / (walk_time rate)) per sample."""
+    the bias starts at N(0, bias^2) and steps by N(0, bias^2 / (walk_time rate)) per sample
+    (its sigma through sqrt(walk_time) sqrt(rate): their product underflows to 0 for a walk
+    time of 1e-323 s at 0.1 Hz, which the config accepts, and the biases became inf)."""
     n = len(truth)
-    steps = rng.normal(0.0, bias / np.sqrt(walk_time_s * rate_hz), (n, 3))
+    steps = rng.normal(0.0, bias / (np.sqrt(walk_time_s) * np.sqrt(rate_hz)), (n, 3))
     steps[0] = rng.normal(0.0, bias, 3)
     biases = np.cumsum(steps, axis=0)
     return truth + biases + rng.normal(0.0, density * np.sqrt(rate_hz), (n, 3)), biases
