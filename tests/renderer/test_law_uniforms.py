@@ -67,6 +67,8 @@ def as_the_shaders_take_it(uniforms: dict) -> SimpleNamespace:
 @example({"model": "hapke", "phase_b": 0.99999999}, *one_query(0.5, 0.5, 1.0))
 # h below float32's least normal reached them as 0: the surge 0 / 0 at opposition;
 @example({"model": "hapke", "opposition_h": 2e-94}, *one_query(0.5, 0.5, 1.0))
+# h at float32's least normal: B0 h' subnormal, flushed, the surge 0 at opposition;
+@example({"model": "hapke", "opposition_b0": 0.5, "opposition_h": 1.4e-45}, *one_query(1.0, 1.0, 1.0))
 # llvmpipe's acos 1.6e-4 rad off (GLSL allows 4096 ulp): L(g) 1.3e-4 of A off near its root.
 @example({"model": "lunar-lambert", "albedo": 0.8}, *one_query(4.622861e-12, 4.692601e-12, -0.24086848))
 @given(declared_values(render.ReflectanceParams), cosines(1e-12), cosines(1e-12), cosines(-1.0))

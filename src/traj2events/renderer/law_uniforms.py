@@ -27,10 +27,12 @@ def lobe_width_float32(b: float) -> float:
 
 def surge_width_float32(h: float) -> float:
     """Hapke's h (declared > 0) as the shaders' float32 `hw` uniform: rounded, but to at
-    least float32's least normal, 2^-126. An h below it would reach them as 0 (GPUs flush
-    subnormals), and the surge B0 h' / (h' + sqrt(1 - cos g)) be 0 / 0 at exact
-    opposition, where it is B0 for every h > 0."""
-    return float(max(np.float32(h), np.finfo(np.float32).tiny))
+    least 2^-64. Below float32's least normal, 2^-126, h would reach them as 0 (GPUs flush
+    subnormals) and the surge B0 h' / (h' + sqrt(1 - cos g)) be 0 / 0 at exact opposition,
+    where it is B0 for every h > 0; and B0 h' must stay normal too (an h of 2^-126 with B0
+    0.5 flushed the surge to 0). The floor changes no float32 surge: away from opposition
+    sqrt(1 - cos g) >= 2^-12 in float32, so an h below 2^-64 adds < 3e-16 B0 there."""
+    return float(max(np.float32(h), np.float32(2.0**-64)))
 
 
 def law_uniforms(reflectance: ReflectanceParams, sun: Sun, earth: Earth | None = None) -> dict:
