@@ -7,9 +7,10 @@ from hypothesis import example, given, settings
 
 from declared_values import declared_values
 from normal_floats import normal_floats
+from traj2events.config import resolve_config
 from traj2events.formats.imu import read_imu
 from traj2events.formats.trajectory import read_trajectory, vehicle_attrs, write_trajectory
-from traj2events.settings.imu import ImuNoiseSection
+from traj2events.settings.imu import ImuNoiseSection, imu_settings
 from traj2events.stages.imu import imu_command
 from traj2events.trajectory.imu import ImuNoise, altitude_above_sphere
 from traj2events.trajectory.state import BODY_RATES
@@ -63,8 +64,9 @@ def test_no_imu_the_check_accepts_writes_a_nan_or_an_inf(trajectory_h5, tmp_path
     """Every error across its declared bounds (the walk time, open, to 1e12 s), rates from
     1e-100 Hz (one sample) to the default 1 kHz (the declared 100 kHz: the same law, 100
     times the samples): every stream finite, and the white noise of the drawn density."""
+    config = resolve_config({"imu": {"rate_hz": rate_hz, "noise": noise}})  # the check accepts every draw
     output = tmp_path_factory.mktemp("drawn") / "imu.h5"
-    imu_command(trajectory_h5, output, {**SETTINGS, "rate_hz": rate_hz, "noise": noise}, seed=1)
+    imu_command(trajectory_h5, output, imu_settings(config), seed=1)
     streams, _ = read_imu(output)
     for name, stream in streams.items():
         assert np.isfinite(stream).all(), name
