@@ -59,6 +59,8 @@ def test_imu_h5_agrees_with_the_camera_poses_of_the_same_integration(tmp_path):
 @settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)  # 0.3 s each
 # the search's find: the bias's step sigma through sqrt(walk time x rate), which underflowed to 0
 @example({**SETTINGS["noise"], "bias_walk_time_s": 5e-324}, 0.1)
+# and a sample past the flight's end (floor(tf rate + 1e-9) samples): the flight refused it
+@example(SETTINGS["noise"], 1.9999999999998863)
 @given(declared_values(ImuNoiseSection, bias_walk_time_s=1e12), normal_floats(0.0, 1000.0).filter(lambda r: r > 0))
 def test_no_imu_the_check_accepts_writes_a_nan_or_an_inf(trajectory_h5, tmp_path_factory, noise, rate_hz):
     """Every error across its declared bounds (the walk time, open, to 1e12 s), rates from

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
@@ -26,6 +26,16 @@ def test_frame_times_cover_zero_to_tf():
     t = frame_times(1.05, 10.0)
     assert len(t) == 11 and t[-1] <= 1.05
     np.testing.assert_allclose(np.diff(frame_times(75.3, 100.0)), 0.01, atol=1e-12)
+
+
+@example(1.16, 25.0)  # 1.16 x 25 rounds to 28.999999999999996: the frame at tf was dropped
+@example(20.0, 1.9999999999998863)  # the IMU's floor(tf rate + 1e-9) took 40 / rate, past tf
+@given(st.floats(0.0, 1e4), st.floats(1e-3, 1e5) | st.sampled_from([24.0, 25.0, 30.0, 50.0, 100.0, 1000.0]))
+def test_frame_times_are_every_k_over_fps_up_to_tf(tf, fps):
+    """Exactly the k / fps (float64) at most tf: none past it, the next beyond it."""
+    assume(tf * fps < 1e6)
+    t = frame_times(tf, fps)
+    assert np.array_equal(t, np.arange(len(t)) / fps) and t[-1] <= tf < len(t) / fps
 
 
 def test_free_fall_matches_closed_form(dynamics, vehicle):

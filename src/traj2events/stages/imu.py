@@ -14,6 +14,7 @@ from ..progress import log
 from ..provenance import provenance
 from ..trajectory.flight import flight_of
 from ..trajectory.imu import ImuNoise, altitude_above_sphere, angular_rate_body, measured, specific_force
+from ..trajectory.upsample import frame_times
 
 
 def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settings: dict, seed: int = 0) -> None:
@@ -26,7 +27,7 @@ def imu_command(trajectory: str | os.PathLike, output: str | os.PathLike, settin
         raise ValueError(f"imu: seed: expected a value >= 0, got {seed}")
     tr = read_trajectory(trajectory)
     flight, g = flight_of(tr), float(tr.attrs["g_m_s2"])
-    t = np.arange(int(np.floor(float(tr.t_nodes[-1]) * rate + 1e-9)) + 1) / rate
+    t = frame_times(float(tr.t_nodes[-1]), rate)
     states = flight.states(t)
     noise = ImuNoise.from_config(settings["noise"])
     rng = np.random.Generator(np.random.PCG64([seed, 0x1A0]))  # its own stream of the trajectory's seed

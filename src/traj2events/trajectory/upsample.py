@@ -24,8 +24,12 @@ ATOL = 1e-10 * STATE_SCALE  # per-component absolute tolerance in SI units
 
 
 def frame_times(tf_s: float, fps: float) -> np.ndarray:
-    """Frame timestamps k / fps for every k with k / fps <= tf (frame 0 at t = 0)."""
-    t = np.arange(int(np.floor(tf_s * fps)) + 1) / fps
+    """Timestamps k / fps for every k with k / fps <= tf (frame 0 at t = 0): the camera's
+    frames, the IMU's samples. Candidates to floor(tf fps) + 1: tf fps rounds below k for
+    many a tf of k / fps (29 / 25 s times 25 is 28.999999999999996), whose last frame a
+    bare floor dropped."""
+    with np.errstate(over="ignore"):  # the candidate past tf is inf for a rate near 0
+        t = np.arange(int(np.floor(tf_s * fps)) + 2) / fps
     return t[t <= tf_s]
 
 
