@@ -14,9 +14,11 @@ from traj2events.settings.declare import declared_fields
 OPEN_CAPS = {"Hz": 1e4, "s": 0.05, "ln": 5.0, "cm^-2 s^-1": 1e5, "": 1.0}
 
 
-def declared_values(cls, **caps):
+def declared_values(cls, normal: bool = False, **caps):
     """A strategy for a section's every key, drawn across its declared bounds (open ones
-    capped by unit, OPEN_CAPS, or by `caps`): floats 0 or >= 1e-100, choices, booleans."""
+    capped by unit, OPEN_CAPS, or by `caps`): floats (subnormals included, as the config
+    check accepts them; `normal`: 0 or >= 1e-100, for a law's relative bound), choices,
+    booleans."""
     keys = {}
     for f in declared_fields(cls):
         meta, bounds = f.metadata, f.metadata["bounds"]
@@ -28,5 +30,6 @@ def declared_values(cls, **caps):
             lo = bounds.get("ge", bounds.get("gt", 0.0))
             hi = bounds.get("le", bounds.get("lt"))
             hi = min(hi if hi is not None else np.inf, caps.get(f.name, OPEN_CAPS.get(meta["unit"], np.inf)))
-            keys[f.name] = normal_floats(lo, hi).filter(lambda x, b=bounds: x > b.get("gt", -np.inf))
+            floats = normal_floats(lo, hi) if normal else st.floats(lo, hi)
+            keys[f.name] = floats.filter(lambda x, b=bounds: x > b.get("gt", -np.inf))
     return st.fixed_dictionaries(keys)
