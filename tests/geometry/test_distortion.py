@@ -7,6 +7,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
+from normal_floats import normal_floats
 from traj2events.config import load_config
 from traj2events.geometry.camera import Camera
 from traj2events.geometry.distortion import Distortion, distortion_from
@@ -146,8 +147,23 @@ def test_resampled_depth_keeps_sky_where_most_of_the_samples_are_sky():
     assert np.all(out[sky_side] == 0) and np.all(out[~sky_side] == pytest.approx(50.0))
 
 
-COEFFICIENT = st.floats(-2.0, 2.0).map(lambda x: x if abs(x) >= 1e-100 else 0.0)  # no underflow
-COORDINATE = st.floats(-300.0, 300.0).map(lambda x: x if abs(x) >= 1e-100 else 0.0)
+COEFFICIENT, COORDINATE = normal_floats(-2.0, 2.0), normal_floats(-300.0, 300.0)
+
+
+def distort_50_digit(k1, k2, p1, p2, k3, a, b) -> tuple:
+    """The model as the module docstring writes it, at the caller's mpmath precision:
+    ((a_d, b_d), each one's terms' absolute values summed: the scale of its rounding)."""
+    import mpmath as mp
+
+    a_, b_ = mp.mpf(a), mp.mpf(b)
+    r2 = a_ * a_ + b_ * b_
+    radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    radial_terms = 1 + r2 * (abs(k1) + r2 * (abs(k2) + r2 * abs(k3)))
+    exact = (a_ * radial + 2 * p1 * a_ * b_ + p2 * (r2 + 2 * a_ * a_),
+             b_ * radial + p1 * (r2 + 2 * b_ * b_) + 2 * p2 * a_ * b_)  # fmt: skip
+    terms = (abs(a_) * radial_terms + abs(2 * p1 * a_ * b_) + abs(p2) * (r2 + 2 * a_ * a_),
+             abs(b_) * radial_terms + abs(p1) * (r2 + 2 * b_ * b_) + abs(2 * p2 * a_ * b_))  # fmt: skip
+    return exact, terms
 
 
 @pytest.mark.accuracy
@@ -161,14 +177,7 @@ def test_distort_is_within_8_eps_of_its_terms_of_the_50_digit_model(k1, k2, p1, 
 
     got = Distortion(k1, k2, p1, p2, k3).distort(np.array(a), np.array(b))
     with mp.workdps(50):
-        a_, b_ = mp.mpf(a), mp.mpf(b)
-        r2 = a_ * a_ + b_ * b_
-        radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
-        radial_terms = 1 + r2 * (abs(k1) + r2 * (abs(k2) + r2 * abs(k3)))
-        exact = (a_ * radial + 2 * p1 * a_ * b_ + p2 * (r2 + 2 * a_ * a_),
-                 b_ * radial + p1 * (r2 + 2 * b_ * b_) + 2 * p2 * a_ * b_)  # fmt: skip
-        terms = (abs(a_) * radial_terms + abs(2 * p1 * a_ * b_) + abs(p2) * (r2 + 2 * a_ * a_),
-                 abs(b_) * radial_terms + abs(p1) * (r2 + 2 * b_ * b_) + abs(2 * p2 * a_ * b_))  # fmt: skip
+        exact, terms = distort_50_digit(k1, k2, p1, p2, k3, a, b)
         for value, x, size in zip(got, exact, terms):
             assert abs(float(value) - x) <= 8 * np.finfo(float).eps * size, (float(value), float(x))
 
@@ -195,11 +204,7 @@ def test_undistort_finds_the_principal_pre_image_within_1e13(k1, k2, p1, p2, k3,
     lens = Distortion(k1, k2, p1, p2, k3)
     assume(a * a + b * b < 0.95 * lens.fold_radius2 and float(lens.determinant(np.array(a), np.array(b))) > 0.05)
     with mp.workdps(50):
-        a_, b_ = mp.mpf(a), mp.mpf(b)
-        r2 = a_ * a_ + b_ * b_
-        radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
-        a_d = float(a_ * radial + 2 * p1 * a_ * b_ + p2 * (r2 + 2 * a_ * a_))
-        b_d = float(b_ * radial + p1 * (r2 + 2 * b_ * b_) + 2 * p2 * a_ * b_)
+        a_d, b_d = (float(x) for x in distort_50_digit(k1, k2, p1, p2, k3, a, b)[0])
     back_a, back_b = lens.undistort(np.array([a_d]), np.array([b_d]))
     assert abs(back_a[0] - a) + abs(back_b[0] - b) <= 1e-13
 
