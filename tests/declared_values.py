@@ -2,10 +2,12 @@
 declarations give (settings.declare): the property tests that drive a stage with configs
 the check accepts (docs/accuracy.md "End-to-end stress")."""
 
+import typing
+
 import numpy as np
 from hypothesis import strategies as st
 
-from normal_floats import normal_floats
+from normal_floats import SMALLEST, normal_floats
 from traj2events.settings.declare import declared_fields
 
 # Caps on the bounds the declarations leave open (a rate's ge=0 and no more), by unit: for
@@ -16,20 +18,52 @@ OPEN_CAPS = {"Hz": 1e4, "s": 0.05, "ln": 5.0, "cm^-2 s^-1": 1e5, "": 1.0}
 
 def declared_values(cls, normal: bool = False, **caps):
     """A strategy for a section's every key, drawn across its declared bounds (open ones
-    capped by unit, OPEN_CAPS, or by `caps`): floats (subnormals included, as the config
-    check accepts them; `normal`: 0 or >= 1e-100, for a law's relative bound), choices,
-    booleans."""
-    keys = {}
+    capped by unit, OPEN_CAPS; any by `caps`): floats (subnormals included, as the config
+    check accepts them; `normal`: 0 or >= 1e-100, for a law's relative bound), tuples of
+    floats, choices, booleans."""
+    keys, hints = {}, typing.get_type_hints(cls)
     for f in declared_fields(cls):
-        meta, bounds = f.metadata, f.metadata["bounds"]
+        meta, bounds, hint = f.metadata, f.metadata["bounds"], hints[f.name]
         if meta["choices"]:
             keys[f.name] = st.sampled_from(meta["choices"])
-        elif f.type in ("bool", bool):
+        elif hint is bool:
             keys[f.name] = st.booleans()
-        elif f.type in ("float", float):
-            lo = bounds.get("ge", bounds.get("gt", 0.0))
-            hi = bounds.get("le", bounds.get("lt"))
-            hi = min(hi if hi is not None else np.inf, caps.get(f.name, OPEN_CAPS.get(meta["unit"], np.inf)))
-            floats = normal_floats(lo, hi) if normal else st.floats(lo, hi)
-            keys[f.name] = floats.filter(lambda x, b=bounds: x > b.get("gt", -np.inf))
+        elif hint is float:
+            keys[f.name] = _floats(bounds, _cap(f, caps), normal)
+        elif typing.get_origin(hint) is tuple and set(typing.get_args(hint)) == {float}:
+            item = _floats(bounds, _cap(f, caps), normal)
+            keys[f.name] = st.tuples(*[item] * len(typing.get_args(hint)))
     return st.fixed_dictionaries(keys)
+
+
+def accepted(cls, normal: bool = False, **caps):
+    """A strategy for instances of section `cls` drawn with `declared_values`, those its own
+    checks refuse (e.g. a dry mass above the wet mass) left out."""
+    return declared_values(cls, normal, **caps).map(lambda keys: _built(cls, keys)).filter(bool)
+
+
+def _built(cls, keys: dict):
+    try:
+        return cls(**keys)
+    except ValueError:
+        return None
+
+
+def _cap(f, caps: dict) -> float:
+    """The largest value to draw for field `f`: the caller's cap, else the unit's cap where
+    the declaration sets no upper bound, else none (its declared bound)."""
+    if f.name in caps:
+        return caps[f.name]
+    bounds = f.metadata["bounds"]
+    return np.inf if "le" in bounds or "lt" in bounds else OPEN_CAPS.get(f.metadata["unit"], np.inf)
+
+
+def _floats(bounds: dict, cap: float, normal: bool):
+    """Floats inside a declaration's bounds, open ones (`gt`, `lt`) left out, capped at `cap`."""
+    lo, hi = bounds.get("ge", bounds.get("gt", 0.0)), min(bounds.get("le", bounds.get("lt", np.inf)), cap)
+    above, below = "gt" in bounds, hi == bounds.get("lt")
+    if not normal:
+        return st.floats(lo, hi).filter(lambda x: x > bounds.get("gt", -np.inf) and x < bounds.get("lt", np.inf))
+    if above and lo == 0:  # gt=0: the smallest normal float up
+        lo, above = SMALLEST[np.float64], False
+    return normal_floats(lo, hi).filter(lambda x: (x > lo if above else x >= lo) and (x < hi if below else True))

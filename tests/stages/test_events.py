@@ -366,8 +366,12 @@ def test_the_standalone_emulator_takes_a_window_a_crop_a_size_and_timestamps(tmp
     {"enabled": False},
     0,
 )
-@given(declared_values(EmulatorParams, theta_on=2.0, theta_off=2.0), declared_values(ReadoutParams),
-       declared_values(SpaceParams), st.integers(0, 2**32 - 1))  # fmt: skip
+# Delays and glitches to 50 ms and fluxes to 1e5 /cm^2/s (declared: 1 s, 1e7): the same laws
+# over this 0.4 s recording, in fewer events.
+@given(declared_values(EmulatorParams, theta_on=2.0, theta_off=2.0),
+       declared_values(ReadoutParams, latency_s=0.05, jitter_s=0.05),
+       declared_values(SpaceParams, glitch_duration_s=0.05, particle_flux_cm2_s=1e5),
+       st.integers(0, 2**32 - 1))  # fmt: skip
 def test_no_pixel_readout_or_space_the_check_accepts_gives_events_off_the_clock(tmp_path_factory, pixel, readout,
                                                                                 space, seed):  # fmt: skip
     """Issue 71: events.pixel, events.readout and events.space drawn across their declared
