@@ -28,11 +28,9 @@ def declared_values(cls, normal: bool = False, **caps):
             keys[f.name] = st.sampled_from(meta["choices"])
         elif hint is bool:
             keys[f.name] = st.booleans()
-        elif hint is float:
-            keys[f.name] = _floats(bounds, _cap(f, caps), normal)
-        elif typing.get_origin(hint) is tuple and set(typing.get_args(hint)) == {float}:
-            item = _floats(bounds, _cap(f, caps), normal)
-            keys[f.name] = st.tuples(*[item] * len(typing.get_args(hint)))
+        elif hint is float or (typing.get_origin(hint) is tuple and set(typing.get_args(hint)) == {float}):
+            floats = _floats(bounds, _cap(f, caps), normal)
+            keys[f.name] = floats if hint is float else st.tuples(*[floats] * len(typing.get_args(hint)))
     return st.fixed_dictionaries(keys)
 
 
@@ -61,9 +59,7 @@ def _cap(f, caps: dict) -> float:
 def _floats(bounds: dict, cap: float, normal: bool):
     """Floats inside a declaration's bounds, open ones (`gt`, `lt`) left out, capped at `cap`."""
     lo, hi = bounds.get("ge", bounds.get("gt", 0.0)), min(bounds.get("le", bounds.get("lt", np.inf)), cap)
-    above, below = "gt" in bounds, hi == bounds.get("lt")
-    if not normal:
-        return st.floats(lo, hi).filter(lambda x: x > bounds.get("gt", -np.inf) and x < bounds.get("lt", np.inf))
-    if above and lo == 0:  # gt=0: the smallest normal float up
-        lo, above = SMALLEST[np.float64], False
-    return normal_floats(lo, hi).filter(lambda x: (x > lo if above else x >= lo) and (x < hi if below else True))
+    if normal and lo == 0 and "gt" in bounds:  # gt=0: from the smallest normal float up
+        lo = SMALLEST[np.float64]
+    floats = normal_floats(lo, hi) if normal else st.floats(lo, hi)
+    return floats.filter(lambda x: x > bounds.get("gt", -np.inf) and x < bounds.get("lt", np.inf))
