@@ -214,7 +214,7 @@ def _stage_settings(kind: str, key: str, value) -> str:
     "kind, key, value, fragment",
     [
         ("solve", "ocp.n_nodes", float("nan"), "ocp.n_nodes: expected a finite number, got nan"),
-        ("solve", "vehicle.isp_s", -1.0, "vehicle.isp_s: expected a value > 0, got -1.0"),
+        ("solve", "vehicle.isp_s", -1.0, "vehicle.isp_s: expected a value >= 1, got -1.0"),
         ("render", "sun.elevation_deg", float("nan"), "'sun.elevation_deg': expected a finite number, got nan"),
         ("render", "sun.elevation_deg", 95.0, "sun.elevation_deg: expected a value <= 90, got 95.0"),
         ("render", "lod.texture_filter", "bilinear", "render.lod.texture_filter: expected one of"),

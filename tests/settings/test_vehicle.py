@@ -23,7 +23,7 @@ def test_values_beyond_the_physical_bounds_are_refused_by_name(key, value):
         Vehicle(**{key: value})
 
 
-@pytest.mark.parametrize(("isp_s", "inertia"), itertools.product([1.0, 1e5], [1e-3, 1e10]))
+@pytest.mark.parametrize(("isp_s", "inertia"), list(itertools.product([1.0, 1e5], [1e-3, 1e10])))
 def test_every_term_of_the_dynamics_is_finite_at_the_bounds_corners(isp_s, inertia):
     """The lightest lander (2 kg, 1 kg dry) with the strongest engine (1e8 N) and thrusters
     (1e5 N at 100 m), full commands and 1 rad/s rates at 89 deg pitch: a finite derivative,
