@@ -9,9 +9,10 @@ from hypothesis import strategies as st
 SMALLEST = {np.float64: 1e-100, np.float32: 1e-12}  # products of three stay normal floats
 
 
-def normal_floats(lo: float, hi: float) -> st.SearchStrategy[float]:
-    """Floats in [lo, hi], those nearer 0 than float64's SMALLEST taken as 0."""
-    return st.floats(lo, hi).map(lambda x: x if abs(x) >= SMALLEST[np.float64] else 0.0)
+def normal_floats(lo: float, hi: float, **exclude: bool) -> st.SearchStrategy[float]:
+    """Floats in [lo, hi] (`exclude_min`, `exclude_max`: open), those nearer 0 than
+    float64's SMALLEST taken as 0."""
+    return st.floats(lo, hi, **exclude).map(lambda x: x if abs(x) >= SMALLEST[np.float64] else 0.0)
 
 
 def flushed(x: float, dtype) -> float:
