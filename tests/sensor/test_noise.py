@@ -86,3 +86,19 @@ def test_a_block_of_many_events_comes_out_by_pixel_then_time_at_each_pixels_rate
     expected = shot_noise_hz * shot_noise_gain_scalar(0.0) / theta * dt
     counts = np.bincount(pix, minlength=12)
     assert counts[5] > 2e5 and np.all(np.abs(counts - expected) < 5 * np.sqrt(expected)), (counts, expected)
+
+
+def test_a_rate_that_underflows_gives_no_shot_noise():
+    """Issue 71's counterexample: shot_noise_hz 5e-324 (the config accepts any rate >= 0)
+    times a block's majorant of 0.38 underflows to 0; the mean gap was 1 / 0, a
+    ZeroDivisionError in the events job. It is now inf: no candidate, no event."""
+    from traj2events.sensor.draws import SHOT_NOISE_STREAM, interval_key
+    from traj2events.sensor.noise import block_majorants, block_mean_gap_s, shot_noise_events
+
+    theta_on, theta_off = np.full(12, 0.25), np.ones(12)
+    majorants = block_majorants(theta_on, theta_off, 0.25)
+    assert 5e-324 * majorants[0] * 32 == 0.0 and block_mean_gap_s(5e-324, majorants[0]) == np.inf
+    out = np.empty(8, np.int64), np.empty(8), np.empty(8, np.bool_)
+    for interval in range(100):
+        assert shot_noise_events(np.zeros(12, np.float32), 1.0, theta_on, theta_off, 0.25, majorants, 5e-324,
+                                 interval_key(7, SHOT_NOISE_STREAM, interval), 1e6, *out) == 0  # fmt: skip

@@ -366,6 +366,12 @@ def test_the_standalone_emulator_takes_a_window_a_crop_a_size_and_timestamps(tmp
     {"enabled": False},
     0,
 )
+@example(  # a shot-noise rate whose block rate underflows (the long profile's find)
+    {**dict(preset_params("clean").__dict__), "theta_on": 0.25, "theta_off": 1.0, "shot_noise_hz": 5e-324},
+    {"latency_s": 0.0, "jitter_s": 0.0, "max_event_rate_hz": 0.0, "mode": "delay"},
+    {"enabled": False},
+    0,
+)
 # Delays and glitches to 50 ms and fluxes to 1e5 /cm^2/s (declared: 1 s, 1e7): the same laws
 # over this 0.4 s recording, in fewer events.
 @given(declared_values(EmulatorParams, theta_on=2.0, theta_off=2.0),
@@ -381,7 +387,9 @@ def test_no_pixel_readout_or_space_the_check_accepts_gives_events_off_the_clock(
     pixels are in the image. The search found a readout queue (1 event/s) draining for an
     hour past the recording's end, beyond events.h5's clock, and one (1e-14 events/s)
     whose departures wrapped int64: the recording now ends at its last frame, and a
-    departure past int64's clock is never (sensor/readout.py)."""
+    departure past int64's clock is never (sensor/readout.py). Drawing the floats next to
+    the open bounds, it found a pixel at the thresholds' 0.01 clip whose block of shot noise
+    took 220 s to sort, and a rate of 5e-324 Hz dividing by 0 (sensor/noise.py)."""
     from traj2events.config import ConfigError, resolve_config
     from traj2events.sensor.sources import SENSOR_KIND, FrameSource
     from traj2events.stages.events import emulate_with_settings, pixel_and_sensor

@@ -52,8 +52,11 @@ def kept(coin, majorant, intensity_dn, theta_on, theta_off, theta_nominal):
 
 @njit(inline="always")
 def block_mean_gap_s(shot_noise_hz, majorant):
-    """The mean time between a block's candidates: 1 / (R_shot majorant NOISE_BLOCK)."""
-    return 1.0 / (shot_noise_hz * majorant * NOISE_BLOCK)
+    """The mean time between a block's candidates: 1 / (R_shot majorant NOISE_BLOCK); inf
+    where that rate underflows to 0 (R_shot 5e-324 Hz, which the config accepts: no
+    candidate ever comes, and its time, inf or NaN, passes no `< dt`)."""
+    rate_hz = shot_noise_hz * majorant * NOISE_BLOCK
+    return 1.0 / rate_hz if rate_hz > 0.0 else math.inf
 
 
 @njit(inline="always")
