@@ -102,6 +102,17 @@ def test_a_burst_leaves_on_the_arbiters_clock_within_its_bound(start_us, log_rat
             assert int(mp.floor(e - r)) <= got <= int(mp.floor(e + r))
 
 
+@pytest.mark.parametrize("rate", [1e-14, 5e-324])
+def test_at_the_smallest_rates_the_first_event_leaves_at_once_and_no_other(rate):
+    # At 5e-324 events/s (the check accepts any rate > 0) the spacing is inf: start + 0 x
+    # inf was NaN, and the queue's first event never left either (issue 71).
+    events = {"x": np.zeros(3, np.uint16), "y": np.zeros(3, np.uint16), "t": np.array([5, 10, 20], np.int64),
+              "p": np.ones(3, np.uint8)}  # fmt: skip
+    out, readout = run(ReadoutParams(max_event_rate_hz=rate, mode="delay"), [(events, np.zeros(3, np.uint8))],
+                       end_us=10**9)  # fmt: skip
+    assert out["t"].tolist() == [5] and readout.dropped.tolist() == [2, 0, 0, 0]
+
+
 @pytest.mark.parametrize("params", [ReadoutParams(max_event_rate_hz=1e4), ReadoutParams(latency_s=0.3)],
                          ids=["queue", "latency"])  # fmt: skip
 def test_the_recording_ends_at_its_last_frame_and_counts_what_leaves_after_it(params):

@@ -42,12 +42,20 @@ def _queue(arrival_us, spacing_us, busy_start_us, queued):
     out = np.empty(arrival_us.size, np.int64)
     for k in range(arrival_us.size):
         arrival = float(arrival_us[k])
-        if arrival >= busy_start_us + queued * spacing_us:  # the queue is empty: a new busy period
+        if arrival >= _nth_departure(busy_start_us, queued, spacing_us):  # the queue is empty: a new busy period
             busy_start_us, queued = arrival, 0
-        departure = np.floor(busy_start_us + queued * spacing_us)
+        departure = np.floor(_nth_departure(busy_start_us, queued, spacing_us))
         out[k] = np.int64(departure) if departure < 2.0**63 else NEVER_US
         queued += 1
     return out, busy_start_us, queued
+
+
+@njit(inline="always")
+def _nth_departure(busy_start_us, n, spacing_us):
+    """A busy period's n-th departure after its first, start + n spacing; the start itself
+    for n = 0 even where the spacing is inf (a rate limit of 5e-324 events/s: 0 x inf would
+    be NaN, and the period's first event would never leave)."""
+    return busy_start_us + n * spacing_us if n else busy_start_us
 
 
 @njit(cache=True, nogil=True)
