@@ -143,9 +143,6 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"config key 'camera.fps': expected at least 2 frames per trajectory, scenario '{name}' would have "
             f"{frames:.3g} (t_f ~ {sc['tf_guess_s']} s at {config['camera']['fps']} fps)"
         )
-    if sc["altitude_m"][0] <= 0:
-        errors.append(f"config key 'scenarios.{name}.altitude_m': expected a start above the ground (> 0 m), "
-                      f"got {sc['altitude_m']}")  # fmt: skip
     return errors
 
 

@@ -1,14 +1,15 @@
-"""base.h5 (stages/base_solution.py): for every lander the config check accepts, the base
-solve either refuses with an error that names the scenario and the vehicle, or writes
-finite nodes that meet the scenario's boundary conditions."""
+"""base.h5 (stages/base_solution.py): for every lander and initial state the config check
+accepts, the base solve either refuses with an error that names the scenario and the
+vehicle, or writes finite nodes that meet the scenario's boundary conditions."""
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, event, example, given, settings
 
-from declared_values import accepted
+from declared_values import accepted, declared_values
 from traj2events.config import ConfigError, resolve_config
 from traj2events.formats.trajectory import read_trajectory
+from traj2events.settings.tree import ScenarioSection
 from traj2events.settings.vehicle import Vehicle
 from traj2events.stages.base_solution import BaseSolveError, base_solution
 from traj2events.trajectory.scenarios import ScenarioSettings, base_conditions
@@ -43,8 +44,30 @@ def test_no_lander_the_check_accepts_writes_a_nan_or_a_wrong_landing(tmp_path_fa
         config = resolve_config({"vehicle": vehicle.to_dict(), "ocp": OCP})
     except ConfigError:  # e.g. a tilt limit below a scenario's initial tilt
         assume(False)
+    refused_or_landed(config, tmp_path_factory.mktemp("base") / "base.h5")
+
+
+@settings(max_examples=max(settings.default.max_examples // 60, 5), deadline=None,
+          suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow])  # fmt: skip
+# the initial state's bounds' far corner (the check accepted 1e300 m before it had bounds)
+@example({"downrange_m": [2e5, 2e5], "altitude_m": [1e5, 1e5], "speed_forward_m_s": [1680.0, 1680.0]})
+@given(declared_values(ScenarioSection).map(lambda keys: {k: v for k, v in keys.items() if k != "tf_guess_s"}))
+def test_no_initial_state_the_check_accepts_writes_a_nan_or_a_wrong_landing(tmp_path_factory, ranges):
+    """The same for the descent's ranges drawn across their declared bounds (200 km out,
+    100 km up, 1680 m/s, any attitude the tilt limit allows) with the default lander (and
+    the scenario's own guess of the final time)."""
+    try:
+        config = resolve_config({"ocp": OCP, "scenarios": {"descent": ranges}})
+    except ConfigError:  # e.g. a tilt beyond the limit, a rising pitch with pitch_decreasing
+        assume(False)
+    refused_or_landed(config, tmp_path_factory.mktemp("base") / "base.h5")
+
+
+def refused_or_landed(config: dict, output) -> None:
+    """The descent's base solve of `config`: a BaseSolveError naming the scenario and the
+    vehicle, and no file; or a landing (the docstring above)."""
     s = ScenarioSettings.from_config(config, "descent")
-    output = tmp_path_factory.mktemp("base") / "base.h5"
+    vehicle = s.vehicle
     try:
         base_solution(s, output)
     except BaseSolveError as error:

@@ -90,8 +90,17 @@ OCP_REQUIRED = ("n_trajectories", "tf_guess_s", "downrange_m", "crossrange_m", "
                 "speed_cross_m_s", "speed_down_m_s", "roll_deg", "pitch_deg", "yaw_deg")  # fmt: skip
 
 
-def _range(doc: str, unit: str, source: str = "") -> object:
-    return setting(unit=unit, doc=f"{doc}, [low, high]", source=source, length=2, optional=True)
+# The initial state's physical bounds (the config check refused none before: an altitude
+# of 1e300 m reached IPOPT). Distances: the flat, uniform-gravity dynamics and the site
+# frame are this project's to 200 km of the site (the ground falls d^2 / 2R below the
+# plane: 11.5 km there); heights: the renderer's depth is tested to 100 km; speeds: below
+# the circular orbital speed at the mean radius, sqrt(GM / R) = 1680 m/s (no landing starts
+# faster); angles: one turn.
+REACH_M, CEILING_M, ORBITAL_SPEED_M_S = 2.0e5, 1.0e5, 1680.0
+
+
+def _range(doc: str, unit: str, source: str = "", **bounds) -> object:
+    return setting(unit=unit, doc=f"{doc}, [low, high]", source=source, length=2, optional=True, **bounds)
 
 
 @section("scenarios.<name>", f"a scenario: ranges of the initial state the OCP solves from ({RANGE}), or pose "
@@ -103,16 +112,20 @@ class ScenarioSection:
     n_trajectories: int = setting(unit="", doc="trajectories (ids 0000..n-1; failed samples are drawn again)",
                                   optional=True, ge=1, le=9999)  # fmt: skip
     tf_guess_s: float = setting(unit="s", doc="initial guess of the final time", optional=True, gt=0)
-    downrange_m: list[float] = _range("horizontal distance before the site along +x", "m", TABLE_1)
-    crossrange_m: list[float] = _range("initial lateral offset along +y", "m")
-    altitude_m: list[float] = _range("initial height above the site", "m")
-    speed_forward_m_s: list[float] = _range("initial speed along +x (toward the site)", "m/s")
-    speed_cross_m_s: list[float] = _range("initial speed along +y", "m/s")
-    speed_down_m_s: list[float] = _range("initial vertical speed, positive downwards", "m/s")
-    roll_deg: list[float] = _range("initial roll", "deg")
+    downrange_m: list[float] = _range("horizontal distance before the site along +x", "m", TABLE_1, ge=-REACH_M,
+                                      le=REACH_M)  # fmt: skip
+    crossrange_m: list[float] = _range("initial lateral offset along +y", "m", ge=-REACH_M, le=REACH_M)
+    altitude_m: list[float] = _range("initial height above the site", "m", gt=0, le=CEILING_M)
+    speed_forward_m_s: list[float] = _range("initial speed along +x (toward the site)", "m/s",
+                                            ge=-ORBITAL_SPEED_M_S, le=ORBITAL_SPEED_M_S)  # fmt: skip
+    speed_cross_m_s: list[float] = _range("initial speed along +y", "m/s", ge=-ORBITAL_SPEED_M_S,
+                                          le=ORBITAL_SPEED_M_S)  # fmt: skip
+    speed_down_m_s: list[float] = _range("initial vertical speed, positive downwards", "m/s", ge=-ORBITAL_SPEED_M_S,
+                                         le=ORBITAL_SPEED_M_S)  # fmt: skip
+    roll_deg: list[float] = _range("initial roll", "deg", ge=-180, le=180)
     pitch_deg: list[float] = _range("initial pitch; positive: thrust tilted backwards (braking), camera forwards",
-                                    "deg", TABLE_1)  # fmt: skip
-    yaw_deg: list[float] = _range("initial yaw", "deg")
+                                    "deg", TABLE_1, ge=-180, le=180)  # fmt: skip
+    yaw_deg: list[float] = _range("initial yaw", "deg", ge=-180, le=180)
     pitch_decreasing: bool = setting(False, "", "constrain the pitch never to increase, at every node and midpoint: "
                                      "the paper's \"pitch decreases over the entire trajectory\" of braking and "
                                      "approach, ~0.5 % more fuel (a monotone pitch needs pitch_deg >= 0; "
