@@ -66,7 +66,8 @@ def check_working_directory():
     if config["render"]["tile_cache"] and (unusable := tile_cache_unusable(config["render"]["tile_cache"])):
         raise WorkflowError(f"invalid configuration: render.tile_cache: {unusable}")
     # A GPU the jobs need but this machine lacks; a cluster's jobs run where the GPUs are.
-    if workflow.local_exec and models_importable():
+    # (Asked only off the CPU: importing the emulator costs every invocation ~0.9 s.)
+    if workflow.local_exec and config["events"]["device"] != "cpu" and models_importable():
         from traj2events.sensor.emulator import device_problem
 
         if problem := device_problem(config["events"]["device"]):
