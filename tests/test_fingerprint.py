@@ -141,6 +141,27 @@ def test_each_module_is_parsed_once_for_all_the_stages(package_copy):
     assert fingerprint.read_source.cache_info().misses == len(modules) + 1
 
 
+def test_a_parse_is_stored_read_back_the_same_and_parsed_again_when_damaged(tmp_path, monkeypatch):
+    # Every Snakemake invocation fingerprints the stages: parses stored across processes.
+    monkeypatch.setattr(fingerprint, "CACHE_DIR", tmp_path)
+    parses = []
+    parse = fingerprint.parse_source
+    monkeypatch.setattr(fingerprint, "parse_source", lambda text: parses.append(1) or parse(text))
+    text = (fingerprint.PACKAGE_DIR / "sensor" / "laws.py").read_text()
+    fingerprint.read_source.cache_clear()
+    fresh = fingerprint.read_source(text)
+    (entry,) = tmp_path.iterdir()
+    fingerprint.read_source.cache_clear()  # a new process
+    assert fingerprint.read_source(text) == fresh and len(parses) == 1
+    assert fresh.imports and isinstance(fresh.code, bytes) and isinstance(fresh.imports[0][2], tuple)
+    entry.write_text('{"imports": [[0, "numpy"')  # a damaged entry (a full disk, a killed write)
+    fingerprint.read_source.cache_clear()
+    assert fingerprint.read_source(text) == fresh and len(parses) == 2
+    assert fingerprint.read_source.__wrapped__(text) == fresh  # and stored again, whole
+    assert [p.name for p in tmp_path.iterdir()] == [entry.name]
+    fingerprint.read_source.cache_clear()
+
+
 def test_the_installed_version_is_in_no_closure_and_provenance_in_every_stages():
     """setuptools-scm rewrites _version.py at each install: a stage's files name the version
     (provenance) but do not rerun on it."""
