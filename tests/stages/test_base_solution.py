@@ -9,6 +9,7 @@ from hypothesis import HealthCheck, assume, event, example, given, settings
 from declared_values import accepted, declared_values
 from traj2events.config import ConfigError, resolve_config
 from traj2events.formats.trajectory import read_trajectory
+from traj2events.settings.solve import OcpSettings
 from traj2events.settings.tree import ScenarioSection
 from traj2events.settings.vehicle import Vehicle
 from traj2events.stages.base_solution import BaseSolveError, base_solution
@@ -59,6 +60,20 @@ def test_no_initial_state_the_check_accepts_writes_a_nan_or_a_wrong_landing(tmp_
     try:
         config = resolve_config({"ocp": OCP, "scenarios": {"descent": ranges}})
     except ConfigError:  # e.g. a tilt beyond the limit, a rising pitch with pitch_decreasing
+        assume(False)
+    refused_or_landed(config, tmp_path_factory.mktemp("base") / "base.h5")
+
+
+@settings(max_examples=max(settings.default.max_examples // 60, 5), deadline=None,
+          suppress_health_check=[HealthCheck.filter_too_much, HealthCheck.too_slow])  # fmt: skip
+@given(declared_values(OcpSettings, tf_min_s=60.0, tf_max_s=1e4))  # the final time's bounds about the descent's guess
+def test_no_solver_setting_the_check_accepts_writes_a_nan_or_a_wrong_landing(tmp_path_factory, ocp):
+    """The same for `ocp`'s floats and choices drawn across their declared bounds (the
+    transcription, mesh clustering to 1 - eps, epsilon and tol from 5e-324 to 1) on the
+    coarse mesh, with the default lander."""
+    try:
+        config = resolve_config({"ocp": {**OCP, **ocp}})
+    except ConfigError:  # e.g. tf_min_s above tf_max_s
         assume(False)
     refused_or_landed(config, tmp_path_factory.mktemp("base") / "base.h5")
 
