@@ -20,7 +20,7 @@ def declared_values(cls, normal: bool = False, **caps):
     """A strategy for a section's every key, drawn across its declared bounds (open ones
     capped by unit, OPEN_CAPS; any by `caps`): floats (subnormals included, as the config
     check accepts them; `normal`: 0 or >= 1e-100, for a law's relative bound), tuples of
-    floats, [low, high] ranges, choices, booleans."""
+    floats (as lists, as a config writes them), [low, high] ranges, choices, booleans."""
     keys, hints = {}, typing.get_type_hints(cls)
     for f in declared_fields(cls):
         meta, bounds, hint = f.metadata, f.metadata["bounds"], hints[f.name]
@@ -30,7 +30,9 @@ def declared_values(cls, normal: bool = False, **caps):
             keys[f.name] = st.booleans()
         elif hint is float or (typing.get_origin(hint) is tuple and set(typing.get_args(hint)) == {float}):
             floats = _floats(bounds, _cap(f, caps), normal)
-            keys[f.name] = floats if hint is float else st.tuples(*[floats] * len(typing.get_args(hint)))
+            # (a tuple as a config writes it: a list; the sections take either)
+            keys[f.name] = floats if hint is float else st.lists(floats, min_size=len(typing.get_args(hint)),
+                                                                 max_size=len(typing.get_args(hint)))  # fmt: skip
         elif hint == list[float] and meta["length"]:  # a [low, high] range
             floats = _floats(bounds, _cap(f, caps), normal)
             keys[f.name] = st.lists(floats, min_size=meta["length"], max_size=meta["length"]).map(sorted)

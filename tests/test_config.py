@@ -276,6 +276,11 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ),
     ({"events": {"preset": "imx"}}, ["events.preset", "expected one of ['clean', 'davis346', 'imx636', 'paper']"]),
     ({"events": {"pixel": {"theta_on": 0.001}}}, ["events.pixel.theta_on", ">= 0.01"]),
+    # the sensor search's finds (issue 71): the events job failed on these
+    ({"events": {"sensor": {"f_number": 5e-324}}}, ["events.sensor.f_number", ">= 0.5"]),
+    ({"events": {"sensor": {"f_number": 1e300}}}, ["events.sensor.f_number", "<= 1000"]),
+    ({"events": {"sensor": {"dark_current_a": 5e-324}}}, ["events.sensor.dark_current_a", ">= 1e-21"]),
+    ({"events": {"sensor": {"quantum_efficiency": 1e-200}}}, ["events.sensor.quantum_efficiency", ">= 0.001"]),
     ({"events": {"pixel": {"theta": 0.2}}}, ["unknown key 'events.pixel.theta'"]),
     ({"scenarios": {"descent": {"altitude_m": [-10.0, 100.0]}}}, ["scenarios.descent.altitude_m.0", "> 0"]),
     ({"scenarios": {"descent": {"altitude_m": [100.0, 1e300]}}}, ["scenarios.descent.altitude_m.1", "<= 100000"]),

@@ -63,9 +63,9 @@ def test_lunar_daylight_is_far_above_the_dark_current():
     "key, value, message",
     [
         ("quantum_efficiency", 1.5, "events.sensor.quantum_efficiency: expected a value <= 1, got 1.5"),
-        ("f_number", 0.0, "events.sensor.f_number: expected a value > 0"),
+        ("f_number", 0.0, "events.sensor.f_number: expected a value >= 0.5"),
         ("band_m", [7e-7, 4e-7], "events.sensor.band_m: expected [low, high]"),
-        ("dark_current_a", -1e-15, "events.sensor.dark_current_a: expected a value > 0"),
+        ("dark_current_a", -1e-15, "events.sensor.dark_current_a: expected a value >= 1e-21"),
     ],
 )
 def test_bad_sensor_values_name_the_key(key, value, message):

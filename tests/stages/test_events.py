@@ -12,7 +12,7 @@ from scipy.special import erf
 from declared_values import declared_values
 from traj2events.formats.events import EVENT_LABELS, read_events
 from traj2events.sensor.sources import frame_source
-from traj2events.settings.events import EmulatorParams, ReadoutParams, SpaceParams
+from traj2events.settings.events import EmulatorParams, ReadoutParams, SensorParams, SpaceParams
 from traj2events.stages.events import emulate, preset_params
 from traj2events.stages.pictures import events_picture
 from traj2events.video import VideoWriter
@@ -407,6 +407,41 @@ def test_no_pixel_readout_or_space_the_check_accepts_gives_events_off_the_clock(
     output = tmp_path_factory.mktemp("events") / "events.h5"
     emulate_with_settings(source, params, settings_, seed, output, "drawn", chunk=8)
     events, _ = read_events(output)
+    assert np.all(np.diff(events["t"].astype(np.int64)) >= 0)
+    assert events["t"].max(initial=0) <= round(1e6 * times[-1])
+    assert np.all(events["x"] < 4) and np.all(events["y"] < 3)
+
+
+@settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)
+@example({"f_number": 0.5, "optics_transmittance": 1e-3, "quantum_efficiency": 1e-3, "dark_current_a": 1e-21}, 0)
+@example({"f_number": 1000.0, "pixel_pitch_m": 5e-7, "psf_diffraction": True, "lens_blur_um": 100.0,
+          "vignetting": True, "dark_current_a": 1e-10}, 0)  # fmt: skip
+@given(declared_values(SensorParams), st.integers(0, 2**32 - 1))
+def test_no_sensor_the_check_accepts_fails_the_events_stage_or_gives_events_off_the_clock(tmp_path_factory, sensor,
+                                                                                        seed):  # fmt: skip
+    """events.sensor drawn across its declared bounds (lens, pixel pitch, band, dark current,
+    the three optics), through the events stage from a frames.h5 of radiance from black to
+    1e3 W/m^2/sr at uneven steps: events in order, on the recording's clock, in the image.
+    The search found the stage failing on what the check accepted: f_number 5e-324 (a
+    division by zero) or 1e300 (N^2 overflowed), a dark current of 5e-324 A (an infinite
+    input scale), a transmittance times a quantum efficiency underflowing to 0; the four
+    keys now have physical bounds (settings/events.py)."""
+    from traj2events.config import ConfigError, resolve_config
+    from traj2events.stages.events import events_command
+
+    try:
+        config = resolve_config({"events": {"sensor": sensor, "input": "sensor", "preset": "clean"}})
+    except ConfigError:  # e.g. a band with low >= high
+        return
+    folder = tmp_path_factory.mktemp("sensor")
+    rng = np.random.default_rng(seed)
+    times = np.cumsum(np.concatenate([[0.0], 10 ** rng.uniform(-5, np.log10(0.2), 5)]))
+    with h5py.File(folder / "frames.h5", "w") as f:
+        f["t"] = times
+        f["radiance"] = (10 ** rng.uniform(-6, 3, (6, 3, 4)) * (rng.random((6, 3, 4)) > 0.1)).astype(np.float32)
+        f.attrs["focal_px"] = 10.0
+    events_command(folder / "frames.h5", folder / "events.h5", config["events"], seed)
+    events, _ = read_events(folder / "events.h5")
     assert np.all(np.diff(events["t"].astype(np.int64)) >= 0)
     assert events["t"].max(initial=0) <= round(1e6 * times[-1])
     assert np.all(events["x"] < 4) and np.all(events["y"] < 3)

@@ -45,17 +45,19 @@ class EmulatorParams:
 )
 class SensorParams:
     f_number: float = setting(2.0, "", "the lens's f-number N (image irradiance pi tau L / 4 N^2): a fast "
-                              "machine-vision lens", source="assumed", gt=0)  # fmt: skip
-    optics_transmittance: float = setting(0.9, "", "the lens's transmittance tau: a coated multi-element lens",
-                                          source="assumed", gt=0, le=1)  # fmt: skip
+                              "machine-vision lens; from f/0.5, a lens's limit in air (N = 1 / 2 NA, NA <= 1), to "
+                              "f/1000, a pinhole's", source="assumed", ge=0.5, le=1000)  # fmt: skip
+    optics_transmittance: float = setting(0.9, "", "the lens's transmittance tau: a coated multi-element lens "
+                                          "(from 1e-3: a dense neutral filter)", source="assumed", ge=1e-3,
+                                          le=1)  # fmt: skip
     pixel_pitch_m: float = setting(4.86e-6, "m", "pixel pitch: 0.5 um (below a visible wavelength) to 100 um (event "
                                    "pixels: 4-40 um)", source=IMX636, ge=5.0e-7, le=1.0e-4)  # fmt: skip
     quantum_efficiency: float = setting(
         0.5,
         "",
-        "electrons per photon over the whole pixel area: a back-illuminated sensor in the visible",
+        "electrons per photon over the whole pixel area: a back-illuminated sensor in the visible (from 1e-3)",
         source="assumed",
-        gt=0,
+        ge=1e-3,
         le=1,
     )
     band_m: tuple[float, float] = setting((4.0e-7, 7.0e-7), "m", "[low, high] wavelengths of the sensor's band: the "
@@ -63,7 +65,8 @@ class SensorParams:
                                           ge=2.0e-7, le=1.2e-6)  # fmt: skip
     dark_current_a: float = setting(1.0e-15, "A", "dark current per pixel, the knee of the log response: the order "
                                     "of IMX636's 0.08 lx low-light cutoff (0.6 fA at 555 nm, QE 0.5); above 100 pA "
-                                    "sunlit regolith would drown", gt=0, le=1.0e-10)  # fmt: skip
+                                    "sunlit regolith would drown; from 1e-21 A, a cooled CCD's 0.006 e-/s",
+                                    ge=1.0e-21, le=1.0e-10)  # fmt: skip
     psf_diffraction: bool = setting(False, "", "blur the radiance by the lens's Airy pattern (f_number over band_m) "
                                     "before the log (docs/events.md \"Optics\")")  # fmt: skip
     lens_blur_um: float = setting(0.0, "um", "and by a Gaussian lens blur of this standard deviation at the focal "
