@@ -276,6 +276,10 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ),
     ({"events": {"preset": "imx"}}, ["events.preset", "expected one of ['clean', 'davis346', 'imx636', 'paper']"]),
     ({"events": {"pixel": {"theta_on": 0.001}}}, ["events.pixel.theta_on", ">= 0.01"]),
+    # the terrain search's finds (issue 71): overflows, heights past float32's range
+    ({"terrain": {"crater_diameter_min_m": 5e-324}}, ["terrain.crater_diameter_min_m", ">= 0.001"]),
+    ({"terrain": {"roughness_m_at_1m": 1e300}}, ["terrain.roughness_m_at_1m", "<= 1"]),
+    ({"terrain": {"crater_density_k": 3e306}}, ["terrain.crater_density_k", "geometric saturation"]),
     # the sensor search's finds (issue 71): the events job failed on these
     ({"events": {"sensor": {"f_number": 5e-324}}}, ["events.sensor.f_number", ">= 0.5"]),
     ({"events": {"sensor": {"f_number": 1e300}}}, ["events.sensor.f_number", "<= 1000"]),

@@ -3,7 +3,9 @@ user grids and the curved-Moon geometry."""
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
 
+from declared_values import declared_values
 from traj2events.scene.terrain import (
     GridTerrain,
     ProceduralTerrain,
@@ -313,3 +315,37 @@ def test_value_noise_passes_through_the_lattice_values_and_is_continuous():
     mid = value_noise(4, 1000, i + 0.5, j)
     corners = 0.5 * (hash_uniform(4, 1000, i, j) + hash_uniform(4, 1000, i + 1, j))
     np.testing.assert_allclose(mid, corners, rtol=0, atol=1e-15)
+
+
+def sizes_in_order(keys: dict) -> dict:
+    """Drawn keys with each smallest size at most its largest (the check's own order), each
+    still within its bounds: a largest raised to its smallest, rocks lowered to boulders."""
+    keys = dict(keys)
+    for lo, hi in (
+        ("crater_diameter_min_m", "crater_diameter_max_m"),
+        ("boulder_diameter_min_m", "boulder_diameter_max_m"),
+    ):
+        keys[hi] = max(keys[lo], keys[hi])
+    keys["rock_diameter_min_m"] = min(keys["rock_diameter_min_m"], keys["boulder_diameter_min_m"])
+    return keys
+
+
+@settings(max_examples=max(settings.default.max_examples // 3, 10), deadline=None)
+@example({"crater_diameter_min_m": 1e-3, "crater_slope": 6.0, "crater_density_k": 1e300,
+          "crater_diameter_max_m": 1e5, "roughness_m_at_1m": 1.0, "roughness_wavelength_max_m": 1e5})  # fmt: skip
+# (boulders dense enough to cover the ground are the check's to refuse: capped)
+@given(declared_values(TerrainParams, site_radius_m=1e4, pad_relief_wavelength_max_m=1e3, boulder_density_k=1e-2)
+       .map(sizes_in_order))  # fmt: skip
+def test_no_surface_the_check_accepts_has_a_height_float32_cannot_hold(keys):
+    """`terrain` drawn across its declared bounds: the procedural surface's heights over a
+    100 m box are finite in float32, as the renderer's tiles hold them. The search found
+    a smallest crater (or boulder) of 5e-324 m overflowing the size octaves, a largest
+    crater of 1e300 m a cell's area, and roughness of 1e300 m heights of 4e301 m; those
+    keys now have physical bounds (settings/render.py)."""
+    try:
+        params = TerrainParams(**keys)
+    except ValueError:  # e.g. boulders covering more than half the ground
+        return
+    x, y = np.meshgrid(np.linspace(-50.0, 50.0, 16), np.linspace(-50.0, 50.0, 16))
+    heights = ProceduralTerrain(params).height_m(x, y, 100.0 / 15)
+    assert np.isfinite(heights.astype(np.float32)).all()

@@ -351,7 +351,8 @@ def site_pad_weight(x_m: np.ndarray, y_m: np.ndarray, radius_m: float) -> np.nda
     """0 on the landing pad (r < radius), smoothly 1 beyond 2 radii."""
     if radius_m <= 0:
         return np.ones(np.broadcast(x_m, y_m).shape)
-    s = np.clip(np.hypot(x_m, y_m) / radius_m - 1.0, 0.0, 1.0)
+    with np.errstate(over="ignore"):  # a subnormal radius: r / radius is inf, and the weight 1
+        s = np.clip(np.hypot(x_m, y_m) / radius_m - 1.0, 0.0, 1.0)
     return s * s * (3 - 2 * s)
 
 

@@ -18,6 +18,13 @@ HAPKE = "representative lunar values after Helfenstein & Veverka (1987) and Sato
 PIKE = "Pike (1977)"
 REFLECTANCE_MODELS = ("hapke", "lunar-lambert")
 TEXTURE_FILTERS = ("box", "trilinear", "point")
+# The procedural surface's physical bounds (the check accepted a smallest crater of 5e-324 m,
+# which overflowed the size octaves, and a roughness of 1e300 m, heights past float32's
+# range): features from 1 mm (coarse sand; no pixel resolves less), craters and roughness
+# to 100 km (the scenes reach 200 km), size-frequency slopes to 6 (lunar ones measure
+# 1-5; Bart & Melosh 2010: 2.5-4 for boulders), 1 m of RMS height at 1 m.
+MIN_FEATURE_M, MAX_CRATER_M, MAX_SLOPE = 1.0e-3, 1.0e5, 6.0
+GEOMETRIC_SATURATION = 1.54  # N(>D) D^2 of craters packed edge to edge (Gault 1970): no denser field
 TIMING_MODES = ("fixed", "adaptive")
 
 
@@ -26,32 +33,33 @@ class TerrainParams:
     seed: int = setting(1, "", "seed of the procedural craters, boulders and roughness", ge=0)
     crater_density_k: float = setting(0.08, "m^-2", "K in N(>D) = K D^-slope craters per m^2, D in m: ~equilibrium "
                                       "for small lunar craters", source="Gault (1970)", ge=0)  # fmt: skip
-    crater_slope: float = setting(2.0, "", "cumulative crater size-frequency slope", gt=0)
-    crater_diameter_min_m: float = setting(0.5, "m", "smallest crater", gt=0)
-    crater_diameter_max_m: float = setting(2000.0, "m", "largest crater", gt=0)
+    crater_slope: float = setting(2.0, "", "cumulative crater size-frequency slope", gt=0, le=MAX_SLOPE)
+    crater_diameter_min_m: float = setting(0.5, "m", "smallest crater", ge=MIN_FEATURE_M, le=MAX_CRATER_M)
+    crater_diameter_max_m: float = setting(2000.0, "m", "largest crater", gt=0, le=MAX_CRATER_M)
     depth_to_diameter: float = setting(0.2, "", "fresh simple craters, rim crest to floor", source=PIKE, ge=0, le=1)
     rim_height_to_diameter: float = setting(0.036, "", "fresh craters' rim height", source=PIKE, ge=0, le=1)
     fresh_fraction: float = setting(0.2, "", "fraction of craters that are fresh (rims, ejecta); the rest degraded",
                                     ge=0, le=1)  # fmt: skip
-    roughness_m_at_1m: float = setting(0.02, "m", "RMS height of the 1 m wavelength", ge=0)
+    roughness_m_at_1m: float = setting(0.02, "m", "RMS height of the 1 m wavelength", ge=0, le=1)
     roughness_hurst: float = setting(0.8, "", "Hurst exponent of the roughness (RMS grows as wavelength^H)", ge=0,
                                      le=1)  # fmt: skip
-    roughness_wavelength_max_m: float = setting(64.0, "m", "longest roughness wavelength", gt=0)
+    roughness_wavelength_max_m: float = setting(64.0, "m", "longest roughness wavelength", gt=0, le=MAX_CRATER_M)
     site_radius_m: float = setting(30.0, "m", "landing pad around the site, level at the lander's scale (the "
                                    "trajectories touch down at z = 0)", ge=0)  # fmt: skip
     boulder_density_k: float = setting(3.0e-4, "m^-2", "K in N(>D) = K D^-slope boulders per m^2, D in m, away from "
                                        "fresh craters: 300 boulders >= 1 m per km^2, the order of mare surfaces; 0: "
                                        "none", source="Cintala & McBride (1995)", ge=0)  # fmt: skip
     boulder_slope: float = setting(2.5, "", "cumulative boulder size-frequency slope (-2.5 .. -4 measured around "
-                                   "lunar craters)", source="Bart & Melosh (2010)", gt=0)  # fmt: skip
-    boulder_diameter_min_m: float = setting(0.5, "m", "smallest boulder", gt=0)
+                                   "lunar craters)", source="Bart & Melosh (2010)", gt=0, le=MAX_SLOPE)  # fmt: skip
+    boulder_diameter_min_m: float = setting(0.5, "m", "smallest boulder", ge=MIN_FEATURE_M, le=100)
     boulder_diameter_max_m: float = setting(8.0, "m", "largest boulder", gt=0, le=100)
     boulder_ejecta_factor: float = setting(30.0, "", "boulder density on fresh craters' ejecta (1-3 radii, craters "
                                            ">= 20 m) relative to elsewhere", ge=1, le=1000)  # fmt: skip
     rock_diameter_min_m: float = setting(0.02, "m", "smallest rock: the boulders' law goes on below "
                                          "boulder_diameter_min_m down to here (pebbles and small rocks, seen where "
                                          "the shading textures resolve them; those up to 0.2 m stay on the pad); "
-                                         "equal to boulder_diameter_min_m: none", gt=0)  # fmt: skip
+                                         "equal to boulder_diameter_min_m: none", ge=MIN_FEATURE_M,
+                                         le=100)  # fmt: skip
     pad_relief_wavelength_max_m: float = setting(2.0, "m", "roughness this short stays on the pad (regolith texture, "
                                                  "~4 cm RMS; at 2 m a 128^2 camera 60 m up still resolves it); 0: a "
                                                  "flat pad", ge=0)  # fmt: skip
@@ -73,6 +81,16 @@ class TerrainParams:
             raise ValueError(f"terrain.rock_diameter_min_m: expected at most terrain.boulder_diameter_min_m = "
                              f"{self.boulder_diameter_min_m} (rocks are the boulders' law below it), got "
                              f"{self.rock_diameter_min_m}")  # fmt: skip
+        # N(>D) D^2 = K D^(2 - slope) is largest at one end of the sizes (in logs: K D^-slope
+        # overflows where the check matters)
+        for end, d in (("smallest", self.crater_diameter_min_m), ("largest", self.crater_diameter_max_m)):
+            if self.crater_density_k > 0 and math.log(self.crater_density_k) + (2 - self.crater_slope) * math.log(
+                d
+            ) > math.log(GEOMETRIC_SATURATION):
+                raise ValueError(f"terrain.crater_density_k: more craters of the {end} size than fit on the ground: "
+                                 f"N(>D) = K D^-slope above the geometric saturation {GEOMETRIC_SATURATION} D^-2 "
+                                 f"(Gault 1970) at D = {d} m, got K = {self.crater_density_k}, slope "
+                                 f"{self.crater_slope}")  # fmt: skip
         covered = self.boulder_cover
         if covered > 0.5:
             raise ValueError(f"terrain.boulder_density_k: boulders and rocks would cover {covered:.0%} of the ground "
