@@ -280,6 +280,7 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"terrain": {"crater_diameter_min_m": 5e-324}}, ["terrain.crater_diameter_min_m", ">= 0.001"]),
     ({"terrain": {"roughness_m_at_1m": 1e300}}, ["terrain.roughness_m_at_1m", "<= 1"]),
     ({"terrain": {"crater_density_k": 3e306}}, ["terrain.crater_density_k", "geometric saturation"]),
+    ({"render": {"lod": {"min_spacing_m": 5e-324}}}, ["render.lod.min_spacing_m", ">= 0.001"]),
     # the sensor search's finds (issue 71): the events job failed on these
     ({"events": {"sensor": {"f_number": 5e-324}}}, ["events.sensor.f_number", ">= 0.5"]),
     ({"events": {"sensor": {"f_number": 1e300}}}, ["events.sensor.f_number", "<= 1000"]),

@@ -129,7 +129,9 @@ class LodSettings:
     margin: int = setting(32, "", "extra cells toward the Sun, for the shadow march", ge=0, le=256)
     pixels_per_cell: float = setting(8.0, "px", "split a tile while one cell covers more pixels than this", gt=0)
     min_spacing_m: float = setting(0.05, "m", "the finest geometry's grid spacing; its shading textures hold detail "
-                                   "3-4 levels finer (docs/rendering.md \"Detail at touchdown\")", gt=0)  # fmt: skip
+                                   "3-4 levels finer (docs/rendering.md \"Detail at touchdown\"); from 1 mm, as the "
+                                   "terrain's features (5e-324 overflowed the tile levels)",
+                                   ge=MIN_FEATURE_M)  # fmt: skip
     shading_levels: int = setting(3, "", "0: the law per vertex of the drawn tiles; k > 0: per pixel, from a texture "
                                   "of the normals and lit fractions k levels finer (docs/rendering.md \"Shading\")",
                                   ge=0, le=4)  # fmt: skip
