@@ -18,11 +18,9 @@ HAPKE = "representative lunar values after Helfenstein & Veverka (1987) and Sato
 PIKE = "Pike (1977)"
 REFLECTANCE_MODELS = ("hapke", "lunar-lambert")
 TEXTURE_FILTERS = ("box", "trilinear", "point")
-# The procedural surface's physical bounds (the check accepted a smallest crater of 5e-324 m,
-# which overflowed the size octaves, and a roughness of 1e300 m, heights past float32's
-# range): features from 1 mm (coarse sand; no pixel resolves less), craters and roughness
-# to 100 km (the scenes reach 200 km), size-frequency slopes to 6 (lunar ones measure
-# 1-5; Bart & Melosh 2010: 2.5-4 for boulders), 1 m of RMS height at 1 m.
+# The procedural surface's physical bounds (5e-324 m overflowed the size octaves): features
+# from 1 mm (coarse sand; no pixel resolves less), craters and roughness to 100 km (scenes
+# reach 200 km), size-frequency slopes to 6 (lunar ones: 1-5; Bart & Melosh 2010).
 MIN_FEATURE_M, MAX_CRATER_M, MAX_SLOPE = 1.0e-3, 1.0e5, 6.0
 GEOMETRIC_SATURATION = 1.54  # N(>D) D^2 of craters packed edge to edge (Gault 1970): no denser field
 TIMING_MODES = ("fixed", "adaptive")
