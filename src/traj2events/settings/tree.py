@@ -90,11 +90,11 @@ OCP_REQUIRED = ("n_trajectories", "tf_guess_s", "downrange_m", "crossrange_m", "
                 "speed_cross_m_s", "speed_down_m_s", "roll_deg", "pitch_deg", "yaw_deg")  # fmt: skip
 
 
-# The initial state's physical bounds (docs/decisions/0012-initial-state-bounds.md). Distances: the flat, uniform-gravity dynamics and the site
-# frame are this project's to 200 km of the site (the ground falls d^2 / 2R below the
-# plane: 11.5 km there); heights: the renderer's depth is tested to 100 km; speeds: below
-# the circular orbital speed at the mean radius, sqrt(GM / R) = 1680 m/s (no landing starts
-# faster); angles: one turn.
+# The initial state's physical bounds (docs/decisions/0012-initial-state-bounds.md).
+# Distances: the flat, uniform-gravity dynamics and the site frame are this project's to
+# 200 km of the site (the ground falls d^2 / 2R below the plane: 11.5 km there); heights:
+# the renderer's depth is tested to 100 km; speeds: below the circular orbital speed at the
+# mean radius, sqrt(GM / R) = 1680 m/s (no landing starts faster); angles: one turn.
 REACH_M, CEILING_M, ORBITAL_SPEED_M_S = 2.0e5, 1.0e5, 1680.0
 
 
