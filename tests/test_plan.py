@@ -203,3 +203,12 @@ def test_a_render_jobs_memory_holds_its_texture_array_while_it_doubles_to_its_ca
     for width in (128, 1024):
         config = resolve_config({"camera": {"width": width, "height": width}})
         assert peak_mib < job_resources(config, "render", "approach")["mem_mb"] < 1.5 * MEMORY_MB["render"][0]
+
+
+@pytest.mark.parametrize("bound", [{"max_log_change": 5e-324}, {"max_log_change": None, "max_displacement_px": 5e-324}])
+def test_a_timing_bound_near_zero_plans_as_many_frames_as_max_fps_allows(bound):
+    # Issue 71: bound^-p overflowed, and the config check itself raised OverflowError.
+    from traj2events.plan import rendered_per_frame
+
+    config = resolve_config({"render": {"timing": {"mode": "adaptive", **bound}}})
+    assert rendered_per_frame(config) == config["render"]["timing"]["max_fps"] / config["camera"]["fps"]

@@ -9,6 +9,7 @@ estimates, not bounds.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -133,7 +134,11 @@ def rendered_per_frame(config: dict) -> float:
         return 1.0
     a, p, q = ADAPTIVE_EXTRA
     bound = timing["max_log_change"] or 2.0 * timing["max_displacement_px"]
-    return min(1.0 + a * (camera["width"] / 128.0) ** q * bound**-p, timing["max_fps"] / camera["fps"])
+    try:
+        extra = a * (camera["width"] / 128.0) ** q * bound**-p
+    except OverflowError:  # a bound near 0 (5e-324): as many frames as max_fps allows
+        extra = math.inf
+    return min(1.0 + extra, timing["max_fps"] / camera["fps"])
 
 
 def render_s_per_frame(config: dict, pixels: int) -> float:
