@@ -398,17 +398,29 @@ def test_no_pixel_readout_or_space_the_check_accepts_gives_events_off_the_clock(
         config = resolve_config({"events": {"pixel": pixel, "readout": readout, "space": space, "input": "sensor"}})
     except ConfigError:
         return
-    rng = np.random.default_rng(seed)
-    times = np.cumsum(np.concatenate([[0.0], 10 ** rng.uniform(-5, np.log10(0.2), 5)]))
-    frames = (10 ** rng.uniform(-3, 6, (6, 3, 4)) * (rng.random((6, 3, 4)) > 0.1)).astype(np.float32)
+    times, frames = uneven_frames(seed, -3, 6)
     source = FrameSource(4, 3, SENSOR_KIND, iter([(frames, times)]))
     settings_ = config["events"]
     params, _ = pixel_and_sensor(settings_)
     output = tmp_path_factory.mktemp("events") / "events.h5"
     emulate_with_settings(source, params, settings_, seed, output, "drawn", chunk=8)
-    events, _ = read_events(output)
+    assert_on_the_clock_and_in_the_image(output, times[-1])
+
+
+def uneven_frames(seed: int, low_decade: float, high_decade: float) -> tuple[np.ndarray, np.ndarray]:
+    """Six 3 x 4 frames at steps of 10 us to 0.2 s: (times s, values from 10^low to 10^high,
+    a tenth of them 0), drawn from `seed`."""
+    rng = np.random.default_rng(seed)
+    times = np.cumsum(np.concatenate([[0.0], 10 ** rng.uniform(-5, np.log10(0.2), 5)]))
+    frames = 10 ** rng.uniform(low_decade, high_decade, (6, 3, 4)) * (rng.random((6, 3, 4)) > 0.1)
+    return times, frames.astype(np.float32)
+
+
+def assert_on_the_clock_and_in_the_image(path, end_s: float) -> None:
+    """events.h5's events in time order, none after the recording's end, all in the 3 x 4 image."""
+    events, _ = read_events(path)
     assert np.all(np.diff(events["t"].astype(np.int64)) >= 0)
-    assert events["t"].max(initial=0) <= round(1e6 * times[-1])
+    assert events["t"].max(initial=0) <= round(1e6 * end_s)
     assert np.all(events["x"] < 4) and np.all(events["y"] < 3)
 
 
@@ -434,14 +446,9 @@ def test_no_sensor_the_check_accepts_fails_the_events_stage_or_gives_events_off_
     except ConfigError:  # e.g. a band with low >= high
         return
     folder = tmp_path_factory.mktemp("sensor")
-    rng = np.random.default_rng(seed)
-    times = np.cumsum(np.concatenate([[0.0], 10 ** rng.uniform(-5, np.log10(0.2), 5)]))
+    times, radiance = uneven_frames(seed, -6, 3)
     with h5py.File(folder / "frames.h5", "w") as f:
-        f["t"] = times
-        f["radiance"] = (10 ** rng.uniform(-6, 3, (6, 3, 4)) * (rng.random((6, 3, 4)) > 0.1)).astype(np.float32)
+        f["t"], f["radiance"] = times, radiance
         f.attrs["focal_px"] = 10.0
     events_command(folder / "frames.h5", folder / "events.h5", config["events"], seed)
-    events, _ = read_events(folder / "events.h5")
-    assert np.all(np.diff(events["t"].astype(np.int64)) >= 0)
-    assert events["t"].max(initial=0) <= round(1e6 * times[-1])
-    assert np.all(events["x"] < 4) and np.all(events["y"] < 3)
+    assert_on_the_clock_and_in_the_image(folder / "events.h5", times[-1])

@@ -116,8 +116,9 @@ def shot_noise_events(
                 k += 1
             j += 1
             s, offset, coin, on = candidate(block_key, j, s, mean_gap_s)
-        if min(k, room) - first > 1:
-            sort_by_pixel(out_pix, out_s, out_on, first, min(k, room))
+        written = min(k, room)
+        if written - first > 1:
+            sort_by_pixel(out_pix, out_s, out_on, first, written)
     return k
 
 

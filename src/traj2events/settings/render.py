@@ -81,10 +81,9 @@ class TerrainParams:
                              f"{self.rock_diameter_min_m}")  # fmt: skip
         # N(>D) D^2 = K D^(2 - slope) is largest at one end of the sizes (in logs: K D^-slope
         # overflows where the check matters)
+        k, slope = self.crater_density_k, self.crater_slope
         for end, d in (("smallest", self.crater_diameter_min_m), ("largest", self.crater_diameter_max_m)):
-            if self.crater_density_k > 0 and math.log(self.crater_density_k) + (2 - self.crater_slope) * math.log(
-                d
-            ) > math.log(GEOMETRIC_SATURATION):
+            if k > 0 and math.log(k) + (2 - slope) * math.log(d) > math.log(GEOMETRIC_SATURATION):
                 raise ValueError(f"terrain.crater_density_k: more craters of the {end} size than fit on the ground: "
                                  f"N(>D) = K D^-slope above the geometric saturation {GEOMETRIC_SATURATION} D^-2 "
                                  f"(Gault 1970) at D = {d} m, got K = {self.crater_density_k}, slope "
@@ -128,8 +127,7 @@ class LodSettings:
     pixels_per_cell: float = setting(8.0, "px", "split a tile while one cell covers more pixels than this", gt=0)
     min_spacing_m: float = setting(0.05, "m", "the finest geometry's grid spacing; its shading textures hold detail "
                                    "3-4 levels finer (docs/rendering.md \"Detail at touchdown\"); from 1 mm, as the "
-                                   "terrain's features (5e-324 overflowed the tile levels)",
-                                   ge=MIN_FEATURE_M)  # fmt: skip
+                                   "terrain's features", ge=MIN_FEATURE_M)  # fmt: skip
     shading_levels: int = setting(3, "", "0: the law per vertex of the drawn tiles; k > 0: per pixel, from a texture "
                                   "of the normals and lit fractions k levels finer (docs/rendering.md \"Shading\")",
                                   ge=0, le=4)  # fmt: skip
