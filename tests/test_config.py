@@ -2,6 +2,7 @@
 class of mistake."""
 
 import copy
+import re
 import subprocess
 import sys
 
@@ -229,6 +230,28 @@ def test_a_manoeuvre_beyond_the_flights_reach_is_refused(kind, manoeuvre):
     with pytest.raises(ConfigError, match=rf"scenarios.descent.{kind}.offset_m': {reach}"):
         validate_config(config)
     config["scenarios"]["descent"][kind]["offset_m"] = [20.0, 2400.0]
+    validate_config(config)
+
+
+HOVER = {"altitude_m": [20.0, 30.0], "duration_s": [1.0, 2.0], "offset_m": [10.0, 20.0], "direction_deg": [0.0, 90.0]}
+
+
+@pytest.mark.parametrize("key, value, expected", [
+    # the search's finds (tests/stages/test_camera_poses.py): the first leg from below the
+    # point, or the hold from under the ground, was IPOPT's Invalid_Problem_Definition in
+    # every trajectory's job
+    ("altitude_m", [50.0, 150.0], "at most the flight's lowest start, scenarios.descent.altitude_m[0] = 100 m"),
+    ("altitude_m", [1e-3, 30.0], "above ocp.accept_error_m = 0.1 m"),
+    # 310.91 s x 9.80665 / 1.6242 x ln(9472.06 / 6000) = 857.1 s
+    ("duration_s", [5.0, 900.0], "at most 857.1 s, the longest the fuel holds"),
+    ("duration_s", [5.0, 4000.0], "a value <= 3600"),
+])  # fmt: skip
+def test_a_hover_no_draw_can_fly_is_refused(key, value, expected):
+    config = with_preset(default_config())
+    config["scenarios"]["descent"]["hover"] = {**HOVER, key: value}
+    with pytest.raises(ConfigError, match=rf"scenarios.descent.hover.{key}(.1)?': expected {re.escape(expected)}"):
+        validate_config(config)
+    config["scenarios"]["descent"]["hover"] = HOVER
     validate_config(config)
 
 

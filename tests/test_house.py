@@ -20,7 +20,7 @@ WITHOUT_TEST_FILE = {
     "renderer/context", "renderer/lens", "renderer/shading_array", "scene/populations",
     "scene/sun", "scene/terrain_kernels", "scene/view", "sensor/ordering", "sensor/parallel",
     "settings/camera", "settings/events", "settings/generate", "settings/imu", "settings/poses",
-    "settings/solve", "settings/tree", "stages/camera_poses",
+    "settings/solve", "settings/tree",
     "stages/index", "stages/motion_field", "stages/pictures",
     "stages/render_events", "stages/sample_trajectories",
     "trajectory/flight", "trajectory/legs",

@@ -124,6 +124,8 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             errors.append(f"config key 'scenarios.{name}.{kind}.offset_m': expected at most the flight's reach, "
                           f"{reach_m:.4g} m (the largest start's distance from the site: downrange_m, crossrange_m, "
                           f"altitude_m), got {sc[kind]['offset_m']}")  # fmt: skip
+    if "hover" in kinds:
+        errors += _hover_errors(config, name, sc)
     tilt = config["vehicle"]["tilt_max_deg"]
     roll, pitch = (math.radians(max(map(abs, sc[k]))) for k in ("roll_deg", "pitch_deg"))
     if math.cos(roll) * math.cos(pitch) < math.cos(math.radians(tilt)):
@@ -143,6 +145,32 @@ def _scenario_errors(config: dict, name: str, sc: dict) -> list[str]:
             f"config key 'camera.fps': expected at least 2 frames per trajectory, scenario '{name}' would have "
             f"{frames:.3g} (t_f ~ {sc['tf_guess_s']} s at {config['camera']['fps']} fps)"
         )
+    return errors
+
+
+def _hover_errors(config: dict, name: str, sc: dict) -> list[str]:
+    """A hover no draw can fly: above the flight's lowest start (its first leg may not
+    climb: the legs keep z <= 0 about their target), within the legs' arrival error of the
+    ground (the hold could start under it), or longer than the fuel holds the weight even
+    from the wet mass."""
+    from .settings.vehicle import Vehicle
+
+    hover, key, errors = sc["hover"], f"config key 'scenarios.{name}.hover", []
+    lowest, accept_m = sc["altitude_m"][0], config["ocp"]["accept_error_m"]
+    if hover["altitude_m"][1] > lowest:
+        errors.append(f"{key}.altitude_m': expected at most the flight's lowest start, scenarios.{name}.altitude_m"
+                      f"[0] = {lowest:g} m (its first leg may not climb), got {hover['altitude_m']}")  # fmt: skip
+    if hover["altitude_m"][0] <= accept_m:
+        errors.append(f"{key}.altitude_m': expected above ocp.accept_error_m = {accept_m:g} m (the lander may arrive "
+                      f"that far from the hover point), got {hover['altitude_m']}")  # fmt: skip
+    try:
+        vehicle = Vehicle(**config["vehicle"])
+    except ValueError:  # (its own check names the key)
+        return errors
+    longest_s = vehicle.longest_hold_s(vehicle.mass_kg)
+    if hover["duration_s"][1] > longest_s:
+        errors.append(f"{key}.duration_s': expected at most {longest_s:.4g} s, the longest the fuel holds the weight "
+                      f"from vehicle.mass_kg to vehicle.dry_mass_kg, got {hover['duration_s']}")  # fmt: skip
     return errors
 
 

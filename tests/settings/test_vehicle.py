@@ -35,3 +35,11 @@ def test_every_term_of_the_dynamics_is_finite_at_the_bounds_corners(isp_s, inert
     xdot = Dynamics(vehicle)(state, [1.0, 1.0, -1.0, 1.0])
     assert np.isfinite(xdot).all()
     assert xdot[12] == pytest.approx(-(1e8 + 2 * 1e5 * 3) / (isp_s * 9.78), rel=1e-15)
+
+
+def test_the_longest_hold_burns_the_wet_mass_down_to_the_dry_mass():
+    """T = Isp g0 / g ln(m / m_dry): 310.91 x 9.80665 / 1.6242 x ln(9472.06 / 6000) =
+    857.11 s for the default lander (worked by hand); without gravity, no limit."""
+    assert Vehicle().longest_hold_s(9472.06) == pytest.approx(857.11, abs=0.01)
+    assert Vehicle().longest_hold_s(6000.0) == 0.0
+    assert Vehicle(g_m_s2=0.0).longest_hold_s(9472.06) == float("inf")

@@ -68,6 +68,34 @@ def test_the_hold_burns_fuel_as_the_rocket_equation_says():
     assert np.abs(end[VELOCITY]).max() < 1e-5 and np.abs(end[POSITION] - start[POSITION]).max() < 1e-4
 
 
+def test_a_hold_longer_than_the_fuel_is_recorded_as_such_and_the_sample_kept(flown):
+    """The search's find (tests/stages/test_camera_poses.py): a hold past the fuel started
+    the last leg below the dry mass (IPOPT: Invalid_Problem_Definition). The longest hold
+    from the arrival's mass ends at the dry mass on the hold's own nodes; one second more
+    fails by name, before any solve of the last leg."""
+    settings, flight, *_ = flown
+    arrived_kg = flight.state[np.searchsorted(flight.t, flight.hover_start_s), MASS]
+    longest_s = settings.vehicle.longest_hold_s(arrived_kg)
+    start = np.zeros(13)
+    start[MASS] = arrived_kg
+    assert holding(settings.vehicle, start, longest_s)[1][-1, MASS] == pytest.approx(6000.0, rel=1e-12)
+    problem = LandingProblem(settings.vehicle, settings.ocp)
+    sample = problem.solve(base_conditions(settings.scenario, settings.vehicle))
+    too_long = Hover(HOVER.altitude_m, longest_s + 1.0, HOVER.offset_m, HOVER.direction_deg, HOVER.point_m)
+    failed = hover_flight(settings.vehicle, settings.ocp, (sample.t, sample.state, sample.control), too_long)
+    assert not failed.success and len(failed.results) == 1 and failed.results[0].success
+    assert failed.hold_failure.startswith("the fuel runs out after 80")  # (~803 s: its mass at the node)
+    assert failed.hold_failure.endswith(f"of the {longest_s + 1.0:.4g} s hold")
+    np.testing.assert_array_equal(failed.state, sample.state)
+
+
+def test_a_hold_shorter_than_a_frame_drifts_by_nothing():
+    """The search's find: a 1 ms hold has no pose in it at 5 fps (an IndexError)."""
+    t, state = np.arange(5) / 5.0, np.zeros((5, 13))
+    assert hover_drift_m(t, state, 0.41, 0.411) == (0.0, 0.0)
+    assert hover_drift_m(t, state, 0.4, 0.4) == (0.0, 0.0)  # one pose: nothing to drift from
+
+
 def test_each_trajectory_draws_its_own_hover_and_a_scenario_flies_one_kind(tmp_path):
     ranges = {"altitude_m": [50.0, 100.0], "duration_s": [5.0, 20.0], "offset_m": [10.0, 50.0],
               "direction_deg": [0.0, 360.0]}  # fmt: skip

@@ -43,7 +43,8 @@ class DivertSection:
 class HoverSection:
     altitude_m: list[float] = setting(unit="m", doc=f"the hover's height above the site's ground: {RANGE}", gt=0,
                                       length=2)  # fmt: skip
-    duration_s: list[float] = setting(unit="s", doc=f"how long it holds: {RANGE}", gt=0, length=2)
+    duration_s: list[float] = setting(unit="s", doc=f"how long it holds: {RANGE}; at most an hour (108,000 frames "
+                                      "at 30 fps)", gt=0, le=3600, length=2)  # fmt: skip
     offset_m: list[float] = setting(unit="m", doc=f"how far from the site the hover point is, horizontally: {RANGE}",
                                     ge=0, length=2)  # fmt: skip
     direction_deg: list[float] = setting(unit="deg", doc=f"towards which azimuth from the site, from +x towards +y: "

@@ -9,6 +9,7 @@ from 1 s (cold gas is ~70 s) to 1e5 s (ion engines: ~1e4 s)."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 
 from .declare import section, setting
@@ -49,3 +50,11 @@ class Vehicle:
 
     def to_dict(self) -> dict:
         return {**asdict(self), "inertia_kgm2": list(self.inertia_kgm2)}
+
+    def longest_hold_s(self, mass_kg: float) -> float:
+        """s: how long the engine can hold the weight from `mass_kg` before the mass
+        reaches the dry mass, the rocket equation's m(t) = m_0 exp(-g t / (Isp g0)) solved
+        for m(t) = m_dry (inf without gravity)."""
+        if self.g_m_s2 == 0:
+            return float("inf")
+        return self.isp_s * self.g0_m_s2 / self.g_m_s2 * math.log(mass_kg / self.dry_mass_kg)

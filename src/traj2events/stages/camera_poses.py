@@ -123,7 +123,8 @@ def manoeuvre_record(flight: DivertedFlight | HoverFlight) -> dict:
         }
     h, legs = flight.hover, flight.results
     failed = next((f"leg {2 * i + 1} ({name}): {r.reason}" for i, (r, name) in
-                   enumerate(zip(legs, ("to the hover point", "to the site"))) if not r.success), "")  # fmt: skip
+                   enumerate(zip(legs, ("to the hover point", "to the site"))) if not r.success),
+                  f"leg 2 (the hold): {flight.hold_failure}")  # fmt: skip
     return {
         "hover": f"flown ({', '.join(r.method for r in legs)})"
         if flight.success

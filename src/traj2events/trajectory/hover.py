@@ -62,10 +62,11 @@ class HoverFlight:
     results: list[SampleResult]  # legs 1 and 3, as far as they were flown
     error_position_m: float  # the whole flight re-integrated, against the site
     error_velocity_m_s: float
+    hold_failure: str = ""  # why the hold could not be flown (the fuel runs out), empty when it could
 
     @property
     def success(self) -> bool:
-        return len(self.results) == 2 and all(r.success for r in self.results)
+        return not self.hold_failure and len(self.results) == 2 and all(r.success for r in self.results)
 
 
 def holding(vehicle: Vehicle, state: np.ndarray, duration_s: float) -> Nodes:
@@ -86,18 +87,22 @@ def hover_flight(vehicle: Vehicle, settings: OcpSettings, sample: Nodes, hover: 
     t, state, control = sample
     dynamics = Dynamics(vehicle)
     point = np.array([*hover.point_m, -hover.altitude_m])  # z down
-    results, leg_3 = [], None
+    results, leg_3, hold_failure = [], None, ""
     to_point, leg_1 = fly_leg(vehicle, settings, state[0], point, sample, np.zeros(3))
     results.append(to_point)
     if leg_1 is not None:
         arrived = ReintegratedStates(dynamics, leg_1[0], leg_1[1][0], leg_1[2]).final_state
-        held = holding(vehicle, arrived, hover.duration_s)
-        left = ReintegratedStates(dynamics, held[0], arrived, held[2]).final_state
-        to_site, leg_3 = fly_leg(vehicle, settings, left, np.zeros(3), None)
-        results.append(to_site)
-    if leg_1 is None or leg_3 is None:
+        longest_s = vehicle.longest_hold_s(arrived[MASS])
+        if hover.duration_s > longest_s:  # (the hold's mass would go below the dry mass)
+            hold_failure = f"the fuel runs out after {longest_s:.4g} s of the {hover.duration_s:.4g} s hold"
+        else:
+            held = holding(vehicle, arrived, hover.duration_s)
+            left = ReintegratedStates(dynamics, held[0], arrived, held[2]).final_state
+            to_site, leg_3 = fly_leg(vehicle, settings, left, np.zeros(3), None)
+            results.append(to_site)
+    if leg_3 is None:
         errors = final_state_error(dynamics, t, state, control)
-        return HoverFlight(t, state, control, hover, np.nan, np.nan, results, *errors)
+        return HoverFlight(t, state, control, hover, np.nan, np.nan, results, *errors, hold_failure)
     nodes = joined(leg_1, held, leg_3)
     start, miss = float(leg_1[0][-1]), landing_miss(dynamics, nodes, np.zeros(3))
     return HoverFlight(*nodes, hover, start, start + hover.duration_s, results, *miss)
@@ -105,7 +110,10 @@ def hover_flight(vehicle: Vehicle, settings: OcpSettings, sample: Nodes, hover: 
 
 def hover_drift_m(t: np.ndarray, state: np.ndarray, start_s: float, end_s: float) -> tuple[float, float]:
     """(largest distance from the hover's first pose, its altitude's spread), m, over the
-    poses during the hover: how still it holds."""
+    poses during the hover: how still it holds (0, 0 where it holds for less than two
+    poses: a hold shorter than a frame has no pose to drift from)."""
     during = (t >= start_s) & (t <= end_s)
     position = state[during][:, POSITION]
+    if len(position) < 2:
+        return 0.0, 0.0
     return float(np.linalg.norm(position - position[0], axis=1).max()), float(np.ptp(position[:, Z]))
