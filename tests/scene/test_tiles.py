@@ -141,6 +141,29 @@ def test_evicting_keeps_the_tiles_a_kept_tiles_scattered_light_is_marched_over()
     assert tiles.n_built == built + 2
 
 
+def test_a_frame_past_the_grid_points_budget_is_refused_before_its_tiles_are_built(monkeypatch):
+    """The render search's find (tests/stages/test_render.py): a split at 5e-324 pixels a
+    cell seen from 3 km kept splitting down to 1 mm and took the machine's 24 GB. Past
+    MAX_FRAME_POINTS (or, with 4-cell tiles, 145 s past MAX_FRAME_TILES) the selection
+    stops, naming the key, with at most that budget built and the ancestors above it (a
+    third more)."""
+    from traj2events.geometry.camera import Camera, camera_pose
+    from traj2events.scene import tiles as tiles_module
+
+    monkeypatch.setattr(tiles_module, "MAX_FRAME_POINTS", 81 * 200)  # 200 tiles of 8 cells
+    tiles = _tiles(pixels_per_cell=5e-324, min_spacing_m=1e-3)
+    state = np.zeros(13)
+    state[2], state[7] = -3000.0, np.radians(60.0)
+    with pytest.raises(RuntimeError, match=r"16,200 terrain grid points .*render.lod.pixels_per_cell"):
+        tiles.select(camera_pose(state), Camera(64, 64, 45.0))
+    assert 150 < tiles.n_built <= 200 * 4 / 3
+    monkeypatch.setattr(tiles_module, "MAX_FRAME_TILES", 100)
+    tiles = _tiles(pixels_per_cell=5e-324, min_spacing_m=1e-3)
+    with pytest.raises(RuntimeError, match=r"more than 100 tiles"):
+        tiles.select(camera_pose(state), Camera(64, 64, 45.0))
+    assert 75 < tiles.n_built <= 100 * 4 / 3
+
+
 def test_a_drawn_tiles_cells_cover_at_most_pixels_per_cell_unless_it_is_the_finest():
     # select_measured's pixels per cell, the renderer's measure of magnified texels: a
     # cell's spacing over its nearest point's distance, in focal lengths (foreshortened

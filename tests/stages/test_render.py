@@ -1,5 +1,6 @@
-"""The render stage driven by configs the check accepts: the reflectance law and the Sun
-drawn across their declared bounds (docs/accuracy.md "End-to-end stress")."""
+"""The render stage driven by configs the check accepts: the reflectance law and the Sun,
+and the level of detail, drawn across their declared bounds (docs/accuracy.md
+"End-to-end stress")."""
 
 import h5py
 import numpy as np
@@ -15,7 +16,7 @@ from traj2events.geometry.camera import Camera
 from traj2events.renderer.law_uniforms import law_uniforms
 from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
 from traj2events.scene.sun import Sun
-from traj2events.settings.render import RenderSettings
+from traj2events.settings.render import LodSettings, RenderSettings
 from traj2events.stages.render import render_trajectory
 
 WIDTH, HEIGHT = 8, 6
@@ -54,28 +55,13 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     radiance_max), a depth that is finite and > 0 on the ground, and, with the Sun's disk
     wholly up, each ground pixel within 2 % of the law at its centre plus the law's change
     to its neighbours."""
-    folder = tmp_path_factory.mktemp("render")
-    np.save(folder / "flat.npy", np.zeros((8, 8)))
-    overlay = {
-        "camera": {"width": WIDTH, "height": HEIGHT, "fps": 10.0, "mount_height_m": 1.0},
-        "terrain": {"elevation_grid": str(folder / "flat.npy"), "grid_spacing_m": 1e4},
-        "render": {"reflectance": reflectance, "preview": False, "tile_cache": None},
-        "scenarios": {"descent": {"sun": {"azimuth_deg": sun_azimuth_deg, "elevation_deg": sun_elevation_deg}}},
-    }
-    try:
-        config = resolve_config(overlay)
-    except ConfigError:
+    sun = {"azimuth_deg": sun_azimuth_deg, "elevation_deg": sun_elevation_deg}
+    drawn = rendered(tmp_path_factory.mktemp("render"), {"reflectance": reflectance}, sun, altitude_m, pitch_deg)
+    if drawn is None:
         return
-    write_poses(folder / "trajectory.h5", altitude_m, pitch_deg)
-    render = RenderSettings.from_config(config, "descent")
-    render_trajectory(folder / "trajectory.h5", render, folder / "frames.h5", folder / "video.mkv", None, "osmesa")
-    with h5py.File(folder / "frames.h5") as f:
-        radiance, depth = f["radiance"][:], f["depth_m"][:]
+    render, radiance, depth = drawn
     law, sun = ReflectanceParams(**render.reflectance), Sun(**render.sun)
-    assert np.all(np.isfinite(radiance)) and np.all(radiance >= 0)
-    assert radiance.max() <= law_uniforms(law, sun)["radiance_max"] * (1 + 1e-3)
     ground = depth[0] > 0
-    assert ground.any() and np.all(np.isfinite(depth[0][ground]))
     if sun_elevation_deg <= 2 * np.degrees(sun.angular_radius_rad):
         return  # the Sun's disk partly below the horizon: lit by the part above (scene.tiles' penumbrae)
     expected = np.full(depth[0].shape, np.nan)
@@ -87,6 +73,59 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     change = np.nanmax(np.abs(np.array(neighbours) - expected), axis=0, initial=0.0)
     error = np.abs(radiance[0] - expected)
     assert np.all(error[ground] <= 0.02 * expected[ground] + change[ground]), (radiance[0], expected)
+
+
+def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: float):
+    """(RenderSettings, frames.h5's radiance, its depth) of flat ground seen `altitude_m`
+    up, pitched `pitch_deg`, with `render` and the descent's `sun` laid over the defaults;
+    None where the check refuses them. Checked: radiance finite, >= 0 and at most the law's
+    brightest (law_uniforms' radiance_max); depth finite and > 0 on some ground."""
+    np.save(folder / "flat.npy", np.zeros((8, 8)))
+    overlay = {
+        "camera": {"width": WIDTH, "height": HEIGHT, "fps": 10.0, "mount_height_m": 1.0},
+        "terrain": {"elevation_grid": str(folder / "flat.npy"), "grid_spacing_m": 1e4},
+        "render": {**render, "preview": False, "tile_cache": None},
+        "scenarios": {"descent": {"sun": sun}},
+    }
+    try:
+        config = resolve_config(overlay)
+    except ConfigError:
+        return None
+    write_poses(folder / "trajectory.h5", altitude_m, pitch_deg)
+    render_settings = RenderSettings.from_config(config, "descent")
+    frames = folder / "frames.h5"
+    render_trajectory(folder / "trajectory.h5", render_settings, frames, folder / "video.mkv", None, "osmesa")
+    with h5py.File(frames) as f:
+        radiance, depth = f["radiance"][:], f["depth_m"][:]
+    law, sun = ReflectanceParams(**render_settings.reflectance), Sun(**render_settings.sun)
+    assert np.all(np.isfinite(radiance)) and np.all(radiance >= 0)
+    assert radiance.max() <= law_uniforms(law, sun)["radiance_max"] * (1 + 1e-3)
+    ground = depth[0] > 0
+    assert ground.any() and np.all(np.isfinite(depth[0][ground]))
+    return render_settings, radiance, depth
+
+
+@pytest.mark.slow  # ~4 s a render
+@settings(max_examples=max(settings.default.max_examples // 60, 5), deadline=None)
+# (cells and margins to 64: 256 of each renders for a minute before the tile budget refuses it)
+# (its finds, a split at 5e-324 pixels a cell taking 24 GB or 145 s, stop at the frame's
+# tile budget: tests/scene/test_tiles.py, on a smaller budget; here 10-40 s a frame)
+@given(declared_values(LodSettings, pixels_per_cell=1e3, magnified_texel_px=1e3, min_spacing_m=1e3),
+       st.integers(4, 64), st.integers(0, 64), st.floats(2.0, 3000.0), st.floats(0.0, 80.0))  # fmt: skip
+def test_no_level_of_detail_the_check_accepts_gives_a_nan_or_a_negative_radiance(
+    tmp_path_factory, lod, cells, margin, altitude_m, pitch_deg
+):
+    """render.lod drawn across its declared bounds (a finest spacing from 1 mm, a split at
+    5e-324 to 1e3 pixels a cell, any shading texture and filter) over the same flat ground:
+    the radiance and depth checks above, or the renderer's refusal of a frame whose tiles
+    its shading texture cannot hold, naming render.lod. (No 2 % check: the level of detail
+    trades accuracy for time; docs/decisions/0005-pixel-footprint.md measures it.)"""
+    sun = {"azimuth_deg": 30.0, "elevation_deg": 20.0}
+    try:
+        rendered(tmp_path_factory.mktemp("lod"), {"lod": {**lod, "cells": cells, "margin": margin}}, sun, altitude_m,
+                 pitch_deg)  # fmt: skip
+    except RuntimeError as refusal:
+        assert "render.lod" in str(refusal)
 
 
 def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_deg):

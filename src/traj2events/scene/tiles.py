@@ -48,6 +48,12 @@ from .view import frustum_planes, line_of_sight_limit
 
 TileKey = tuple[int, int, int]  # (level, i, j); i along x, j along y, 0..2^level - 1
 
+# Tiles and grid points one frame may select (~150 bytes a point when built: ~5 GB; ~0.1 ms
+# a tile). An 8192^2 frame of the default descent selects at most 2,335 tiles of 33^2
+# points (2.5 M); a split at 5e-324 pixels a cell kept splitting to 1 mm and took the
+# machine's 24 GB, or, with 4-cell tiles, 145 s.
+MAX_FRAME_TILES, MAX_FRAME_POINTS = 2**15, 2**25
+
 
 @dataclass
 class Tile:
@@ -395,6 +401,14 @@ class TileSet:
                 for a in (0, 1)
                 for b in (0, 1)
             ]
+            n_tiles = len(chosen) + len(frontier)
+            points = n_tiles * (self.lod.cells + 1) ** 2
+            if n_tiles > MAX_FRAME_TILES or points > MAX_FRAME_POINTS:  # (before the next level's are built)
+                raise RuntimeError(
+                    f"a frame needs more than {MAX_FRAME_TILES:,} tiles or {MAX_FRAME_POINTS:,} terrain grid points "
+                    f"({n_tiles:,} tiles of {self.lod.cells} cells and counting): raise "
+                    f"render.lod.pixels_per_cell (got {self.lod.pixels_per_cell:g}) or render.lod.min_spacing_m"
+                )
         return chosen, np.array(chosen_px)
 
     def _relief_bound(self) -> float:
