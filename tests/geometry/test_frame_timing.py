@@ -67,6 +67,15 @@ def test_steps_split_the_fixed_interval_evenly():
     assert next_render_time(0.0, 0.2, 0.025, min_interval_s=0.025) == pytest.approx(0.025)
 
 
+def test_the_highest_frame_rate_still_advances_the_clock_an_hour_in():
+    """A probe's find: at max_fps 1e300 the shortest step, 1e-300 s, is below a float's
+    step at 100 s, and the render loop stayed at one time. At the bound (1e6 Hz, the
+    events' microsecond clock) each step advances by 1 us an hour in."""
+    assert next_render_time(100.0, 100.02, 1e-300, min_interval_s=1e-300) == 100.0  # (what it was)
+    t = 3600.0
+    assert next_render_time(t, t + 0.02, 1e-6, min_interval_s=1e-6) - t == pytest.approx(1e-6, rel=1e-4)
+
+
 @pytest.mark.parametrize(
     "settings, key",
     [
@@ -74,6 +83,7 @@ def test_steps_split_the_fixed_interval_evenly():
         ({"max_log_change": 0.0}, "max_log_change"),
         ({"max_displacement_px": -1.0}, "max_displacement_px"),
         ({"max_fps": 0.0}, "max_fps"),
+        ({"max_fps": 1.01e6}, "max_fps"),
         ({"mode": "adaptive", "max_log_change": None, "max_displacement_px": None}, "max_log_change or"),
     ],
 )

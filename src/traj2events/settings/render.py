@@ -194,7 +194,9 @@ class FrameTiming:
     )
     max_displacement_px: float | None = setting(None, "px", "adaptive: the largest displacement of a terrain pixel "
                                                 "over an interval; null: no such bound", gt=0)  # fmt: skip
-    max_fps: float = setting(2000.0, "Hz", "adaptive: the shortest interval is 1 / max_fps", gt=0)
+    max_fps: float = setting(2000.0, "Hz", "adaptive: the shortest interval is 1 / max_fps; at most 1e6 Hz, the "
+                             "events' microsecond clock (at 1e300 a step was below a float's at 100 s and the "
+                             "render stalled)", gt=0, le=1e6)  # fmt: skip
 
     def __post_init__(self) -> None:
         if self.mode == "adaptive" and self.max_log_change is None and self.max_displacement_px is None:
