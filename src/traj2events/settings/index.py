@@ -35,10 +35,15 @@ def index_settings(config: dict) -> dict:
 
 
 def split_of(settings: dict, scenario: str, trajectory_id: int) -> str:
-    """The split of one trajectory: a uniform draw u of its own, train below the train share,
-    validation below train + validation, else test."""
-    u = trajectory_rng(settings, scenario, f"{trajectory_id:04d}", "split").random()
-    shares = settings["splits"]
+    """The split of one trajectory, from a uniform draw u in [0, 1) of its own (split_at)."""
+    return split_at(trajectory_rng(settings, scenario, f"{trajectory_id:04d}", "split").random(), settings["splits"])
+
+
+def split_at(u: float, shares: dict) -> str:
+    """train below the train share of u's [0, 1), validation below train + validation, else
+    test; the shares scaled by their sum (within 1e-9 of 1), so that a share of 0 gets no
+    landing."""
+    u *= shares["train"] + shares["validation"] + shares["test"]
     if u < shares["train"]:
         return "train"
     return "validation" if u < shares["train"] + shares["validation"] else "test"
