@@ -11,13 +11,15 @@ from hypothesis import strategies as st
 from declared_values import declared_values
 from normal_floats import normal_floats
 from traj2events.config import ConfigError, resolve_config
-from traj2events.formats.trajectory import write_trajectory
+from traj2events.formats.trajectory import vehicle_attrs, write_trajectory
 from traj2events.geometry.camera import Camera
 from traj2events.renderer.law_uniforms import law_uniforms
 from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
 from traj2events.scene.sun import Sun
 from traj2events.settings.render import LodSettings, RenderSettings
+from traj2events.settings.vehicle import Vehicle
 from traj2events.stages.render import render_trajectory
+from traj2events.trajectory.state import VELOCITY
 
 WIDTH, HEIGHT = 8, 6
 
@@ -32,11 +34,14 @@ def lander_state(x_m: float, altitude_m: float, pitch_deg: float) -> np.ndarray:
 
 def write_poses(path, altitude_m: float, pitch_deg: float, fps: float = 10.0) -> None:
     """Two poses of a camera `altitude_m` up, pitched `pitch_deg` toward the horizon, moving
-    1 m forward between them."""
+    1 m forward between them (the default lander coasting: adaptive frames between them
+    re-integrate its fall)."""
     t = np.array([0.0, 1.0 / fps])
     state = np.array([lander_state(x, altitude_m, pitch_deg) for x in (0.0, 1.0)])
+    state[:, VELOCITY.start] = fps  # m/s: 1 m a frame
     nodes = (t, state, np.zeros((2, 4)))
-    write_trajectory(path, nodes, nodes, {"fps": fps, "scenario": "descent", "id": 0, "tf_s": t[-1]}, 1.0)
+    attrs = {**vehicle_attrs(Vehicle()), "fps": fps, "scenario": "descent", "id": 0, "tf_s": t[-1]}
+    write_trajectory(path, nodes, nodes, attrs, 1.0)
 
 
 @settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)
@@ -59,7 +64,7 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     drawn = rendered(tmp_path_factory.mktemp("render"), {"reflectance": reflectance}, sun, altitude_m, pitch_deg)
     if drawn is None:
         return
-    render, radiance, depth = drawn
+    render, radiance, depth, _ = drawn
     law, sun = ReflectanceParams(**render.reflectance), Sun(**render.sun)
     ground = depth[0] > 0
     if sun_elevation_deg <= 2 * np.degrees(sun.angular_radius_rad):
@@ -76,7 +81,7 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
 
 
 def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: float):
-    """(RenderSettings, frames.h5's radiance, its depth) of flat ground seen `altitude_m`
+    """(RenderSettings, frames.h5's radiance, depth and t) of flat ground seen `altitude_m`
     up, pitched `pitch_deg`, with `render` and the descent's `sun` laid over the defaults;
     None where the check refuses them. Checked: radiance finite, >= 0 and at most the law's
     brightest (law_uniforms' radiance_max); depth finite and > 0 on some ground."""
@@ -96,13 +101,13 @@ def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: floa
     frames = folder / "frames.h5"
     render_trajectory(folder / "trajectory.h5", render_settings, frames, folder / "video.mkv", None, "osmesa")
     with h5py.File(frames) as f:
-        radiance, depth = f["radiance"][:], f["depth_m"][:]
+        radiance, depth, t_s = f["radiance"][:], f["depth_m"][:], f["t"][:]
     law, sun = ReflectanceParams(**render_settings.reflectance), Sun(**render_settings.sun)
     assert np.all(np.isfinite(radiance)) and np.all(radiance >= 0)
     assert radiance.max() <= law_uniforms(law, sun)["radiance_max"] * (1 + 1e-3)
     ground = depth[0] > 0
     assert ground.any() and np.all(np.isfinite(depth[0][ground]))
-    return render_settings, radiance, depth
+    return render_settings, radiance, depth, t_s
 
 
 @pytest.mark.slow  # ~4 s a render
@@ -126,6 +131,28 @@ def test_no_level_of_detail_the_check_accepts_gives_a_nan_or_a_negative_radiance
                  pitch_deg)  # fmt: skip
     except RuntimeError as refusal:
         assert "render.lod" in str(refusal)
+
+
+@settings(max_examples=max(settings.default.max_examples // 60, 5), deadline=None)
+@example(1e-6, None, 1e3)  # the tightest bound at the most frames the search allows
+@given(st.none() | st.floats(0.0, 10.0, exclude_min=True), st.none() | st.floats(0.0, 100.0, exclude_min=True),
+       st.floats(10.0, 1e3, exclude_min=True))  # fmt: skip
+def test_no_adaptive_timing_the_check_accepts_stalls_or_leaves_the_flight(
+    tmp_path_factory, max_log_change, max_displacement_px, max_fps
+):
+    """render.timing, adaptive, its bounds drawn from 5e-324 (max_fps to 1e3 Hz here, 100
+    frames a camera frame; the probe of 1e300 Hz stalled at one time, now bounded at 1e6)
+    over the flat ground from 100 m up: the radiance checks above on every frame, and
+    times from the first pose to the last, increasing, never closer than 1 / max_fps."""
+    timing = {"mode": "adaptive", "max_log_change": max_log_change, "max_displacement_px": max_displacement_px,
+              "max_fps": max_fps}  # fmt: skip
+    sun = {"azimuth_deg": 30.0, "elevation_deg": 20.0}
+    drawn = rendered(tmp_path_factory.mktemp("timing"), {"timing": timing}, sun, 100.0, 30.0)
+    if drawn is None:  # (both bounds null)
+        return
+    t_s = drawn[3]
+    assert t_s[0] == 0.0 and t_s[-1] == pytest.approx(0.1, abs=1e-12) and len(t_s) <= 1 + max_fps / 10.0 + 1e-9
+    assert np.all(np.diff(t_s) >= (1 / max_fps) * (1 - 1e-9))
 
 
 def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_deg):
