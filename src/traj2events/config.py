@@ -233,12 +233,15 @@ def _dem_errors(config: dict) -> list[str]:
     if config["terrain"].get("elevation_grid"):
         return ["config key 'terrain.elevation_grid': a site flies one surface: terrain.dem or terrain.elevation_grid, "
                 "not both"]  # fmt: skip
-    from .scene.dem import DemError, dem_terrain
+    from .scene.dem import DemError, dem_detail, dem_terrain
 
-    try:
-        dem_terrain(dem, float(config["motion_field"]["moon_radius_m"]))
+    try:  # (with the detail: a mask's craters are built from it, and checked)
+        dem_terrain(dem, float(config["motion_field"]["moon_radius_m"]), dem_detail(config["terrain"]))
     except DemError as exc:
         return [f"config key '{exc.key}': {exc}"]
+    except ValueError as exc:  # the mask's craters (scene.dem.band_params) outside the terrain's laws
+        return [f"config key 'terrain.dem.mask': its craters, from half a post to half the interpolated resolution "
+                f"at the terrain's density: {exc}"]  # fmt: skip
     return []
 
 

@@ -7,6 +7,9 @@ import pytest
 
 rasterio = pytest.importorskip("rasterio")  # the dem extra (setup.sh --test installs it)
 
+from hypothesis import example, given, settings  # noqa: E402
+
+from declared_values import declared_values  # noqa: E402
 from stand_in_dem import (  # noqa: E402
     POST_M,
     SITE,
@@ -18,7 +21,9 @@ from stand_in_dem import (  # noqa: E402
     write_site_dem,
 )
 from traj2events.config import ConfigError, resolve_config  # noqa: E402
-from traj2events.scene.dem import DemError, DemProduct, dem_terrain, site_radius_m  # noqa: E402
+from traj2events.scene.dem import DemError, DemProduct, dem_detail, dem_terrain, site_radius_m  # noqa: E402
+from traj2events.scene.terrain import TerrainParams  # noqa: E402
+from traj2events.settings.site import DemMaskSection  # noqa: E402
 
 
 def site_config(path, **site):
@@ -211,7 +216,6 @@ def test_the_detail_below_5m_posts_keeps_each_posts_mean(tmp_path):
     in the product's own map and carried to the site frame by Snyder's formulas: the detail
     (craters, boulders, rocks, roughness below the posts) moves no post's mean by more than
     0.1 m (issue 70's bound), and it is there (centimetres to decimetres of relief)."""
-    from traj2events.scene.terrain import TerrainParams
 
     post = 5.0
     path = write_site_dem(tmp_path / "site5.tif", n=400, post_m=post)
@@ -237,7 +241,6 @@ def test_a_5m_site_is_textured_at_touchdown_with_its_detail_and_smooth_without(t
     from traj2events.renderer.supersample import sensor_renderer
     from traj2events.scene.reflectance import ReflectanceParams
     from traj2events.scene.sun import Sun
-    from traj2events.scene.terrain import TerrainParams
     from traj2events.scene.tiles import LodSettings, TileSet
 
     path = write_site_dem(tmp_path / "site5.tif", n=400, post_m=5.0)
@@ -298,19 +301,33 @@ def test_the_far_field_dem_shapes_the_horizon(tmp_path):
     assert (ground["both"] - ground["site only"]).max() >= 5  # the massif stands above the plain's horizon
 
 
-def test_a_mask_adds_craters_where_the_product_is_interpolated_and_not_where_measured(tmp_path):
-    """A LOLA-style count raster (LDEC: laser spots per post) on the product's grid: 0 in its
-    western half (interpolated), 3 in its eastern: craters up to half the effective resolution
-    join the detail there only; where measured, the surface is the detail's alone."""
-    from traj2events.scene.terrain import TerrainParams
-
+def write_half_measured(folder, n):
+    """A product of 5 m posts, n a side, about the site and a LOLA-style count raster on its
+    grid (LDEC: laser spots per post): 0 in its western half (interpolated), 3 in its
+    eastern; and the site frame's (north, east) m of the post centres of each half's middle,
+    200 m+ from the site at n = 400."""
     post = 5.0
-    path = write_site_dem(tmp_path / "site5.tif", n=400, post_m=post)
-    counts = tmp_path / "ldec.tif"
+    path = write_site_dem(folder / "site5.tif", n=n, post_m=post)
+    counts = folder / "ldec.tif"
     with rasterio.open(path) as src:
         profile = {**src.profile, "nodata": None}
     with rasterio.open(counts, "w", **profile) as dst:
-        dst.write(np.where(np.arange(400) < 200, 0.0, 3.0)[None, :].repeat(400, 0).astype(np.float32), 1)
+        dst.write(np.where(np.arange(n) < n // 2, 0.0, 3.0)[None, :].repeat(n, 0).astype(np.float32), 1)
+    radius = site_radius_m(site_config(path)["terrain"]["dem"])
+    x0, y0 = stereographic(*SITE)
+    halves = {}
+    west, east = np.arange(n // 20, 2 * n // 5), np.arange(3 * n // 5, 19 * n // 20)
+    for name, cols in (("interpolated", west), ("measured", east)):
+        c, r = np.meshgrid(cols, np.arange(7 * n // 20, 13 * n // 20))
+        x, y = x0 + (c - n // 2 + 0.5) * post, y0 - (r - n // 2 + 0.5) * post
+        halves[name] = gnomonic(*inverse_stereographic(x, y), radius, *SITE)
+    return path, counts, halves
+
+
+def test_a_mask_adds_craters_where_the_product_is_interpolated_and_not_where_measured(tmp_path):
+    """Craters up to half the effective resolution join the detail where the count raster
+    says interpolated only; where measured, the surface is the detail's alone."""
+    path, counts, halves = write_half_measured(tmp_path, 400)
     dem = site_config(path)["terrain"]["dem"]
     radius = site_radius_m(dem)
     mask = {"file": str(counts), "measured_min": 1.0, "interpolated_resolution_m": 60.0}
@@ -318,14 +335,54 @@ def test_a_mask_adds_craters_where_the_product_is_interpolated_and_not_where_mea
         dem_terrain(dem, radius, TerrainParams()),
         dem_terrain({**dem, "mask": mask}, radius, TerrainParams()),
     )
-    x0, y0 = stereographic(*SITE)
-    band = {}
-    for name, cols in (("interpolated", np.arange(20, 160)), ("measured", np.arange(240, 380))):
-        c, r = np.meshgrid(cols, np.arange(140, 260))
-        x, y = x0 + (c - 200 + 0.5) * post, y0 - (r - 200 + 0.5) * post  # post centres, 200 m+ from the site
-        north, east = gnomonic(*inverse_stereographic(x, y), radius, *SITE)
-        band[name] = masked.height_m(north, east, 0.5) - plain.height_m(north, east, 0.5)
+    band = {name: masked.height_m(*at, 0.5) - plain.height_m(*at, 0.5) for name, at in halves.items()}
     assert np.abs(band["measured"]).max() < 1e-9
     assert band["interpolated"].std() > 0.05 and band["interpolated"].min() < -1.0  # craters of metres
     with pytest.raises(DemError, match="terrain.dem.detail: true"):
         dem_terrain({**dem, "mask": mask}, radius, None)
+    resolve_config({"terrain": {"dem": {**dem, "mask": mask}}})  # the check builds the same (it refused every mask)
+
+
+@pytest.fixture(scope="module")
+def half_measured(tmp_path_factory):
+    return write_half_measured(tmp_path_factory.mktemp("mask"), 64)
+
+
+CRATER_KEYS = ("crater_density_k", "crater_slope", "crater_diameter_min_m", "crater_diameter_max_m",
+               "depth_to_diameter", "rim_height_to_diameter", "fresh_fraction")  # fmt: skip
+
+
+def crater_keys(keys: dict) -> dict:
+    """The terrain's crater keys, the smallest at most the largest."""
+    craters = {k: keys[k] for k in CRATER_KEYS}
+    craters["crater_diameter_max_m"] = max(craters["crater_diameter_min_m"], craters["crater_diameter_max_m"])
+    return craters
+
+
+@settings(max_examples=max(settings.default.max_examples // 10, 10), deadline=None)
+@example({"measured_min": 5e-324, "interpolated_resolution_m": 2e5},
+         {"crater_density_k": 0.08, "crater_slope": 2.0, "crater_diameter_min_m": 0.5,
+          "crater_diameter_max_m": 2000.0, "depth_to_diameter": 0.2, "rim_height_to_diameter": 0.036,
+          "fresh_fraction": 0.2})  # fmt: skip
+@given(declared_values(DemMaskSection, measured_min=1e300),
+       declared_values(TerrainParams, crater_density_k=10.0).map(crater_keys))  # fmt: skip
+def test_a_mask_the_check_accepts_gives_finite_heights_and_keeps_the_measured_posts(half_measured, mask, craters):
+    """terrain.dem.mask and the terrain's craters drawn across their declared bounds: the
+    check refuses by name, or the surface it accepts has heights float32 holds, the mask's
+    craters only where posts are interpolated. The search found the check refusing every
+    mask (it built the site without the detail the mask needs), and a resolution of 1e6 m
+    failing on a key not set (terrain.crater_diameter_max_m, 5e5 m): it is at most 2e5 m."""
+    path, counts, halves = half_measured
+    dem = site_config(path)["terrain"]["dem"]
+    masked = {**dem, "mask": {"file": str(counts), **mask}}
+    try:
+        config = resolve_config({"terrain": {"dem": masked, **craters}})
+    except ConfigError as exc:
+        assert "config key 'terrain." in str(exc)
+        return
+    radius, detail = site_radius_m(dem), dem_detail(config["terrain"])
+    plain, masked = dem_terrain(dem, radius, detail), dem_terrain(masked, radius, detail)
+    heights = {name: masked.height_m(*at, 0.5) for name, at in halves.items()}
+    assert all(np.isfinite(h.astype(np.float32)).all() for h in heights.values())
+    if mask["measured_min"] <= 3.0:  # (the eastern half's 3 spots a post: measured)
+        assert np.abs(heights["measured"] - plain.height_m(*halves["measured"], 0.5)).max() < 1e-9

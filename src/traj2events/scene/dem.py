@@ -241,7 +241,8 @@ class DemMask:
     def interpolated(self, lat: np.ndarray, lon: np.ndarray, spacing_m: float) -> np.ndarray:
         """0 where measured, 1 where interpolated (bilinear between posts; outside the mask: 1)."""
         value = self.product.sample(lat, lon, spacing_m)
-        return np.where(np.isfinite(value), np.clip(1.0 - value / self.measured_min, 0.0, 1.0), 1.0)
+        with np.errstate(over="ignore"):  # (a tiny measured_min: value / it is inf, clipped to 0)
+            return np.where(np.isfinite(value), np.clip(1.0 - value / self.measured_min, 0.0, 1.0), 1.0)
 
 
 @dataclass(frozen=True)
@@ -331,6 +332,14 @@ def site_radius_m(dem: dict) -> float:
     lon_deg}}): R_ref + h_site, m (what motion_field.moon_radius_m must be with it)."""
     product = DemProduct.open(dem["file"])
     return product.reference_radius_m + site_height_m(product, dem["site"]["lat_deg"], dem["site"]["lon_deg"])
+
+
+def dem_detail(terrain: dict) -> TerrainParams | None:
+    """The procedural surface below terrain.dem's posts (`detail_params`): the terrain
+    section's other keys, or None where terrain.dem.detail is false."""
+    if not terrain["dem"].get("detail", True):
+        return None
+    return TerrainParams(**{k: v for k, v in terrain.items() if k not in ("elevation_grid", "grid_spacing_m", "dem")})
 
 
 def dem_terrain(dem: dict, radius_m: float, detail: TerrainParams | None = None) -> DemTerrain:

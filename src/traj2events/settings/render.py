@@ -455,9 +455,9 @@ class RenderSettings:
         t = dict(self.terrain)
         grid, spacing, dem = t.pop("elevation_grid", None), t.pop("grid_spacing_m", None), t.pop("dem", None)
         if dem:
-            from ..scene.dem import dem_terrain
+            from ..scene.dem import dem_detail, dem_terrain
 
-            terrain = dem_terrain(dem, self.moon_radius_m, TerrainParams(**t) if dem.get("detail", True) else None)
+            terrain = dem_terrain(dem, self.moon_radius_m, dem_detail(self.terrain))
         else:
             terrain = load_elevation_grid(grid, spacing) if grid else ProceduralTerrain(TerrainParams(**t))
         sun = Sun(**dated_sun(self.sun, self.terrain, self.moon_radius_m))

@@ -29,7 +29,8 @@ class DemMaskSection:
     measured_min: float = setting(unit="", doc="the value from which a post is measured (LDEC: 1 spot)", gt=0)
     interpolated_resolution_m: float = setting(unit="m", doc="the product's effective resolution where it is "
                                                "interpolated (LOLA's _EFFRES products give it per post, e.g. 60): "
-                                               "craters up to half of it are added there", gt=0)  # fmt: skip
+                                               "craters up to half of it are added there, so at most 200 km (the "
+                                               "terrain's craters reach 100 km)", gt=0, le=2e5)  # fmt: skip
 
 
 @section("terrain.dem", 'a real site: a DEM product users download and the landing site on it (docs/rendering.md "Real '
