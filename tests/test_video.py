@@ -2,7 +2,11 @@
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
+from declared_values import declared_values
+from traj2events.settings.render import RenderSection
 from traj2events.video import (
     VideoWriter,
     _display_steps,
@@ -115,6 +119,25 @@ def test_display_gamma_below_one_takes_the_law():
     assert _display_steps(40.0, 0.5) is None
     radiance = np.linspace(-1, 50, 1001, dtype=np.float32)
     np.testing.assert_array_equal(display_frame(radiance, 40.0, 0.5), display_code(radiance, 40.0, 0.5))
+
+
+@settings(deadline=None)
+@example((5e-324, 2.2), [], [0.5])  # a white float32 rounds to 0: the steps said 255 for black
+@given(declared_values(RenderSection, display_gamma=np.inf)
+       .map(lambda keys: (keys["display_white_w_m2_sr"], keys["display_gamma"])),
+       st.lists(st.floats(width=32, allow_nan=False), max_size=32),
+       st.lists(st.floats(0.0, 2.0), max_size=32))  # fmt: skip
+def test_any_display_the_check_accepts_gives_the_laws_codes(display, anywhere, shares_of_white):
+    """render.display_white_w_m2_sr and display_gamma drawn across their declared bounds:
+    the float32 path gives the law's code for float32 radiances anywhere (subnormals, inf,
+    negatives) and about the white. The search found a white of 5e-324 (gt=0), 0 in
+    float32, starting the steps' bisection at 0 and making every pixel, black ones too,
+    white; such whites now take the law."""
+    white, gamma = display
+    with np.errstate(over="ignore"):  # (beyond float32's 3.4e38: inf, white)
+        about_white = np.array(shares_of_white) * white
+        radiance = np.array([0.0, white, 2 * white, *anywhere, *about_white]).astype(np.float32)
+        np.testing.assert_array_equal(display_frame(radiance, white, gamma), display_code(radiance, white, gamma))
 
 
 def test_the_pipe_to_ffmpeg_holds_a_whole_frame(tmp_path):

@@ -46,15 +46,18 @@ _BUCKET_SHIFT = 15
 @functools.lru_cache(maxsize=8)
 def _display_steps(white_w_m2_sr: float, gamma: float) -> tuple[np.ndarray, np.ndarray, int] | None:
     """(step_bits, bucket_codes, first_bucket) of the law for float32 radiance; None where
-    a bucket would hold two steps' starts (gamma below ~1).
+    a bucket would hold two steps' starts (gamma below ~1) or float32 cannot hold the white.
 
     step_bits[v], v = 1..255: the bit pattern of the smallest float32 L whose code is >= v,
     found by bisection over bit patterns with `display_code` itself (the patterns of
     non-negative floats sort as the values do). bucket_codes[b]: the code at the start of
     bucket first_bucket + b."""
     v = np.arange(1, 256)
+    twice_white = np.float32(2 * white_w_m2_sr)
+    if display_code(twice_white, white_w_m2_sr, gamma) < 255:  # a white below float32's 1.4e-45: no steps
+        return None
     low = np.zeros(255, np.int64)  # code(0.0) = 0 < v
-    high = np.full(255, np.float32(2 * white_w_m2_sr).view(np.int32), np.int64)  # code 255 >= v
+    high = np.full(255, twice_white.view(np.int32), np.int64)  # code 255 >= v
     while np.any(high - low > 1):
         mid = (low + high) // 2
         reached = display_code(mid.astype(np.int32).view(np.float32), white_w_m2_sr, gamma) >= v
