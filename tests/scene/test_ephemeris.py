@@ -5,6 +5,8 @@ The expected azimuth and elevation are worked here from the IAU's rotation formu
 
 import numpy as np
 import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 
 sp = pytest.importorskip("spiceypy")
 
@@ -201,3 +203,46 @@ def test_a_heading_turns_the_suns_azimuth_with_the_site_frame(tmp_path):
     turned = body_at_site("SUN", UTC, metakernel, *SITE, 1_736_000.0, "IAU_MOON", heading_deg=30.0)
     assert (turned["azimuth_deg"] - north["azimuth_deg"] + 30.0 + 180.0) % 360.0 - 180.0 == pytest.approx(0.0, abs=1e-9)
     assert turned["elevation_deg"] == pytest.approx(north["elevation_deg"], abs=1e-12)
+
+
+EPS = np.finfo(float).eps
+
+
+def sky_position_50_digit(body_m, axes, radius_m) -> tuple[float, float, float, float]:
+    """(range m, azimuth rad, elevation rad, |s| / hypot(s . X, s . Y)) of the body seen
+    from the site, at 50 digits on the same rounded inputs."""
+    import mpmath as mp
+
+    with mp.workdps(50):
+        down = [mp.mpf(float(c)) for c in axes[2]]
+        s = [mp.mpf(float(b)) + mp.mpf(float(radius_m)) * d for b, d in zip(body_m, down, strict=True)]
+        across, along, below = (mp.fsum(a * mp.mpf(float(c)) for a, c in zip(s, row, strict=True)) for row in axes)
+        distance, horizontal = mp.sqrt(mp.fsum(c * c for c in s)), mp.hypot(across, along)
+        return (float(distance), float(mp.atan2(along, across)), float(mp.atan2(-below, horizontal)),
+                float(distance / horizontal) if horizontal else np.inf)  # fmt: skip
+
+
+@pytest.mark.accuracy
+@settings(deadline=None)
+@example(-89.45, 30.0, 0.0, 89.99999, 10.0, 1.5e11, 1_736_000.0)  # near the zenith: asin was 1e4 eps off
+@given(st.floats(-90.0, 90.0), st.floats(-360.0, 360.0), st.floats(-360.0, 360.0), st.floats(-90.0, 90.0),
+       st.floats(-180.0, 180.0), st.floats(3.5e8, 1.6e11), st.floats(1.7e6, 1.76e6))  # fmt: skip
+def test_the_sky_position_is_within_its_bound_of_the_50_digit_geometry(
+    lat_deg, lon_deg, heading_deg, elevation_deg, azimuth_deg, distance_m, radius_m
+):
+    """`sky_position` over its stated domain (a body placed at a drawn elevation and azimuth
+    of the site's sky, the zenith and the nadir included) against mpmath at 50 digits."""
+    from traj2events.scene.ephemeris import sky_position
+    from traj2events.trajectory.external import site_axes
+
+    axes = site_axes(lat_deg, lon_deg, heading_deg)
+    el, az = np.radians(elevation_deg), np.radians(azimuth_deg)
+    direction = np.cos(el) * np.cos(az) * axes[0] + np.cos(el) * np.sin(az) * axes[1] - np.sin(el) * axes[2]
+    body_m = distance_m * direction - radius_m * axes[2]
+    got = sky_position(body_m, axes, radius_m)
+    distance, azimuth, elevation, slope = sky_position_50_digit(body_m, axes, radius_m)
+    assert abs(got["range_m"] - distance) <= 4 * EPS * distance
+    assert abs(np.radians(got["elevation_deg"]) - elevation) <= 4 * EPS + EPS * abs(elevation)
+    if np.isfinite(slope):
+        error = abs(np.remainder(np.radians(got["azimuth_deg"]) - azimuth + np.pi, 2 * np.pi) - np.pi)
+        assert error <= 4 * EPS * slope + EPS * abs(azimuth)
