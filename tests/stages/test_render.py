@@ -16,7 +16,7 @@ from traj2events.geometry.camera import Camera
 from traj2events.renderer.law_uniforms import law_uniforms
 from traj2events.scene.reflectance import ReflectanceParams, angles, radiance_factor
 from traj2events.scene.sun import Sun
-from traj2events.settings.render import LodSettings, RenderSettings
+from traj2events.settings.render import EarthSection, LodSettings, RenderSettings, Stars
 from traj2events.settings.vehicle import Vehicle
 from traj2events.stages.render import render_trajectory
 from traj2events.trajectory.state import VELOCITY
@@ -80,17 +80,17 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     assert np.all(error[ground] <= 0.02 * expected[ground] + change[ground]), (radiance[0], expected)
 
 
-def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: float):
+def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: float, earth: dict | None = None):
     """(RenderSettings, frames.h5's radiance, depth and t) of flat ground seen `altitude_m`
-    up, pitched `pitch_deg`, with `render` and the descent's `sun` laid over the defaults;
-    None where the check refuses them. Checked: radiance finite, >= 0 and at most the law's
+    up, pitched `pitch_deg`, with `render`, the descent's `sun` and `earth` (None: none) laid
+    over the defaults; None where the check refuses them. Checked: radiance finite, >= 0 and at most the law's
     brightest (law_uniforms' radiance_max); depth finite and > 0 on some ground."""
     np.save(folder / "flat.npy", np.zeros((8, 8)))
     overlay = {
         "camera": {"width": WIDTH, "height": HEIGHT, "fps": 10.0, "mount_height_m": 1.0},
         "terrain": {"elevation_grid": str(folder / "flat.npy"), "grid_spacing_m": 1e4},
         "render": {**render, "preview": False, "tile_cache": None},
-        "scenarios": {"descent": {"sun": sun}},
+        "scenarios": {"descent": {"sun": sun, **({"earth": earth} if earth else {})}},
     }
     try:
         config = resolve_config(overlay)
@@ -153,6 +153,29 @@ def test_no_adaptive_timing_the_check_accepts_stalls_or_leaves_the_flight(
     t_s = drawn[3]
     assert t_s[0] == 0.0 and t_s[-1] == pytest.approx(0.1, abs=1e-12) and len(t_s) <= 1 + max_fps / 10.0 + 1e-9
     assert np.all(np.diff(t_s) >= (1 / max_fps) * (1 - 1e-9))
+
+
+def undated(earth: dict) -> dict:
+    """An Earth of fixed azimuth and elevation (a dated one needs a date and SPICE kernels)."""
+    return {**earth, "dated": False}
+
+
+@pytest.mark.slow  # ~2 s a render
+@settings(max_examples=max(settings.default.max_examples // 60, 5), deadline=None)
+@example({"enabled": True, "magnitude_limit": 12.0}, 2**64, {"azimuth_deg": 360.0, "elevation_deg": 5e-324}, 256,
+         3000.0, 80.0)  # fmt: skip
+@given(declared_values(Stars), st.integers(0, 2**128), declared_values(EarthSection).map(undated),
+       st.integers(0, 256), st.floats(2.0, 3000.0), st.floats(0.0, 80.0))  # fmt: skip
+def test_no_star_field_earth_or_scattered_light_the_check_accepts_gives_a_nan(
+    tmp_path_factory, stars, seed, earth, azimuths, altitude_m, pitch_deg
+):
+    """render.stars (to magnitude 12, ~3 M stars, any seed), the Earth in the sky (from
+    5e-324 deg up) and the horizon march's azimuths (0..256) drawn across their declared
+    bounds over the flat ground, the Sun 5 deg up: the radiance and depth checks above.
+    (A probe of each at its bounds' extremes found nothing.)"""
+    render = {"stars": {**stars, "seed": seed}, "scattered_light": {"azimuths": azimuths}}
+    sun = {"azimuth_deg": 30.0, "elevation_deg": 5.0}
+    rendered(tmp_path_factory.mktemp("sky"), render, sun, altitude_m, pitch_deg, earth)
 
 
 def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_deg):
