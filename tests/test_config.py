@@ -304,6 +304,21 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"terrain": {"roughness_m_at_1m": 1e300}}, ["terrain.roughness_m_at_1m", "<= 1"]),
     ({"terrain": {"crater_density_k": 3e306}}, ["terrain.crater_density_k", "geometric saturation"]),
     ({"render": {"lod": {"min_spacing_m": 5e-324}}}, ["render.lod.min_spacing_m", ">= 0.001"]),
+    # the render search's finds: fields of view whose renders lost the ground
+    ({"camera": {"fov_deg": 1e-30}}, ["camera.fov_deg", ">= 0.5"]),
+    ({"camera": {"fov_deg": 179.99999999}}, ["camera.fov_deg", "<= 179.5"]),
+    (
+        {
+            "terrain": {
+                "dem": {
+                    "file": "site.tif",
+                    "site": {"lat_deg": 0.0, "lon_deg": 0.0},
+                    "mask": {"file": "ldec.tif", "measured_min": 1.0, "interpolated_resolution_m": 1e6},
+                }
+            }
+        },
+        ["terrain.dem.mask.interpolated_resolution_m", "<= 200000"],
+    ),
     # the sensor search's finds (issue 71): the events job failed on these
     ({"events": {"sensor": {"f_number": 5e-324}}}, ["events.sensor.f_number", ">= 0.5"]),
     ({"events": {"sensor": {"f_number": 1e300}}}, ["events.sensor.f_number", "<= 1000"]),

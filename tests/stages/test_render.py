@@ -80,14 +80,16 @@ def test_no_reflectance_or_sun_the_check_accepts_gives_a_nan_or_a_negative_radia
     assert np.all(error[ground] <= 0.02 * expected[ground] + change[ground]), (radiance[0], expected)
 
 
-def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: float, earth: dict | None = None):
+def rendered(folder, render: dict, sun: dict, altitude_m: float, pitch_deg: float, earth: dict | None = None,
+             camera: dict | None = None):  # fmt: skip
     """(RenderSettings, frames.h5's radiance, depth and t) of flat ground seen `altitude_m`
-    up, pitched `pitch_deg`, with `render`, the descent's `sun` and `earth` (None: none) laid
-    over the defaults; None where the check refuses them. Checked: radiance finite, >= 0 and at most the law's
-    brightest (law_uniforms' radiance_max); depth finite and > 0 on some ground."""
+    up, pitched `pitch_deg`, with `render`, the descent's `sun` and `earth` (None: none) and
+    `camera` laid over the defaults; None where the check refuses them. Checked: radiance
+    finite, >= 0 and at most the law's brightest (law_uniforms' radiance_max); depth finite
+    and > 0 on some ground."""
     np.save(folder / "flat.npy", np.zeros((8, 8)))
     overlay = {
-        "camera": {"width": WIDTH, "height": HEIGHT, "fps": 10.0, "mount_height_m": 1.0},
+        "camera": {"width": WIDTH, "height": HEIGHT, "fps": 10.0, "mount_height_m": 1.0, **(camera or {})},
         "terrain": {"elevation_grid": str(folder / "flat.npy"), "grid_spacing_m": 1e4},
         "render": {**render, "preview": False, "tile_cache": None},
         "scenarios": {"descent": {"sun": sun, **({"earth": earth} if earth else {})}},
@@ -176,6 +178,41 @@ def test_no_star_field_earth_or_scattered_light_the_check_accepts_gives_a_nan(
     render = {"stars": {**stars, "seed": seed}, "scattered_light": {"azimuths": azimuths}}
     sun = {"azimuth_deg": 30.0, "elevation_deg": 5.0}
     rendered(tmp_path_factory.mktemp("sky"), render, sun, altitude_m, pitch_deg, earth)
+
+
+@settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)
+@example(0.5, 2.0, 0.0)  # the narrowest, straight down
+@example(179.5, 3000.0, 80.0)  # the widest, toward the horizon
+@given(st.floats(0.5, 179.5), st.floats(2.0, 3000.0), st.floats(0.0, 80.0))
+def test_every_field_of_view_the_check_accepts_sees_the_ground_where_its_rays_meet_the_sphere(
+    tmp_path_factory, fov_deg, altitude_m, pitch_deg
+):
+    """camera.fov_deg across its declared bounds (0.5-179.5 deg) over the flat ground: a
+    pixel has a depth where its ray, cast in float64 on the Moon's sphere, meets it, within
+    1e-3 of that ray's length, and none where it misses (rays within 1e-3 rad of the horizon
+    aside). Before its bounds, the check took fovs of 5e-324 (f infinite) to 180 - 3e-14
+    deg: at 1e-30 or 179.99999999 deg the renders lost the ground (float32's f^2 overflowed
+    or its near-plane rays folded), black frames and no depth."""
+    drawn = rendered(tmp_path_factory.mktemp("fov"), {}, {"azimuth_deg": 30.0, "elevation_deg": 20.0}, altitude_m,
+                     pitch_deg, camera={"fov_deg": fov_deg})  # fmt: skip
+    render, _, depth, _ = drawn
+    camera = Camera.from_settings(vars(render))
+    pose = camera.pose(lander_state(0.0, altitude_m, pitch_deg))
+    x_s, y_s = np.broadcast_arrays(*camera.pixel_coordinates())
+    rays = camera.back_project(x_s, y_s) @ pose.rotation.T
+    rays /= np.linalg.norm(rays, axis=-1, keepdims=True)
+    from_centre = pose.position - [0.0, 0.0, render.moon_radius_m]  # the centre below the site (z down)
+    along = rays @ from_centre
+    discriminant = along**2 - (from_centre @ from_centre - render.moon_radius_m**2)
+    meets = (discriminant > 0) & (along < 0)
+    length = -along - np.sqrt(np.maximum(discriminant, 0.0))  # the near root, m
+    grazing = np.abs(np.arcsin(np.clip(-along / np.linalg.norm(from_centre), -1, 1))
+                     - np.arccos(render.moon_radius_m / np.linalg.norm(from_centre))) < 1e-3  # fmt: skip
+    seen = depth[0] > 0
+    assert np.all(seen[~grazing] == meets[~grazing]), (seen, meets)
+    hit = seen & meets & ~grazing
+    distance = depth[0][hit] * np.linalg.norm(camera.back_project(x_s, y_s)[hit], axis=-1)  # depth is along the axis
+    np.testing.assert_allclose(distance, length[hit], rtol=1e-3)
 
 
 def radiance_on_the_sphere(render, law, sun, depth_m, ground, altitude_m, pitch_deg):

@@ -28,8 +28,9 @@ class CameraSection:
                          "minutes)", gt=0, le=10000)  # fmt: skip
     width: int = setting(128, "px", "image width (the paper: 1024)", ge=1, le=8192)
     height: int = setting(128, "px", "image height (the paper: 1024)", ge=1, le=8192)
-    fov_deg: float = setting(45.0, "deg", "field of view across the width, the paper's; f = W / (2 tan(fov/2))",
-                             gt=0, lt=180)  # fmt: skip
+    fov_deg: float = setting(45.0, "deg", "field of view across the width, the paper's; f = W / (2 tan(fov/2)); "
+                             "0.5-179.5, where the laws are checked (at 1e-30 or 179.99999999 the renders lost the "
+                             "ground)", ge=0.5, le=179.5)  # fmt: skip
     mount_height_m: float = setting(3.0, "m", "camera height above the trajectory point (the landing gear's contact "
                                     "point) along -z_b: its height above the ground at touchdown (the Apollo LM "
                                     "descent stage: 3.2 m tall with its legs)", ge=0, lt=100)  # fmt: skip
