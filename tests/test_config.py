@@ -306,6 +306,7 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"render": {"lod": {"min_spacing_m": 5e-324}}}, ["render.lod.min_spacing_m", ">= 0.001"]),
     # the render search's finds: fields of view whose renders lost the ground
     ({"camera": {"fov_deg": 1e-30}}, ["camera.fov_deg", ">= 0.5"]),
+    ({"events": {"window_ms": 1e-4}}, ["events.window_ms", ">= 0.001"]),  # 0 us: pictures of no events
     ({"camera": {"fov_deg": 179.99999999}}, ["camera.fov_deg", "<= 179.5"]),
     (
         {

@@ -147,7 +147,8 @@ class EventsSection:
                           "paper's Table 2; clean: no noise, no low-pass, no mismatch; imx636, davis346: sensors "
                           "that exist, which also set events.sensor and events.readout keys)")  # fmt: skip
     pixel: EmulatorParams = setting({}, "", "keys that change the preset's values, e.g. {refractory_s: 0.001}")
-    window_ms: float = setting(10.0, "ms", "event frames' window: the paper's 10 ms", gt=0)
+    window_ms: float = setting(10.0, "ms", "event frames' window: the paper's 10 ms; from 1 us, the events' clock "
+                               "(shorter ones rounded to 0 us: frames with no events)", ge=0.001)  # fmt: skip
     input: str = setting("sensor", "", "frames.h5's radiance into the emulator: sensor (the photocurrent, "
                          "events.sensor) or display (255 L / render.display_white_w_m2_sr, the videos' scale)",
                          choices=("sensor", "display"))  # fmt: skip
