@@ -349,3 +349,13 @@ def test_no_surface_the_check_accepts_has_a_height_float32_cannot_hold(keys):
     x, y = np.meshgrid(np.linspace(-50.0, 50.0, 16), np.linspace(-50.0, 50.0, 16))
     heights = ProceduralTerrain(params).height_m(x, y, 100.0 / 15)
     assert np.isfinite(heights.astype(np.float32)).all()
+
+
+def test_seeds_2_to_the_32_apart_are_different_surfaces_and_64_bits_bound_them():
+    """The surface's hash took a seed's low 32 bits: seeds 1 and 2^32 + 1 were one surface
+    (a probe of terrain.seed's open bound). It takes 64 now, and the key is bounded there."""
+    x, y = np.meshgrid(np.linspace(-50.0, 50.0, 16), np.linspace(-50.0, 50.0, 16))
+    one, apart, top = (ProceduralTerrain(TerrainParams(seed=s)).height_m(x, y, 1.0) for s in (1, 2**32 + 1, 2**64 - 1))
+    assert np.abs(one - apart).max() > 0.1 and np.abs(one - top).max() > 0.1
+    with pytest.raises(ValueError, match="terrain.seed"):
+        TerrainParams(seed=2**64)

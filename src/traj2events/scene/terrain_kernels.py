@@ -22,9 +22,10 @@ def mix64(z):
 
 @functools.cache  # a few hundred streams, asked for by every tile: mix64 from Python costs ~40 us
 def stream_key(seed: int, stream: int) -> np.uint64:
-    """The hash key of one (seed, stream)."""
+    """The hash key of one (seed, stream), the seed's 64 bits (terrain.seed's bound; its low
+    32 alone made seeds 2^32 apart one surface)."""
     with np.errstate(over="ignore"):
-        return np.uint64(mix64(np.uint64(seed & 0xFFFFFFFF) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream)))
+        return np.uint64(mix64(np.uint64(seed % 2**64) * np.uint64(0x9E3779B97F4A7C15) + np.uint64(stream)))
 
 
 @njit(cache=True, nogil=True)

@@ -28,7 +28,7 @@ TIMING_MODES = ("fixed", "adaptive")
 
 @section("terrain", "the procedural surface (sources in docs/rendering.md), or a DEM in its place")
 class TerrainParams:
-    seed: int = setting(1, "", "seed of the procedural craters, boulders and roughness", ge=0)
+    seed: int = setting(1, "", "seed of the procedural craters, boulders and roughness; 64 bits", ge=0, le=2**64 - 1)
     crater_density_k: float = setting(0.08, "m^-2", "K in N(>D) = K D^-slope craters per m^2, D in m: ~equilibrium "
                                       "for small lunar craters", source="Gault (1970)", ge=0)  # fmt: skip
     crater_slope: float = setting(2.0, "", "cumulative crater size-frequency slope", gt=0, le=MAX_SLOPE)
