@@ -304,6 +304,7 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"terrain": {"roughness_m_at_1m": 1e300}}, ["terrain.roughness_m_at_1m", "<= 1"]),
     ({"terrain": {"crater_density_k": 3e306}}, ["terrain.crater_density_k", "geometric saturation"]),
     ({"render": {"lod": {"min_spacing_m": 5e-324}}}, ["render.lod.min_spacing_m", ">= 0.001"]),
+    ({"terrain": {"grid_spacing_m": 5e-324}}, ["terrain.grid_spacing_m", ">= 0.001"]),
     # the render search's finds: fields of view whose renders lost the ground
     ({"camera": {"fov_deg": 1e-30}}, ["camera.fov_deg", ">= 0.5"]),
     ({"events": {"window_ms": 1e-4}}, ["events.window_ms", ">= 0.001"]),  # 0 us: pictures of no events

@@ -62,7 +62,8 @@ class TerrainParams:
                                                  "~4 cm RMS; at 2 m a 128^2 camera 60 m up still resolves it); 0: a "
                                                  "flat pad", ge=0)  # fmt: skip
     elevation_grid: str | None = setting(None, "", "a DEM file (.npy, .npz, .tif) in place of the procedural surface")
-    grid_spacing_m: float | None = setting(None, "m", "the DEM's spacing where its file does not give it", gt=0)
+    grid_spacing_m: float | None = setting(None, "m", "the DEM's spacing where its file does not give it, 1 mm to "
+                                           "100 km", ge=MIN_FEATURE_M, le=MAX_CRATER_M)  # fmt: skip
     dem: DemSection | None = setting(None, "", "a real site's elevation model in place of the procedural surface "
                                      "(null: procedural); the sphere through its site sets motion_field.moon_radius_m",
                                      optional=True)  # fmt: skip
