@@ -113,11 +113,11 @@ class ReflectanceParams:
     single_scattering_albedo: float = setting(0.21, "", "Hapke's single-scattering albedo w", source=HAPKE, gt=0, lt=1)
     phase_b: float = setting(0.26, "", "Hapke's double Henyey-Greenstein lobe width b", source=HAPKE, ge=0, lt=1)
     phase_c: float = setting(0.4, "", "Hapke's lobe weight c (> 0: backscatter)", source=HAPKE, ge=-1, le=1)
-    opposition_b0: float = setting(1.0, "", "Hapke's opposition-surge amplitude B0 (at most 10, ten times the "
-                                   "default: from ~2e21 the light scattered into shadows, albedo squared, left "
-                                   "float32 and frames were black; docs/accuracy.md)", source=HAPKE, ge=0,
-                                   le=10)  # fmt: skip
-    opposition_h: float = setting(0.07, "", "Hapke's opposition-surge width h", source=HAPKE, gt=0)
+    opposition_b0: float = setting(1.0, "", "Hapke's opposition-surge amplitude B0, at most 10 (from ~2e21 the light "
+                                   "scattered into shadows, albedo squared, left float32: black frames)", source=HAPKE,
+                                   ge=0, le=10)  # fmt: skip
+    opposition_h: float = setting(0.07, "", "Hapke's opposition-surge width h, at most 10 (porosity 1 - 3e-12; at "
+                                  "1e300 the shaders' h was inf: black frames)", source=HAPKE, gt=0, le=10)  # fmt: skip
     albedo: float = setting(0.12, "", "lunar-lambert only: the normal albedo, the maria-highland average", gt=0, le=1)
 
 
