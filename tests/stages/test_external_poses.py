@@ -286,6 +286,12 @@ def test_an_external_scenario_is_checked_and_planned_from_its_files(tmp_path, pr
     both["scenarios"]["flown"]["tf_guess_s"] = 30.0
     with pytest.raises(ConfigError, match="flies its files' poses or the OCP's, not both: it also has 'tf_guess_s'"):
         resolve_config(both)
+    spice = {"target": "LANDER", "camera_frame": "LANDER_CAMERA",
+             "site": {"latitude_deg": 0.0, "longitude_deg": 0.0, "radius_m": 5e-324}}  # fmt: skip
+    at_the_centre = flown_config(tmp_path, [spice_kernels(tmp_path)])
+    at_the_centre["scenarios"]["flown"]["poses"]["spice"] = spice
+    with pytest.raises(ConfigError, match=r"'scenarios.flown.poses.spice.site.radius_m': expected a value >= 1.7e\+06"):
+        resolve_config(at_the_centre)  # (the site frame's law is searched over 1700-1760 km)
     (tmp_path / "k.tm").write_text("\\begindata\n\\begintext\n")
     with pytest.raises(ConfigError, match=r"'scenarios.flown.poses.spice': .*k.tm is a SPICE meta-kernel"):
         resolve_config(flown_config(tmp_path, [tmp_path / "k.tm"]))

@@ -55,7 +55,8 @@ class HoverSection:
 class SpiceSite:
     latitude_deg: float = setting(unit="deg", doc="planetocentric latitude", ge=-90, le=90)
     longitude_deg: float = setting(unit="deg", doc="longitude", ge=-360, le=360)
-    radius_m: float = setting(unit="m", doc="distance from the Moon's centre", gt=0)
+    radius_m: float = setting(unit="m", doc="distance from the Moon's centre: the Moon's mean radius +- its relief, "
+                              "as motion_field.moon_radius_m", ge=1.70e6, le=1.76e6)  # fmt: skip
 
 
 @section("scenarios.<name>.poses.spice", "how to read the SPICE meta-kernels among `files`")
