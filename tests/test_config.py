@@ -307,6 +307,9 @@ BAD_OVERLAYS = [  # (overlay on the defaults, fragments the message must hold)
     ({"terrain": {"grid_spacing_m": 5e-324}}, ["terrain.grid_spacing_m", ">= 0.001"]),
     # the render search's finds: fields of view whose renders lost the ground
     ({"camera": {"fov_deg": 1e-30}}, ["camera.fov_deg", ">= 0.5"]),
+    # integers no HDF5 attribute holds failed the jobs writing them
+    ({"seed": 2**64}, ["config key 'seed'", "<= 18446744073709551615"]),
+    ({"motion_field": {"every_n_frames": 10**30}}, ["motion_field.every_n_frames", "<= 1000000"]),
     ({"render": {"reflectance": {"opposition_h": 1e300}}}, ["render.reflectance.opposition_h", "<= 10"]),
     ({"events": {"window_ms": 1e-4}}, ["events.window_ms", ">= 0.001"]),  # 0 us: pictures of no events
     ({"camera": {"fov_deg": 179.99999999}}, ["camera.fov_deg", "<= 179.5"]),

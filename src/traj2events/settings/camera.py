@@ -39,7 +39,8 @@ class CameraSection:
 
 @section("motion_field", "the motion-field ground truth")
 class MotionFieldSection:
-    every_n_frames: int = setting(50, "", "write the field of every n-th frame (50: 1 Hz at 50 fps; 1: all)", ge=1)
+    every_n_frames: int = setting(50, "", "write the field of every n-th frame (50: 1 Hz at 50 fps; 1: all); at most "
+                                  "1e6 (10^30 failed the job: no HDF5 integer holds it)", ge=1, le=10**6)  # fmt: skip
     moon_radius_m: float = setting(1737400.0, "m", "radius of the sphere through the landing site: the Moon's mean "
                                    "radius, +- its relief (-9 .. +11 km)", ge=1.70e6, le=1.76e6)  # fmt: skip
 

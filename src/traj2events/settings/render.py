@@ -171,7 +171,7 @@ class Stars:
         ge=-1,
         le=12,
     )
-    seed: int = setting(1, "", "the star field's seed", ge=0)
+    seed: int = setting(1, "", "the star field's seed; 64 bits, as the other seeds", ge=0, le=2**64 - 1)
 
 
 @section(

@@ -172,7 +172,8 @@ SCENARIOS = {
     "angles); every mapping refuses unknown keys",
 )
 class Config:
-    seed: int = setting(20230801, "", "seed of every random draw; same config and seed give the same bytes", ge=0)
+    seed: int = setting(20230801, "", "seed of every random draw; same config and seed give the same bytes; 64 bits "
+                        "(the files' uint64 attributes: 2^64 failed the solve's job)", ge=0, le=2**64 - 1)  # fmt: skip
     compression: str = setting("blosc", "", "how the large HDF5 datasets (events, frames, motion fields) are "
                                "compressed: blosc (hdf5plugin's filter, the fastest; readers need the plugin), gzip "
                                "(HDF5's own, level 1 with shuffle) or none, both read by any HDF5 reader "
