@@ -180,6 +180,7 @@ def test_no_star_field_earth_or_scattered_light_the_check_accepts_gives_a_nan(
     rendered(tmp_path_factory.mktemp("sky"), render, sun, altitude_m, pitch_deg, earth)
 
 
+@pytest.mark.slow  # ~3 s a render
 @settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)
 @example(0.5, 2.0, 0.0)  # the narrowest, straight down
 @example(179.5, 3000.0, 80.0)  # the widest, toward the horizon
