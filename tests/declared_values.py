@@ -20,7 +20,8 @@ def declared_values(cls, normal: bool = False, **caps):
     """A strategy for a section's every key, drawn across its declared bounds (open ones
     capped by unit, OPEN_CAPS; any by `caps`): floats (subnormals included, as the config
     check accepts them; `normal`: 0 or >= 1e-100, for a law's relative bound), tuples of
-    floats (as lists, as a config writes them), [low, high] ranges, choices, booleans."""
+    floats (as lists, as a config writes them), [low, high] ranges, choices, booleans,
+    integers."""
     keys, hints = {}, typing.get_type_hints(cls)
     for f in declared_fields(cls):
         meta, bounds, hint = f.metadata, f.metadata["bounds"], hints[f.name]
@@ -28,6 +29,9 @@ def declared_values(cls, normal: bool = False, **caps):
             keys[f.name] = st.sampled_from(meta["choices"])
         elif hint is bool:
             keys[f.name] = st.booleans()
+        elif hint is int:  # (seeds to 2^64 - 1: larger ones failed the jobs writing them to HDF5)
+            lo, hi = bounds.get("ge", bounds.get("gt", -1) + 1), bounds.get("le", bounds.get("lt", 2**64) - 1)
+            keys[f.name] = st.integers(lo, min(hi, caps.get(f.name, hi)))
         elif hint is float or (typing.get_origin(hint) is tuple and set(typing.get_args(hint)) == {float}):
             floats = _floats(bounds, _cap(f, caps), normal)
             # (a tuple as a config writes it: a list; the sections take either)
