@@ -161,6 +161,7 @@ def ray_cast_depth(grids, radius, rays_world, origin, t_max=20_000.0, step=10.0)
     return np.where(hit, (lo + hi) / 2, np.inf)
 
 
+@pytest.mark.slow  # a 256^2 render and its ray cast: ~10 s
 def test_the_rendered_depth_is_the_dem_surfaces(tmp_path):
     """256^2 frame 1.5 km above the site, pitched 30 deg: the renderer's depth against the
     ray cast above, on every 4th pixel of every 4th row. Goal (issue 70): median relative
