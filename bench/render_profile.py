@@ -64,7 +64,7 @@ def timed(log: list[float], function):
 
 # Probes of the textured fragment shader: (committed text, replacement), each taking one
 # part out; together they split a frame's time (docs/performance.md).
-_LAW = "    float per_mu0 = law_per_mu0(mu0, mu, frag_phase);"
+_LAW = "    float per_mu0 = law_per_mu0(mu0, mu, phase_term(dot(sun_dir, normalize(frag_to_camera_m))));"
 _AT = "vec3((texel_at + 0.5) / texture_side, layer)"
 _READ = f"    return textureLod(shading, {_AT}, level);"  # the trilinear read (shaders/footprint.glsl)
 _FOOTPRINT = (
@@ -75,7 +75,7 @@ _EARTHSHINE = "    float earthshine = earthshine_radiance(normal);"
 _RADIANCE = "    float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);"
 PROBED_SHADER = "terrain_textured.frag"
 PROBES = {
-    "no law": (_LAW, "    float per_mu0 = mu0 + mu + frag_phase;"),
+    "no law": (_LAW, "    float per_mu0 = mu0 + mu;"),
     "no earthshine": (_EARTHSHINE, "    float earthshine = 0.0;"),
     "one level (no footprint)": (_FOOTPRINT, f"    return textureLod(shading, {_AT}, 0.0);"),
     "one layer (in cache)": (_READ, _READ.replace("layer)", "0.0)")),

@@ -8,7 +8,6 @@ in vec2 frag_uv;
 flat in float frag_layer;
 flat in vec4 frag_fine_slots;   // >= 0: the layers of the tile's texture one level finer, by quarter
 in vec3 frag_to_camera_m;
-in float frag_phase;
 in float frag_scattered;
 
 uniform sampler2DArray shading;  // per slot: normal xyz, lit fraction times mu0 (0..1)
@@ -41,7 +40,9 @@ void main()
     // lights over lit texels would make the law's 1 / (mu0 + mu) unbounded at the limb.
     float mu = max(dot(normal, normalize(frag_to_camera_m)), MU_LIMB);
     float mu0 = max(dot(normal, sun_dir), clamp(texel.w, 0.0, 1.0));
-    float per_mu0 = law_per_mu0(mu0, mu, frag_phase);
+    // The phase term per pixel too: interpolated from the vertices, it was 3.6 % off in a
+    // column 2 m above cells of several pixels (docs/decisions/0014-phase-per-pixel.md).
+    float per_mu0 = law_per_mu0(mu0, mu, phase_term(dot(sun_dir, normalize(frag_to_camera_m))));
     float direct = per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI;
     float earthshine = earthshine_radiance(normal);
     float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);

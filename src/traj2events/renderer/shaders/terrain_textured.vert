@@ -1,9 +1,8 @@
 #version 330 core
 // traj2events terrain shaded per pixel, vertex stage: coarse tiles whose normals and lit
 // fractions come from a texture of finer levels (render.lod.shading_levels > 0). Here:
-// positions relative to the camera, where each vertex sits in its tile's shading texture,
-// and the law's phase term, which depends on directions only and so varies little across
-// a triangle of a few pixels (the per-pixel rest: terrain_textured.frag).
+// positions relative to the camera and where each vertex sits in its tile's shading
+// texture (the law, per pixel: terrain_textured.frag).
 layout(location = 0) in vec4 tile;  // per instance (tile): xyz its origin minus the camera position (m), w its slot
 layout(location = 1) in vec2 uv;    // per vertex of a tile: its place in the tile's shading texture
 layout(location = 2) in vec4 fine_slots;  // per instance: the slots of its texture one level finer, or -1
@@ -18,7 +17,6 @@ out vec2 frag_uv;
 flat out float frag_layer;  // the tile's slot: its layer of the shading texture array
 flat out vec4 frag_fine_slots;
 out vec3 frag_to_camera_m;
-out float frag_phase;
 out float frag_scattered;   // light scattered into shadows by the terrain (W m^-2 sr^-1)
 
 #include "reflectance.glsl"
@@ -32,6 +30,5 @@ void main()
     frag_layer = tile.w;
     frag_fine_slots = fine_slots;
     frag_to_camera_m = -offset;
-    frag_phase = phase_term(dot(sun_dir, -normalize(offset)));
     gl_Position = P * V * vec4(offset, 1.0);
 }
