@@ -25,6 +25,9 @@ from dataclasses import MISSING
 # What a field's metadata may hold, beside its default.
 BOUNDS = {"ge": "minimum", "gt": "exclusiveMinimum", "le": "maximum", "lt": "exclusiveMaximum"}
 OPS = {"ge": ">=", "gt": ">", "le": "<=", "lt": "<"}
+# Every seed's bound: 64 bits, what the files' uint64 attributes and the hashes' keys hold
+# (a dataset seed of 2^64 failed the solve's job writing it).
+SEED_MAX = 2**64 - 1
 
 
 def setting(default=MISSING, unit: str = "", doc: str = "", *, source: str = "", choices=None, length=None,

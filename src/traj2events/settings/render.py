@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from ..geometry.horizon import horizon_distance_m
 from . import trajectory_rng
 from .camera import CameraSection
-from .declare import non_finite, section, setting
+from .declare import SEED_MAX, non_finite, section, setting
 from .poses import external_extents, is_external, scenario_divert
 from .site import SUN_KEYS, DemSection, date_between, dated_earth, dated_sun
 
@@ -28,7 +28,7 @@ TIMING_MODES = ("fixed", "adaptive")
 
 @section("terrain", "the procedural surface (sources in docs/rendering.md), or a DEM in its place")
 class TerrainParams:
-    seed: int = setting(1, "", "seed of the procedural craters, boulders and roughness; 64 bits", ge=0, le=2**64 - 1)
+    seed: int = setting(1, "", "seed of the procedural craters, boulders and roughness; 64 bits", ge=0, le=SEED_MAX)
     crater_density_k: float = setting(0.08, "m^-2", "K in N(>D) = K D^-slope craters per m^2, D in m: ~equilibrium "
                                       "for small lunar craters", source="Gault (1970)", ge=0)  # fmt: skip
     crater_slope: float = setting(2.0, "", "cumulative crater size-frequency slope", gt=0, le=MAX_SLOPE)
@@ -171,7 +171,7 @@ class Stars:
         ge=-1,
         le=12,
     )
-    seed: int = setting(1, "", "the star field's seed; 64 bits, as the other seeds", ge=0, le=2**64 - 1)
+    seed: int = setting(1, "", "the star field's seed; 64 bits, as the other seeds", ge=0, le=SEED_MAX)
 
 
 @section(

@@ -8,7 +8,7 @@ from __future__ import annotations
 import functools
 
 from .camera import CameraSection, MotionFieldSection
-from .declare import declared_fields, defaults_of, schema_of, section, setting
+from .declare import SEED_MAX, declared_fields, defaults_of, schema_of, section, setting
 from .events import EventsSection
 from .imu import ImuSection
 from .index import SplitsSection
@@ -173,7 +173,7 @@ SCENARIOS = {
 )
 class Config:
     seed: int = setting(20230801, "", "seed of every random draw; same config and seed give the same bytes; 64 bits "
-                        "(the files' uint64 attributes: 2^64 failed the solve's job)", ge=0, le=2**64 - 1)  # fmt: skip
+                        "(the files' uint64 attributes: 2^64 failed the solve's job)", ge=0, le=SEED_MAX)  # fmt: skip
     compression: str = setting("blosc", "", "how the large HDF5 datasets (events, frames, motion fields) are "
                                "compressed: blosc (hdf5plugin's filter, the fastest; readers need the plugin), gzip "
                                "(HDF5's own, level 1 with shuffle) or none, both read by any HDF5 reader "
