@@ -46,6 +46,10 @@ def write_poses(path, altitude_m: float, pitch_deg: float, fps: float = 10.0) ->
 
 @settings(max_examples=max(settings.default.max_examples // 30, 10), deadline=None)
 @example({"opposition_b0": 10.0}, 0.0, 45.0, 100.0, 0.0)  # the surge's largest, the Sun behind the camera
+# the long profile's, at the horizon under a grazing Sun: a box a whole tile wide (its side from the quad's
+# pixel beyond the vanishing line), 13 % bright; then a box over a tile's edge, 8 % (decisions/0015)
+@example({"model": "lunar-lambert"}, 8.0, 1.0, 1098.0, 80.0)
+@example({"model": "lunar-lambert", "albedo": 1.0}, 276.0, 1.0, 629.0, 66.0)
 @given(
     declared_values(ReflectanceParams), st.floats(-360.0, 360.0), normal_floats(0.0, 90.0),
     st.floats(2.0, 3000.0), st.floats(0.0, 80.0),

@@ -43,7 +43,9 @@ LOD_BIAS = float(np.log2(1.0 / np.sqrt(3.0)))  # -0.79
 # above level 0: the exact match, `- 2 + 3 / 4^k`, is 0.75 wider at level 1, and fires fewer
 # events than a 16 x 16 average (docs/rendering.md "Pixel footprint"). Where the trilinear
 # read's tent changes slope at every texel a moving pixel crosses, the box's mean changes
-# only as its edges cross texels (docs/rendering.md "Pixel footprint").
+# only as its edges cross texels (docs/rendering.md "Pixel footprint"). The shader takes
+# a and b at the pixel's centre (the GPU's quad differences reach past the horizon) and
+# shrinks a box that would cross its layer's edge about its centre (decisions/0015).
 BOX_MIN_TEXELS = float(np.sqrt(2.0))
 
 

@@ -30,8 +30,23 @@ void main()
     vec2 texel_at = (frag_uv * texture_side - 0.5) * (fine ? 2.0 : 1.0);
     vec2 quarter = fine ? step(vec2(texture_side - 1.0), texel_at) : vec2(0.0);
     float layer = fine ? frag_fine_slots[int(quarter.y) * 2 + int(quarter.x)] : frag_layer;
-    vec2 across = dFdx(texel_at), down = dFdy(texel_at);  // texels per pixel
-    vec4 texel = footprint_mean(shading, texel_at - quarter * (texture_side - 1.0), layer, across, down);
+    // The footprint's sides (texels per pixel): the derivatives at the pixel's centre.
+    // dFdx(texel_at) differences it with the quad's other pixel, which next to the horizon
+    // lies beyond the triangle's vanishing line (a box a whole tile wide). texel_at times
+    // gl_FragCoord.w (1 / w) is linear on the screen, so its differences are exact, and
+    // d(A / B) = (dA - (A / B) dB) / B.
+    vec2 texel_over_w = texel_at * gl_FragCoord.w;
+    vec2 across = (dFdx(texel_over_w) - texel_at * dFdx(gl_FragCoord.w)) / gl_FragCoord.w;
+    vec2 down = (dFdy(texel_over_w) - texel_at * dFdy(gl_FragCoord.w)) / gl_FragCoord.w;
+    // The box centred on the pixel and inside its layer: one over the edge read the edge
+    // texel of its level for the ground beyond, a mean from inside the tile (12 % bright at
+    // the horizon under a grazing Sun; docs/decisions/0015-footprint-at-edges.md).
+    vec2 local = texel_at - quarter * (texture_side - 1.0);
+    vec2 room = 2.0 * max(min(local + 0.5, texture_side - 0.5 - local), 0.0);
+    vec2 keep = min(room / max(sqrt(across * across + down * down), 1e-30), 1.0);
+    across *= keep;
+    down *= keep;
+    vec4 texel = footprint_mean(shading, local, layer, across, down);
     vec3 normal = normalize(texel.xyz);
     // The triangle drawn here faces the camera; relief in its texture that faces away is
     // seen edge-on (its limb, mu -> 0), not black: a cut to 0 at mu = 0 flickered between
