@@ -66,6 +66,17 @@ def test_frames_round_trip_with_reused_buffers(tmp_path):
             np.testing.assert_array_equal(f.depth_m(k), rounded_reference(depth))
 
 
+@pytest.mark.parametrize("name", ["radiance", "depth_m"])
+def test_a_frame_with_a_nan_is_refused_by_name_and_leaves_no_file(tmp_path, name):
+    images = {"radiance": np.ones((4, 3), np.float32), "depth_m": np.ones((4, 3), np.float32)}
+    images[name][2, 1] = np.nan
+    with pytest.raises(ValueError, match=rf"frames.h5: frame 1 .* 1 {name} values that are not finite"):
+        with FramesWriter(tmp_path / "frames.h5", 4, 3, {"width": 3, "height": 4}) as out:
+            out.append(0.0, 0, np.ones((4, 3), np.float32), np.ones((4, 3), np.float32))
+            out.append(0.1, 1, images["radiance"], images["depth_m"])
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("buffers", [1, 2, 3])
 def test_radiance_chunks_take_turns_in_a_ring_of_buffers(tmp_path, buffers):
     rng = np.random.default_rng(8)

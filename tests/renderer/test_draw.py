@@ -461,6 +461,19 @@ def test_earthshine_on_a_flat_plane_is_the_lambert_sphere_value(shading_levels):
     assert frames[1] - frames[0] == pytest.approx(np.full((16, 16), expected), rel=2e-3)
 
 
+@pytest.mark.parametrize("shading_levels", [0, 1], ids=["vertex", "pixel"])
+def test_a_nan_in_the_law_reaches_the_frame_as_a_nan_not_a_black_pixel(shading_levels):
+    # The shaders' final clamp made a NaN 0 on llvmpipe: black ground that no stage's check
+    # could tell from shadow (a B0 of 1e25 rendered so; docs/accuracy.md).
+    flat = GridTerrain(np.zeros((2, 2)), 1.0, (0.0, 0.0))
+    sun = Sun(1.496e11, 0.0, 30.0)
+    tiles = TileSet(flat, sun.direction, 1e12, 5e3, LodSettings(shading_levels=shading_levels), scattered_azimuths=0)
+    with TerrainRenderer(tiles, Camera(8, 8, 10.0), sun, ReflectanceParams(), backend=BACKEND) as renderer:
+        renderer._uniforms["irradiance"] = float("nan")
+        frame = renderer.render(camera_pose(state(altitude=100.0)))
+    assert (frame.depth_m > 0).all() and np.isnan(frame.radiance).all()
+
+
 def test_rendered_regolith_backscatters():
     """Equal incidence and emission (60 deg), opposition surge off: a flat plane seen with
     the Sun behind the camera (g = 0) is brighter than with the Sun ahead (g = 120 deg),

@@ -123,7 +123,14 @@ class FramesWriter:
 
     def append(self, t_s: float, frame_index: int, radiance: np.ndarray, depth_m: np.ndarray) -> np.ndarray:
         """Adds a frame; returns its radiance rounded as stored (a buffer reused by the next
-        call: copy it to keep it)."""
+        call: copy it to keep it). A frame with a NaN or an inf is refused: the renderer's
+        fault (no input the config check accepts makes one), and the file is not written."""
+        for name, image in (("radiance", radiance), ("depth_m", depth_m)):
+            if not np.isfinite(image).all():
+                raise ValueError(
+                    f"{self.path}: frame {len(self._t)} (t = {t_s} s) has {np.count_nonzero(~np.isfinite(image))} "
+                    f"{name} values that are not finite: a renderer bug, please report it; nothing is written"
+                )
         ensure_free_space(self.path, len(self._sets) * np.asarray(radiance).size * 4)  # uncompressed
         i = len(self._t)
         with write_errors_named(self.path):

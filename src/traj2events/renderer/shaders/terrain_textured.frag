@@ -60,6 +60,9 @@ void main()
     float per_mu0 = law_per_mu0(mu0, mu, phase_term(dot(sun_dir, normalize(frag_to_camera_m))));
     float direct = per_mu0 * clamp(texel.w, 0.0, 1.0) * irradiance / PI;
     float earthshine = earthshine_radiance(normal);
-    float radiance = clamp(direct + frag_scattered + earthshine, 0.0, radiance_max);
+    float radiance = direct + frag_scattered + earthshine;
+    // A NaN passes (clamp made it 0 on llvmpipe: a black pixel no check tells from shadow),
+    // so that frames.h5's writer refuses the frame.
+    radiance = isnan(radiance) ? radiance : clamp(radiance, 0.0, radiance_max);
     frag_color = vec4(radiance, 1.0 / gl_FragCoord.w, 0.0, 1.0);
 }
