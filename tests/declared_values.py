@@ -69,7 +69,8 @@ def _floats(bounds: dict, cap: float, normal: bool):
     """Floats inside a declaration's bounds, capped at `cap`; open bounds (`gt`, `lt`) left
     out by Hypothesis itself, so that the search reaches the float next to them (the
     smallest subnormal above gt=0 found issue 71's 112 s shot-noise sort)."""
-    lo, hi = bounds.get("ge", bounds.get("gt", 0.0)), min(bounds.get("le", bounds.get("lt", np.inf)), cap)
+    hi = min(bounds.get("le", bounds.get("lt", np.inf)), cap)
+    lo = bounds.get("ge", bounds.get("gt", -hi))  # no lower bound (a lens's coefficients): as far below 0
     open_lo, open_hi = "gt" in bounds, "lt" in bounds and hi == bounds["lt"]
     if normal and lo == 0 and open_lo:  # gt=0: from the smallest normal float up
         lo, open_lo = SMALLEST[np.float64], False

@@ -9,8 +9,6 @@ import sys
 import numpy as np
 import pytest
 import yaml
-from hypothesis import given
-from hypothesis import strategies as st
 
 from conftest import ROOT
 from traj2events.config import ConfigError, load_config, load_yaml, resolve_config, validate_config
@@ -352,8 +350,6 @@ def test_bad_values_are_refused_naming_the_key(overlay, fragments):
 
 
 def write_dem(path, kind):
-    import numpy as np
-
     if kind == "1-D":
         np.save(path, np.zeros(10))
     elif kind == "NaN":
@@ -452,42 +448,6 @@ def test_a_supersampled_image_beyond_what_opengl_draws_is_refused_naming_the_key
     with pytest.raises(ConfigError, match=r"'render\.supersample'.*expected at most 16384 px a side"):
         resolve_config({"camera": camera, "render": {"supersample": supersample}})
     resolve_config({"camera": {"width": 1024, "height": 1024}, "render": {"supersample": 16}})  # 16 384: drawn
-
-
-CAMERAS = (st.integers(1, 8), st.integers(1, 8), st.floats(0.5, 179.5), st.floats(0, 99),
-           st.tuples(*[st.floats(-2, 2)] * 5), st.floats(1.70e6, 1.76e6))  # fmt: skip
-POSES = (st.floats(0.5, 4), st.tuples(*[st.floats(-89, 89)] * 3), st.floats(-3, 0))
-
-
-@given(*CAMERAS, *POSES)
-def test_no_camera_the_check_accepts_gives_the_motion_field_a_nan(w, h, fov, mount, k, radius, log_alt, att, log_dt):
-    """Issue 71: configs drawn across the camera's and the sphere's bounds; for each the
-    config check accepts, the motion field's law at a pose 3 m to 10 km up gives a finite
-    flow and displacement at every pixel, and no lens the check accepts is refused by the
-    stage (a fold between the pixel centres, from tangential terms near 1, passed the
-    border's check before the check computed the centres' rays: docs/accuracy.md)."""
-    from traj2events.geometry.camera import Camera
-    from traj2events.geometry.motion_field import sphere_motion
-
-    camera = {"width": w, "height": h, "fov_deg": fov, "mount_height_m": mount,
-              "distortion": dict(zip(("k1", "k2", "p1", "p2", "k3"), k))}  # fmt: skip
-    overlay = {"camera": camera, "motion_field": {"moon_radius_m": radius}, "scenarios": {"descent": {}}}
-    try:
-        config = resolve_config(overlay)
-    except ConfigError:
-        return
-    state = np.zeros(13)
-    state[2], state[3:6], state[6:9], state[9:12] = (
-        -(10**log_alt),
-        (20, -5, 10),
-        np.radians(att),
-        (0.05, -0.02, 0.01),
-    )
-    later = state.copy()
-    later[:3] += state[3:6] * 10**log_dt
-    later[6:9] += state[9:12] * 10**log_dt
-    flow, displacement, _ = sphere_motion(Camera.from_settings(config["camera"]), state, later, radius)
-    assert np.isfinite(flow).all() and np.isfinite(displacement).all()
 
 
 def test_a_lens_folding_between_the_pixel_centres_is_refused_before_any_job():

@@ -21,7 +21,7 @@ WITHOUT_TEST_FILE = {
     "scene/sun", "scene/terrain_kernels", "scene/view", "sensor/ordering", "sensor/parallel",
     "settings/camera", "settings/events", "settings/generate", "settings/imu", "settings/poses",
     "settings/solve", "settings/tree",
-    "stages/index", "stages/motion_field", "stages/pictures",
+    "stages/index", "stages/pictures",
     "stages/render_events", "stages/sample_trajectories",
     "trajectory/flight", "trajectory/legs",
 }  # fmt: skip

@@ -53,7 +53,7 @@ UNITS = {
     "motion_field": {"t": {"units": "s"}, "frame_index": {"units": "1"}, "flow_*": {"units": "px s-1"},
                      "displacement_*": {"units": "px"}, "status_*": _STATUS, "valid*": _VALID,
                      "range_meter/t": {"units": "s"}, "range_meter/slant_range_m": {"units": "m"},
-                     "sphere_minus_terrain_*": {"units": "px s-1"}},
+                     "sphere_minus_terrain_pixels": {"units": "1"}, "sphere_minus_terrain_*": {"units": "px s-1"}},
 }  # fmt: skip
 
 

@@ -75,9 +75,11 @@ def motion_field(
             )
         picked = np.arange(0, len(tr.t) - 1, every_n_frames)  # each needs its next frame
         n, h, w = len(picked), camera.height, camera.width
-        # Per field: sphere minus terrain-true flow where both exist (mean (u, v) and RMS, px/s).
-        offset_mean = np.full((n, 2), np.nan, np.float32)
-        offset_rms = np.full(n, np.nan, np.float32)
+        # Per field: sphere minus terrain-true flow where both exist (mean (u, v) and RMS, px/s),
+        # and over how many pixels: 0 where none (a view of the sky), whose mean is not a NaN.
+        offset_mean = np.zeros((n, 2), np.float32)
+        offset_rms = np.zeros(n, np.float32)
+        offset_pixels = np.zeros(n, np.int64)
         attrs = {
             "width": w,
             "height": h,
@@ -121,7 +123,9 @@ def motion_field(
                     fields["status_terrain"][i] = terrain_status
                     fields["valid_terrain"][i] = terrain_status <= OCCLUDED  # terrain, in front of camera k+1
                     both = (status != SKY) & (terrain_status != SKY)  # sphere and terrain under the pixel
-                    offset_mean[i], offset_rms[i] = field_difference(flow, terrain_flow, both)
+                    offset_pixels[i] = np.count_nonzero(both)
+                    if offset_pixels[i]:
+                        offset_mean[i], offset_rms[i] = field_difference(flow, terrain_flow, both)
                 if (i + 1) % max(1, n // 10) == 0:
                     log(f"  {i + 1}/{n} fields")
             if rendered is not None:
@@ -131,11 +135,14 @@ def motion_field(
                 write_dataset(out, "range_meter/slant_range_m", rendered.slant_range_m()[poses].astype(np.float32))
                 write_dataset(out, "sphere_minus_terrain_mean_px_s", offset_mean)
                 write_dataset(out, "sphere_minus_terrain_rms_px_s", offset_rms)
-                median = float(np.nanmedian(offset_rms)) if np.isfinite(offset_rms).any() else np.nan
+                write_dataset(out, "sphere_minus_terrain_pixels", offset_pixels)
+                measured = offset_pixels > 0
+                median = float(np.median(offset_rms[measured])) if measured.any() else 0.0
                 attrs["sphere_minus_terrain_rms_px_s_median"] = median
                 log(
-                    f"sphere minus terrain-true field: median RMS {median:.3g} px/s, "
-                    f"mean offset {np.nanmean(offset_mean, axis=0)} px/s"
+                    f"sphere minus terrain-true field: median RMS {median:.3g} px/s, mean offset "
+                    f"{offset_mean[measured].mean(axis=0) if measured.any() else 'none'} px/s "
+                    f"({np.count_nonzero(measured)} of {n} fields see ground in both)"
                 )
             set_attrs(out, attrs)
     finally:
