@@ -178,10 +178,11 @@ def _external_errors(config: dict, name: str, sc: dict, sun: list) -> list[str]:
     """An external scenario (scenarios.<name>.poses): no OCP key beside it, SPICE settings
     for its meta-kernels, every file read now (settings.poses.external_extents: a file that
     cannot be used stops the run before any job), at least 2 frames per flight."""
+    from .formats.events import MAX_T_US
     from .formats.hdf5 import FileFormatError
     from .formats.poses import pose_format
     from .settings.poses import external_extents
-    from .settings.tree import OCP_SCENARIO_KEYS
+    from .settings.tree import CEILING_M, OCP_SCENARIO_KEYS, REACH_M
 
     errors = [f"config key 'scenarios.{name}.{key}': expected [min, max] with min <= max, got {[lo, hi]}"
               for key, (lo, hi) in sun if lo > hi]  # fmt: skip
@@ -206,6 +207,16 @@ def _external_errors(config: dict, name: str, sc: dict, sun: list) -> list[str]:
         if extent["tf_s"] * config["camera"]["fps"] < 1:
             errors.append(f"config key 'camera.fps': expected at least 2 frames per trajectory, {path} lasts "
                           f"{extent['tf_s']:.3g} s")  # fmt: skip
+        # The domains the laws are checked over (docs/decisions/0012) and events.h5's clock: a
+        # file beyond them failed the events job after hours of rendering, or left every domain.
+        key = f"config key 'scenarios.{name}.poses.files'"
+        if extent["tf_s"] > MAX_T_US / 1e6:
+            errors.append(f"{key}: {path} lasts {extent['tf_s']:.6g} s, expected at most {MAX_T_US / 1e6:.6g} s "
+                          "(events.h5's clock: uint32 us, as DSEC's)")  # fmt: skip
+        if extent["reach_m"] > REACH_M or extent["top_m"] > CEILING_M:
+            errors.append(f"{key}: {path} goes {extent['reach_m']:.4g} m from the site and {extent['top_m']:.4g} m "
+                          f"up, expected within {REACH_M:.4g} m and at most {CEILING_M:.4g} m up (where the site "
+                          "frame and the renderer are checked)")  # fmt: skip
     return errors
 
 

@@ -2,28 +2,35 @@
 formats/spice.py, stages/external_poses.py): the interpolation against motions it must
 reproduce exactly (a free fall, a turn at a constant rate) and against a solved landing,
 the frame conventions checked with values worked by hand, a trajectory the project writes
-and reads back, and a small SPICE SPK/CK pair made here."""
+and reads back, a small SPICE SPK/CK pair made here, and pose files drawn through the config
+check and the stage (docs/accuracy.md "End-to-end stress")."""
 
 import json
 import re
 
+import h5py
 import numpy as np
 import pandas as pd
 import pytest
+from hypothesis import event, example, given, settings
+from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 from conftest import landing_bc
+from traj2events.config import ConfigError, resolve_config
 from traj2events.formats.hdf5 import FileFormatError
 from traj2events.formats.imu import read_imu
 from traj2events.formats.poses import read_pose_samples
 from traj2events.formats.trajectory import read_trajectory, vehicle_attrs, write_trajectory
 from traj2events.geometry.camera import camera_motion, camera_pose
+from traj2events.settings.poses import external_pose_settings
 from traj2events.stages.external_poses import external_poses
 from traj2events.stages.imu import imu_command
 from traj2events.stages.index import index_row
 from traj2events.trajectory.dynamics import Dynamics
 from traj2events.trajectory.external import ExternalFlight, PoseSamples, quaternions_from_euler, site_axes
 from traj2events.trajectory.flight import camera_samples, flight_of
+from traj2events.trajectory.state import MASS
 from traj2events.trajectory.upsample import upsample
 
 G = 1.6242
@@ -342,3 +349,87 @@ def test_the_point_under_a_turning_camera_accelerates_as_a_rigid_body_says():
     # Slerp's rate within a 10 ms interval is its mean: omega off by up to alpha dt / 2.
     assert flight.acceleration(tm) == pytest.approx(tangential + centripetal, abs=2e-4)
     assert np.abs(flight.acceleration(tm) - tangential - centripetal).max() < 0.01 * np.abs(tangential).max()
+
+
+LEVEL = {"qw": [1.0, 1.0], "qx": [0.0, 0.0], "qy": [0.0, 0.0], "qz": [0.0, 0.0]}  # two samples, camera level
+
+
+def pose_tables() -> st.SearchStrategy[dict]:
+    """Pose files' columns: 2-5 samples from any time, steps 1 ns to 3 h (events.h5's clock
+    holds 71.6 min), up to 300 km out and 120 km up or just below the ground; any first
+    attitude, each next turned by up to 99 deg (90 the most the check takes), quaternions of
+    either sign, some up to 2e-3 off unit length; velocities that agree with the positions
+    (each interval's mean its difference quotient) or none."""
+    floats = st.floats
+    return st.integers(2, 5).flatmap(lambda k: st.tuples(
+        floats(-1e12, 1e12), st.lists(floats(1e-9, 1e4), min_size=k - 1, max_size=k - 1),
+        st.lists(st.tuples(floats(-3e5, 3e5), floats(-3e5, 3e5), floats(-5.0, 1.2e5)), min_size=k, max_size=k),
+        st.tuples(*[floats(-np.pi, np.pi)] * 3), st.lists(st.tuples(*[floats(-1.0, 1.0)] * 3), min_size=k - 1,
+                                                          max_size=k - 1),
+        st.lists(st.tuples(st.sampled_from([1.0, -1.0]), st.one_of(st.just(1.0), st.just(1.0), floats(0.998, 1.002))),
+                 min_size=k, max_size=k),
+        st.one_of(st.none(), st.tuples(*[floats(-100.0, 100.0)] * 3)),
+    ).map(_pose_table))  # fmt: skip
+
+
+def _pose_table(drawn) -> dict:
+    t0, steps, points, first_angles, turns, scales, first_velocity = drawn
+    t = t0 + np.concatenate([[0.0], np.cumsum(steps)])
+    p = np.array(points) * [1.0, 1.0, -1.0]  # z down: altitude up
+    attitude = [Rotation.from_euler("ZYX", first_angles)]
+    for turn in turns:
+        attitude.append(attitude[-1] * Rotation.from_rotvec(turn))
+    q = np.array([r.as_quat()[[3, 0, 1, 2]] for r in attitude]) * np.prod(scales, axis=1)[:, None]
+    table = {"t_s": t, "x_m": p[:, 0], "y_m": p[:, 1], "z_m": p[:, 2], "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2],
+             "qz": q[:, 3]}  # fmt: skip
+    if first_velocity is not None:
+        with np.errstate(all="ignore"):
+            quotients = np.diff(p, axis=0) / np.diff(t)[:, None]
+        v = [np.array(first_velocity) + quotients[0]]
+        for quotient in quotients:  # (v_k + v_k+1) / 2 = the interval's quotient
+            v.append(2.0 * quotient - v[-1])
+        table |= dict(zip(("vx_m_s", "vy_m_s", "vz_m_s"), np.array(v).T))
+    return table
+
+
+@settings(max_examples=max(settings.default.max_examples // 10, 10), deadline=None)
+# the probes' finds: a file lasting 1e5 s (the events job refused it after the render) and one 1e30 m out
+@example({"t_s": [0.0, 1e5], "x_m": [0.0, 1.0], "y_m": [0.0, 0.0], "z_m": [-10.0, -10.0], **LEVEL})
+@example({"t_s": [0.0, 1.0], "x_m": [0.0, 1e30], "y_m": [0.0, 0.0], "z_m": [-10.0, -10.0], **LEVEL})
+# the search's: samples 3127 s and 4 ms apart, whose spline flew 200 km out between them
+@example(
+    {
+        "t_s": [0.0, 3127.0, 3127.00390625],
+        "x_m": [0.0] * 3,
+        "y_m": [0.0, 0.0, 1.0],
+        "z_m": [0.0] * 3,
+        **{k: v + v[:1] for k, v in LEVEL.items()},
+    }
+)
+@given(pose_tables())
+def test_no_pose_file_the_check_accepts_gives_a_nan_or_leaves_the_laws_domains(tmp_path_factory, table):
+    """Issue 71: pose files drawn across what a user may write; each the config check
+    accepts (the others refused naming the file) the stage turns into a trajectory.h5 whose
+    poses and camera are finite (the mass, not known, is NaN), within 200 km of the site and
+    100 km up and at most 71.6 min long, and whose first camera pose is the file's first."""
+    folder = tmp_path_factory.mktemp("poses")
+    pd.DataFrame(table).to_csv(folder / "a.csv", index=False)
+    try:
+        config = resolve_config(flown_config(folder, [folder / "a.csv"]))
+    except ConfigError as error:
+        assert "a.csv" in str(error) or "camera.fps" in str(error)
+        event(f"refused: {' '.join(re.findall(r'[a-z]{4,}', str(error).split('a.csv')[-1])[:4])}")
+        return
+    external_poses(folder / "a.csv", 0, external_pose_settings(config, "flown"), folder / "trajectory.h5")
+    tr = read_trajectory(folder / "trajectory.h5")
+    for states in (tr.state_nodes, tr.state):
+        assert np.isfinite(np.delete(states, MASS, axis=1)).all() and np.isnan(states[:, MASS]).all()
+    # (the check samples the path 32 times an interval: a frame between two may lie a little beyond)
+    assert tr.t[-1] <= 4294.967296 and np.all(np.hypot(tr.state[:, 0], tr.state[:, 1]) <= 1.01 * 2e5 + 100.0)
+    with h5py.File(folder / "trajectory.h5") as f:
+        position, quaternion = f["camera/position_m"][0], f["camera/quaternion_xyzw"][0]
+        assert np.isfinite(f["camera/T_world_cam"][()]).all()
+    first = np.array([table[k][0] for k in ("x_m", "y_m", "z_m")])
+    assert position == pytest.approx(first, abs=8 * np.finfo(float).eps * np.abs(first).sum() + 1e-9)
+    expected = Rotation.from_quat([table[k][0] for k in ("qx", "qy", "qz", "qw")]).as_matrix()
+    assert Rotation.from_quat(quaternion).as_matrix() == pytest.approx(expected, abs=1e-12)

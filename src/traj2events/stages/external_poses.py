@@ -15,25 +15,30 @@ from ..formats.trajectory import write_trajectory
 from ..progress import log
 from ..provenance import provenance
 from ..settings.poses import check_external_pose_settings
-from ..trajectory.external import ExternalFlight, PoseSamples, interpolation_record, sample_problems
+from ..trajectory.external import ExternalFlight, PoseSamples, interpolation_record, path_problems, sample_problems
 
 
-def external_samples(source: str | os.PathLike, settings: dict) -> tuple[PoseSamples, dict]:
-    """The source's samples (time from the first), and its record; a source that cannot be
-    used, or whose frames look mistaken, is an error naming the file."""
+def external_flight(source: str | os.PathLike, settings: dict) -> tuple[PoseSamples, dict, ExternalFlight]:
+    """The source's samples (time from the first), its record and the interpolated flight;
+    a source that cannot be used, whose frames look mistaken or whose interpolation flies
+    below the ground, is an error naming the file."""
     samples, record = read_pose_samples(source, settings["mount_height_m"], settings.get("spice"))
+    record = {**record, "source_t0_s": float(samples.t_s[0])}
     problems = sample_problems(samples, settings["moon_radius_m"])
+    if not problems:
+        samples = samples.shifted()
+        flight = ExternalFlight(samples, settings["mount_height_m"])
+        problems = path_problems(flight.camera_path(), settings["moon_radius_m"])
     if problems:
         raise FileFormatError(f"{source}: {problems[0]}")
-    return samples.shifted(), {**record, "source_t0_s": float(samples.t_s[0])}
+    return samples, record, flight
 
 
 def external_poses(source: str | os.PathLike, trajectory_id: int, settings: dict, output: str | os.PathLike) -> None:
     """Write trajectory.h5 of `source` at settings' fps: settings = settings.poses.external_pose_settings's
     (fps, mount_height_m, moon_radius_m, g_m_s2, scenario, seed, spice)."""
     settings = check_external_pose_settings(settings)
-    samples, record = external_samples(source, settings)
-    flight = ExternalFlight(samples, settings["mount_height_m"])
+    samples, record, flight = external_flight(source, settings)
     tf = float(samples.t_s[-1])
     # k / fps up to t_f, a frame within 1e-6 of one frame interval of t_f counted (the file's times are rounded).
     t = np.minimum(np.arange(int(np.floor(tf * settings["fps"] + 1e-6)) + 1) / settings["fps"], tf)

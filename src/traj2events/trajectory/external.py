@@ -27,6 +27,10 @@ from .state import ATTITUDE, BODY_RATES, N_STATE, POSITION, VELOCITY
 
 HERMITE_POSITION = "position: cubic Hermite"  # how interpolation_record names the Hermite
 MAX_STEP_DEG = 90.0  # a larger turn between two samples: slerp's shortest way may not be the flown one
+# Times per interval at which the camera's interpolated path is checked: a cubic through
+# samples at uneven steps overshoots between them (samples 1 m apart 3127 s and 4 ms apart
+# flew 200 km out between them; others dipped below the ground).
+PATH_POINTS = 32
 
 
 @dataclass(frozen=True)
@@ -99,6 +103,16 @@ def sample_problems(samples: PoseSamples, moon_radius_m: float) -> list[str]:
     return problems
 
 
+def path_problems(path_m: np.ndarray, moon_radius_m: float) -> list[str]:
+    """What the camera's interpolated path (`ExternalFlight.camera_path`) does that its
+    samples do not show, each a sentence: dipping below the sphere through the site."""
+    altitude = np.linalg.norm(path_m - [0.0, 0.0, moon_radius_m], axis=1) - moon_radius_m
+    if altitude.min() >= -1.0:
+        return []
+    return [f"the interpolation between the samples flies {-altitude.min():.3g} m below the surface (samples at "
+            "uneven steps overshoot): sample it more evenly or give velocities"]  # fmt: skip
+
+
 def interpolation_record(samples: PoseSamples) -> str:
     """How ExternalFlight makes the poses between `samples` (trajectory.h5's `interpolation`)."""
     if samples.velocity_m_s is not None:
@@ -130,6 +144,17 @@ class ExternalFlight:
         middles = (self.t_nodes[1:] + self.t_nodes[:-1]) / 2
         self._alpha_t = self.t_nodes[1:-1]
         self._alpha = np.diff(self._rates, axis=0) / np.diff(middles)[:, None]
+
+    def camera_position(self, t: np.ndarray) -> np.ndarray:
+        """(len(t), 3) the camera's position, m, site frame: the samples' interpolation."""
+        return self._camera(np.atleast_1d(np.asarray(t, dtype=float)))
+
+    def camera_path(self, per_interval: int = PATH_POINTS) -> np.ndarray:
+        """(n, 3) the camera's positions at `per_interval` times evenly over each interval
+        between samples (its ends included): where the interpolation flies between them."""
+        s = np.linspace(0.0, 1.0, per_interval + 1)[:-1]
+        t = (self.t_nodes[:-1, None] + np.diff(self.t_nodes)[:, None] * s).ravel()
+        return self.camera_position(np.append(t, self.t_nodes[-1]))
 
     def _interval(self, t: np.ndarray) -> np.ndarray:
         if len(t) and (t.min() < self.t_nodes[0] - 1e-9 or t.max() > self.t_nodes[-1] + 1e-9):
