@@ -383,11 +383,11 @@ def _pose_table(drawn) -> dict:
     table = {"t_s": t, "x_m": p[:, 0], "y_m": p[:, 1], "z_m": p[:, 2], "qw": q[:, 0], "qx": q[:, 1], "qy": q[:, 2],
              "qz": q[:, 3]}  # fmt: skip
     if first_velocity is not None:
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"):  # (steps too short for their float: inf velocities, refused)
             quotients = np.diff(p, axis=0) / np.diff(t)[:, None]
-        v = [np.array(first_velocity) + quotients[0]]
-        for quotient in quotients:  # (v_k + v_k+1) / 2 = the interval's quotient
-            v.append(2.0 * quotient - v[-1])
+            v = [np.array(first_velocity) + quotients[0]]
+            for quotient in quotients:  # (v_k + v_k+1) / 2 = the interval's quotient
+                v.append(2.0 * quotient - v[-1])
         table |= dict(zip(("vx_m_s", "vy_m_s", "vz_m_s"), np.array(v).T))
     return table
 
