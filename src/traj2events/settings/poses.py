@@ -160,6 +160,6 @@ def _extent(path: str, modified: float, settings_json: str) -> dict:
     from ..stages.external_poses import external_flight
 
     samples, _, flight = external_flight(path, json.loads(settings_json))
-    p = flight.camera_path()  # (the samples and the interpolation between them)
+    p = flight.camera_path  # (the samples and the interpolation between them)
     return {"tf_s": float(samples.t_s[-1]), "reach_m": float(np.hypot(p[:, 0], p[:, 1]).max()),
             "top_m": float(-p[:, 2].min())}  # fmt: skip

@@ -28,7 +28,7 @@ def external_flight(source: str | os.PathLike, settings: dict) -> tuple[PoseSamp
     if not problems:
         samples = samples.shifted()
         flight = ExternalFlight(samples, settings["mount_height_m"])
-        problems = path_problems(flight.camera_path(), settings["moon_radius_m"])
+        problems = path_problems(flight.camera_path, settings["moon_radius_m"])
     if problems:
         raise FileFormatError(f"{source}: {problems[0]}")
     return samples, record, flight

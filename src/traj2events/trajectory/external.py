@@ -17,6 +17,7 @@ is not known: NaN in the states.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -149,10 +150,12 @@ class ExternalFlight:
         """(len(t), 3) the camera's position, m, site frame: the samples' interpolation."""
         return self._camera(np.atleast_1d(np.asarray(t, dtype=float)))
 
-    def camera_path(self, per_interval: int = PATH_POINTS) -> np.ndarray:
-        """(n, 3) the camera's positions at `per_interval` times evenly over each interval
-        between samples (its ends included): where the interpolation flies between them."""
-        s = np.linspace(0.0, 1.0, per_interval + 1)[:-1]
+    @functools.cached_property
+    def camera_path(self) -> np.ndarray:
+        """(n, 3) the camera's positions at PATH_POINTS times evenly over each interval
+        between samples (its ends included): where the interpolation flies between them
+        (the stage's check and the config's extents read it: computed once)."""
+        s = np.linspace(0.0, 1.0, PATH_POINTS + 1)[:-1]
         t = (self.t_nodes[:-1, None] + np.diff(self.t_nodes)[:, None] * s).ravel()
         return self.camera_position(np.append(t, self.t_nodes[-1]))
 
